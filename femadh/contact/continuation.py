@@ -1,0 +1,216 @@
+"""Continuation in the separation d: approach and retract branches, fold detection and jumps.
+
+Each grid step is taken with a predictor (the tangent dw/dd for the complementarity model,
+a secant otherwise) and the Newton corrector. A step is accepted only if the corrector
+converges to a *stable* state close to the prediction; otherwise the step is halved. When even
+the smallest step fails, the branch has folded (the stable equilibrium ceased to exist: jump-in
+on approach, jump-out on retract). The fold is reported at the last stable d, and the surface
+is then landed on the other branch by minimising the total energy from the last state
+(L-BFGS-B with the gap bound h >= sigma), which is where a quasi-static surface would snap to,
+and polished by Newton.
+"""
+from dataclasses import dataclass, field
+import math
+import time
+
+import numpy as np
+from scipy import optimize
+
+from ..errors import ConvergenceError
+from .newton import solve_state, tangent
+
+#: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
+MIN_STEP_FRACTION = 2.0**-10
+#: a corrector that moves any gap by more than this fraction away from the prediction has
+#: left the branch (jumped) even if it converged
+MAX_CORRECTION_FRACTION = 0.25
+
+
+@dataclass
+class Jump:
+    """A fold of the equilibrium branch and where the surface landed.
+
+    Attributes
+    ----------
+    branch : str
+        ``"approach"`` (jump-in) or ``"retract"`` (jump-out).
+    d_fold : float
+        Last separation (m) at which the departing branch was found stable.
+    d_land : float
+        Separation (m) at which the landing state was computed (d_fold + smallest step).
+    resolution : float
+        |d_land - d_fold| (m): the fold lies within this distance of d_fold.
+    before, after : State
+        The last state of the departing branch and the landing state.
+    """
+
+    branch: str
+    d_fold: float
+    d_land: float
+    resolution: float
+    before: object
+    after: object
+
+
+@dataclass
+class Sweep:
+    """The states of one branch at the requested separations, and its folds."""
+
+    branch: str
+    states: list = field(default_factory=list)
+    jumps: list = field(default_factory=list)
+    n_solves: int = 0
+    wall_time: float = 0.0
+
+
+def _accept(new, pred_w, d):
+    if not (new.converged and new.stable):
+        return False
+    # gaps of the prediction; the sphere moves by d but b - w_pred is what was predicted
+    h_pred = new.h + (new.w - pred_w)
+    change = np.abs(new.w - pred_w)
+    return bool(np.all(change <= MAX_CORRECTION_FRACTION * np.maximum(h_pred, 0) + 1e-15))
+
+
+PREDICTOR = "tangent"
+
+
+def _predict(problem, state, prev, d):
+    """Predicted displacements at d and the active set they imply."""
+    if prev is not None and prev.d != state.d and PREDICTOR == "secant":
+        s = (d - state.d) / (state.d - prev.d)
+        w = state.w + s * (state.w - prev.w)
+    elif state.lu is not None and problem.contact_model != "hertz-closure":
+        w = state.w + tangent(problem, state) * (d - state.d)
+    else:
+        w = state.w.copy()
+    if problem.sigma is None:
+        return w, state.active
+    return w, state.active | (problem.contour(d) - w < problem.sigma)
+
+
+def land(problem, d, w_start, *, tol, max_iter):
+    """Equilibrium reached by energy descent from w_start at separation d (a jump's landing).
+
+    Minimises elastic + interaction energy with L-BFGS-B under the bound h >= sigma (or
+    h >= z_min for a smooth sphere, where the LJ repulsion keeps the minimiser far from it),
+    then polishes with the Newton corrector of the problem's contact model.
+    """
+    b = problem.contour(d)
+    if problem.sigma is not None:
+        h_floor = problem.sigma
+    else:
+        z0s = [getattr(e, "z0", None) for e in problem.effects.values()]
+        h_floor = 0.3 * min(z for z in z0s if z) if any(z0s) else 1e-12
+    scale = max(float(np.max(np.abs(b))), problem.sigma or 0.0, 1e-10)
+    e_scale = None
+
+    def fun(x):
+        nonlocal e_scale
+        w = x * scale
+        e = problem.energy(w, d)
+        g = problem.energy_gradient(w, d) * scale
+        if e_scale is None:
+            e_scale = max(abs(e), float(np.max(np.abs(g))), 1e-30)
+        return e / e_scale, g / e_scale
+
+    upper = (b - h_floor) / scale
+    x0 = np.minimum(w_start / scale, upper)
+    bounds = list(zip([None] * b.size, upper))
+    opt = optimize.minimize(fun, x0, jac=True, method="L-BFGS-B", bounds=bounds,
+                            options={"maxiter": 20000, "ftol": 1e-15, "gtol": 1e-12})
+    w = opt.x * scale
+    active = (b - w) <= h_floor * (1 + 1e-9) if problem.sigma is not None else None
+    st = solve_state(problem, d, w, tol=tol, max_iter=max_iter, active0=active,
+                     r_c0=None)
+    return st
+
+
+def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
+          progress=None):
+    """Follow the stable equilibrium through the separations ``d_values`` (m).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    d_values : sequence of float
+        Separations in the order they are visited (decreasing for an approach).
+    branch : str
+        Label of the branch (``"approach"`` or ``"retract"``).
+    tol : float
+        Residual tolerance (m) every state must meet.
+    start : State, optional
+        Converged state at d_values[0] to continue from (else solved from w = 0).
+    on_state : callable(State), optional
+        Called with each converged grid state as soon as it exists (writes it to disk).
+    progress : callable(int), optional
+        Called with the number of grid steps finished.
+
+    Raises
+    ------
+    ConvergenceError
+        If a grid separation cannot be reached with a converged, stable state even after
+        step halving and an energy-descent landing. States already passed to ``on_state``
+        are kept by the caller.
+    """
+    t0 = time.perf_counter()
+    sweep = Sweep(branch)
+    d_values = [float(x) for x in d_values]
+    if start is None:
+        state = solve_state(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
+                            max_iter=max_iter)
+        sweep.n_solves += 1
+        if not (state.converged and state.stable):
+            state = land(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
+                         max_iter=max_iter)
+            sweep.n_solves += 1
+        _check(state, "first state", tol)
+    else:
+        state = start
+    sweep.states.append(state)
+    if on_state:
+        on_state(state)
+    prev = None
+    for k, d_next in enumerate(d_values[1:], start=1):
+        grid_step = d_next - state.d
+        step = grid_step
+        min_step = abs(grid_step) * MIN_STEP_FRACTION
+        while state.d != d_next:
+            d_try = state.d + step
+            if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
+                    abs(d_next - d_try) < 0.5 * min_step:
+                d_try = d_next
+            w_pred, act = _predict(problem, state, prev, d_try)
+            new = solve_state(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
+                              active0=act, r_c0=state.r_c, factor=state.lu)
+            sweep.n_solves += 1
+            if _accept(new, w_pred, d_try):
+                prev, state = state, new
+                step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
+                continue
+            if abs(step) > min_step * 1.5:
+                step *= 0.5
+                continue
+            # Fold: no stable state continues the branch beyond state.d.
+            landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
+            sweep.n_solves += 1
+            _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol)
+            sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
+            prev, state = None, landed
+        sweep.states.append(state)
+        if on_state:
+            on_state(state)
+        if progress:
+            progress(k)
+    sweep.wall_time = time.perf_counter() - t0
+    return sweep
+
+
+def _check(state, what, tol):
+    if not state.converged:
+        raise ConvergenceError(f"{what}: Newton did not reach the tolerance {tol:.3g} m",
+                               d=state.d, residual=state.residual, n_iter=state.n_iter)
+    if not state.stable:
+        raise ConvergenceError(f"{what}: the converged state is unstable (not an energy "
+                               "minimum)", d=state.d, residual=state.residual,
+                               n_iter=state.n_iter)

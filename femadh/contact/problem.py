@@ -1,0 +1,144 @@
+"""The discrete sphere-flat problem: K w = P(h) - p_c with h = b(r; d) - w (paper 1 eqs 5-10).
+
+Unknowns live on the operator's radial nodes; pressures are piecewise constant on its annuli.
+Sign convention (one place, see :mod:`femadh.conventions`): w > 0 moves the disk surface up,
+towards the sphere; effect pressures P > 0 are attractive (pull the surface up); the contact
+pressure p_c >= 0 is repulsive.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..effects import AsperityGap
+from ..indenter import Sphere
+
+
+@dataclass(eq=False)
+class ContactProblem:
+    """Everything the solvers need, precomputed once per operator.
+
+    Parameters
+    ----------
+    operator : SurfaceOperator
+        Provides ``grid``, ``compliance`` C (m/Pa) and ``stiffness`` K = C^-1 (Pa/m).
+    sphere : Sphere
+        The rigid indenter, b(r; d) = d + shape(r) (eq 4).
+    effects : dict[str, effect]
+        Pressure laws of the gap, by name (e.g. ``{"lj": LennardJones(...)}``); only these are
+        evaluated.
+    gap : AsperityGap or None
+        The sigma-gap constraint (eq 8) and its contact model; None for a smooth sphere.
+    """
+
+    operator: object
+    sphere: Sphere
+    effects: dict
+    gap: AsperityGap | None = None
+    shape: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        g = self.operator.grid
+        self.grid = g
+        self.shape = self.sphere.shape(g.nodes)
+        self.K = self.operator.stiffness
+        self.C = self.operator.compliance
+        self.areas = g.areas
+        # Symmetric force-displacement stiffness for the energy and the stability test.
+        S = self.areas[:, None] * self.K
+        self.S_sym = 0.5 * (S + S.T)
+
+    @property
+    def contact_model(self):
+        return None if self.gap is None else self.gap.contact_model
+
+    @property
+    def sigma(self):
+        return None if self.gap is None else self.gap.sigma
+
+    def contour(self, d):
+        """b(r_k; d) (m) at the nodes."""
+        return d + self.shape
+
+    def pressure(self, h):
+        """Sum of the effect pressures (Pa, attractive positive) at gaps h."""
+        out = np.zeros_like(h)
+        for eff in self.effects.values():
+            out += eff.pressure(h)
+        return out
+
+    def dpressure(self, h):
+        """d/dh of :meth:`pressure` (Pa/m)."""
+        out = np.zeros_like(h)
+        for eff in self.effects.values():
+            out += eff.dpressure(h)
+        return out
+
+    def energy(self, w, d):
+        """Total potential energy (J): elastic 1/2 w.S.w plus sum_k area_k U(h_k).
+
+        Its gradient S w - area * P(h) vanishes at equilibrium (S = diag(area) K); it is the
+        merit function that decides where the surface lands after a jump.
+        """
+        h = self.contour(d) - w
+        u = sum(eff.energy(h) for eff in self.effects.values()) if self.effects else 0.0 * h
+        return 0.5 * w @ (self.S_sym @ w) + self.areas @ u
+
+    def energy_gradient(self, w, d):
+        h = self.contour(d) - w
+        return self.S_sym @ w - self.areas * self.pressure(h)
+
+
+@dataclass(eq=False)
+class State:
+    """A converged (or failed) equilibrium at one separation d.
+
+    Attributes
+    ----------
+    d : float
+        Separation of the sphere tip from the undeformed mean plane (m).
+    w, h : ndarray
+        Surface displacement (m, up positive) and gap h = b - w (m) at the nodes.
+    p_effects : dict[str, ndarray]
+        Each effect's pressure (Pa, attractive positive).
+    p_contact : ndarray
+        Contact (asperity elastic) pressure, repulsive positive (Pa): the complementarity
+        multiplier or the paper's Hertz closure, eq (9).
+    active : ndarray of bool
+        Nodes held at h = sigma (complementarity) or inside r_c (Hertz closure).
+    r_c : float
+        Contact radius (m): area-equivalent radius of the active set (complementarity) or the
+        closure's own r_c with h(r_c) = sigma (Hertz closure).
+    n_iter : int
+        Newton iterations of the final corrector.
+    residual : float
+        max_k |w - C (P - p_c)| (m): the residual of eq (6)/(10) itself.
+    converged, stable : bool
+        Newton met the tolerance; the state is a local energy minimum (see newton.py).
+    """
+
+    d: float
+    w: np.ndarray
+    h: np.ndarray
+    p_effects: dict
+    p_contact: np.ndarray
+    active: np.ndarray
+    r_c: float
+    n_iter: int
+    residual: float
+    converged: bool
+    stable: bool
+    lu: object = None  # factorisation of the reduced Jacobian (tangent predictor), transient
+    diagnostics: dict = field(default_factory=dict)
+
+    @property
+    def h0(self):
+        """Gap at the axis, h(0) = d - w(0) (m)."""
+        return float(self.h[0])
+
+    @property
+    def p_total(self):
+        """Net attractive surface pressure (Pa): sum of effects minus contact pressure."""
+        p = -self.p_contact.copy()
+        for v in self.p_effects.values():
+            p += v
+        return p

@@ -1,0 +1,52 @@
+"""Lennard-Jones surface pressure between mean planes, paper 1 eq (3)."""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class LennardJones:
+    """LJ pressure P(h) = A/(6 pi h^3) [1 - (z0/h)^6] (Pa), positive = attractive (eq 3).
+
+    Attributes
+    ----------
+    hamaker : float
+        Hamaker constant A (J).
+    z0 : float
+        Atomic equilibrium distance z0 (m); P(z0) = 0.
+    """
+
+    hamaker: float
+    z0: float
+
+    def pressure(self, h):
+        """Attractive pressure (Pa) at gap h (m), eq (3)."""
+        h = np.asarray(h, dtype=float)
+        s = (self.z0 / h) ** 6
+        return self.hamaker / (6.0 * math.pi * h**3) * (1.0 - s)
+
+    def dpressure(self, h):
+        """dP/dh (Pa/m): -A/(2 pi h^4) [1 - 3 (z0/h)^6]."""
+        h = np.asarray(h, dtype=float)
+        s = (self.z0 / h) ** 6
+        return -self.hamaker / (2.0 * math.pi * h**4) * (1.0 - 3.0 * s)
+
+    def energy(self, h):
+        """Interaction energy per area (J/m^2), zero at h -> inf; dU/dh = P.
+
+        U(h) = -A/(12 pi h^2) [1 - (z0/h)^6 / 4]; U(z0) = -A/(16 pi z0^2) = -Delta gamma (eq 19).
+        """
+        h = np.asarray(h, dtype=float)
+        s = (self.z0 / h) ** 6
+        return -self.hamaker / (12.0 * math.pi * h**2) * (1.0 - 0.25 * s)
+
+    @property
+    def peak_gap(self):
+        """Gap (m) of the maximum attractive pressure, 3^(1/6) z0 (paper 1 sec 5.1)."""
+        return 3.0 ** (1.0 / 6.0) * self.z0
+
+    @property
+    def work_of_adhesion(self):
+        """Delta gamma = -U(z0) = A/(16 pi z0^2) (J/m^2), eq (19)."""
+        return self.hamaker / (16.0 * math.pi * self.z0**2)

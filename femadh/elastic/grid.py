@@ -1,0 +1,75 @@
+"""Radial node sets with their annuli (piecewise-constant pressure cells)."""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class RadialGrid:
+    """Collocation nodes r_k and the annuli [e_k, e_{k+1}] that carry their pressure.
+
+    Attributes
+    ----------
+    nodes : ndarray, shape (N,)
+        Node radii (m), increasing, nodes[0] == 0 (the central disk is collocated at its centre).
+    edges : ndarray, shape (N+1,)
+        Annulus edges (m), edges[0] == 0, edges[-1] == the analysis radius a.
+    """
+
+    nodes: np.ndarray
+    edges: np.ndarray
+
+    def __post_init__(self):
+        r, e = np.asarray(self.nodes, float), np.asarray(self.edges, float)
+        if r.ndim != 1 or e.shape != (r.size + 1,):
+            raise ValueError("edges must have one more entry than nodes")
+        if e[0] != 0.0 or np.any(np.diff(e) <= 0):
+            raise ValueError("edges must start at 0 and increase strictly")
+        if np.any(r < e[:-1]) or np.any(r >= e[1:]):
+            raise ValueError("every node must lie inside its annulus [e_k, e_k+1)")
+
+    @classmethod
+    def uniform(cls, radius, n):
+        """N nodes r_k = k*dr with dr = a/(N - 1/2); annuli edges half-way between nodes.
+
+        Parameters
+        ----------
+        radius : float
+            Analysis radius a (m), the outer edge of the last annulus.
+        n : int
+            Number of nodes N >= 2.
+        """
+        if n < 2:
+            raise ValueError(f"need at least 2 nodes, got {n}")
+        dr = radius / (n - 0.5)
+        nodes = dr * np.arange(n)
+        edges = np.concatenate([[0.0], dr * (np.arange(n) + 0.5)])
+        edges[-1] = radius
+        return cls(nodes, edges)
+
+    @classmethod
+    def from_nodes(cls, nodes, radius):
+        """Annuli with edges half-way between the given nodes (nodes[0] must be 0)."""
+        nodes = np.asarray(nodes, float)
+        edges = np.concatenate([[0.0], 0.5 * (nodes[1:] + nodes[:-1]), [radius]])
+        return cls(nodes, edges)
+
+    @property
+    def n(self):
+        return self.nodes.size
+
+    @property
+    def radius(self):
+        """Analysis radius a (m)."""
+        return float(self.edges[-1])
+
+    @property
+    def areas(self):
+        """Annulus areas pi (e_{k+1}^2 - e_k^2) (m^2): the weights of force integrals."""
+        e = self.edges
+        return math.pi * (e[1:] ** 2 - e[:-1] ** 2)
+
+    def force(self, pressure):
+        """Force (N) of a piecewise-constant pressure field (Pa): sum p_k * area_k."""
+        return float(np.dot(self.areas, pressure))

@@ -1,0 +1,74 @@
+"""Units: scene quantities are strings with units ("2 mm"), parsed with pint; plain numbers are SI.
+
+Inside femadh every quantity is a float in SI units. This module is the only place that
+knows about pint, and pint is imported lazily so that the numerical core never pays for it.
+"""
+from functools import lru_cache
+
+from .errors import SceneError
+
+
+@lru_cache(maxsize=1)
+def _registry():
+    import pint
+
+    ureg = pint.UnitRegistry()
+    return ureg
+
+
+#: dimension name -> (pint dimensionality string, SI unit it is converted to, words for errors)
+DIMENSIONS = {
+    "length": ("[length]", "m", "a length such as '2 mm' or '0.165 nm'"),
+    "pressure": ("[mass] / [length] / [time] ** 2", "Pa", "a pressure such as '163 GPa'"),
+    "energy": ("[mass] * [length] ** 2 / [time] ** 2", "J", "an energy such as '1e-19 J'"),
+    "surface_energy": ("[mass] / [time] ** 2", "J/m^2", "a surface energy such as '0.06 J/m^2'"),
+    "areal_density": ("1 / [length] ** 2", "1/m^2", "an areal density such as '100 um^-2'"),
+    "temperature": ("[temperature]", "K", "a temperature such as '298.15 K'"),
+    "molar_volume": ("[length] ** 3 / [substance]", "m^3/mol", "a molar volume such as '58.7 cm^3/mol'"),
+    "dimensionless": ("", "", "a plain number"),
+}
+
+
+def to_si(value, dimension, *, file=None, key=None):
+    """Convert a scene value to a float in SI units.
+
+    Parameters
+    ----------
+    value : str or float or int
+        ``"2 mm"``-style string (any unit pint knows) or a plain number, taken as SI.
+    dimension : str
+        One of :data:`DIMENSIONS`.
+    file, key : str, optional
+        Where the value came from, for the error message.
+
+    Raises
+    ------
+    SceneError
+        If the value is not a number or does not have the expected dimension.
+    """
+    dim, si, words = DIMENSIONS[dimension]
+    if isinstance(value, bool):
+        raise SceneError(file, key, value, words)
+    if isinstance(value, (int, float)):
+        return float(value)
+    if not isinstance(value, str):
+        raise SceneError(file, key, value, words)
+    ureg = _registry()
+    try:
+        q = ureg.Quantity(value.replace("^", "**"))
+    except Exception as exc:  # pint raises many types for unparsable input
+        raise SceneError(file, key, value, f"{words} (could not parse: {exc})") from None
+    if dimension == "temperature" and not q.dimensionless and q.check("[temperature]"):
+        return float(q.to("K").magnitude)
+    if not isinstance(q, ureg.Quantity):
+        return float(q)
+    if dimension == "dimensionless":
+        if not q.dimensionless:
+            raise SceneError(file, key, value, words)
+        return float(q.to("").magnitude)
+    if q.dimensionless:
+        raise SceneError(file, key, value, f"{words}; a bare number in a string has no unit "
+                         f"(write it as a plain TOML number to mean SI)")
+    if not q.check(dim):
+        raise SceneError(file, key, value, f"{words}, but it has units of {q.units:~}")
+    return float(q.to(si.replace("^", "**")).magnitude)
