@@ -1,0 +1,104 @@
+"""Writers for run results: csv (streamed as each state is computed), json summary.
+
+Each converged state reaches disk as soon as it exists, so an interrupted or failed run keeps
+everything it computed.
+"""
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+CURVE_HEADER = ["branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
+                "residual_m", "converged"]
+DIAG_HEADER = ["branch", "d_m", "stable", "n_active", "min_gap_minus_sigma_m",
+               "min_contact_pressure_Pa", "eq10_violation_inside_m"]
+FIELD_HEADER = ["branch", "d_m", "r_m", "w_m", "h_m", "P_LJ_Pa", "P_el_Pa"]
+
+SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ = sum P_LJ dA "
+             "(attractive positive), F_el = contact (asperity elastic) force, repulsive "
+             "positive, F_ex = F_LJ - F_el. The force on the sphere is -F_ex; adhesion shows as "
+             "F_ex > 0.")
+
+
+def state_forces(problem, state):
+    """(F_LJ, F_el, F_ex) in N for a state (eqs 11-13 with 2 pi r dr area weights)."""
+    g = problem.grid
+    f_lj = g.force(state.p_effects["lj"]) if "lj" in state.p_effects else 0.0
+    f_eff = sum(g.force(p) for p in state.p_effects.values())
+    f_el = g.force(state.p_contact)
+    return f_lj, f_el, f_eff - f_el
+
+
+class RunWriter:
+    """Streams curve.csv, diagnostics.csv and fields.csv rows into an output folder."""
+
+    def __init__(self, out_dir, problem):
+        self.dir = Path(out_dir)
+        self.dir.mkdir(parents=True, exist_ok=True)
+        self.problem = problem
+        self._files = {}
+        self._writers = {}
+        for name, header in (("curve", CURVE_HEADER), ("diagnostics", DIAG_HEADER),
+                             ("fields", FIELD_HEADER)):
+            f = open(self.dir / f"{name}.csv", "w", newline="")
+            w = csv.writer(f)
+            w.writerow(header)
+            self._files[name], self._writers[name] = f, w
+
+    def write_state(self, branch, state):
+        p = self.problem
+        f_lj, f_el, f_ex = state_forces(p, state)
+        self._writers["curve"].writerow([
+            branch, _g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
+            state.n_iter, _g(state.residual), state.converged])
+        sigma = p.sigma
+        self._writers["diagnostics"].writerow([
+            branch, _g(state.d), state.stable, int(state.active.sum()),
+            _g(float(np.min(state.h) - sigma)) if sigma is not None else "",
+            _g(float(np.min(state.p_contact))) if state.active.any() else "",
+            _g(state.diagnostics.get("eq10_violation_inside_m", 0.0))])
+        p_lj = state.p_effects.get("lj", np.zeros_like(state.w))
+        rows = np.column_stack([np.full(state.w.size, state.d), p.grid.nodes, state.w, state.h,
+                                p_lj, state.p_contact])
+        fw = self._writers["fields"]
+        for row in rows:
+            fw.writerow([branch] + [_g(x) for x in row])
+        for f in self._files.values():
+            f.flush()
+
+    def close(self):
+        for f in self._files.values():
+            f.close()
+
+
+def _g(x):
+    return repr(float(x)) if math.isfinite(x) else str(x)
+
+
+def write_json(path, data):
+    Path(path).write_text(json.dumps(data, indent=2, default=_json_default) + "\n")
+
+
+def _json_default(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    raise TypeError(type(o))
+
+
+def read_curve(path):
+    """Read curve.csv into a dict of numpy arrays (and the branch labels)."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    out = {"branch": np.array([r["branch"] for r in rows])}
+    for k in CURVE_HEADER[1:]:
+        if k == "converged":
+            out[k] = np.array([r[k] == "True" for r in rows])
+        else:
+            out[k] = np.array([float(r[k]) for r in rows])
+    return out

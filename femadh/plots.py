@@ -1,0 +1,75 @@
+"""Figures a researcher would draw from a run (matplotlib, Agg backend, PNG)."""
+import numpy as np
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def paper1_panels(result, path, *, max_profiles=12):
+    """Paper 1 Fig 3-style panels: (a) w(r), (b) P_LJ(r), (c) P_el(r), (d) forces vs d,
+    (e) r_c vs -F_ex, (f) iterations and -log10(residual) per step."""
+    from .reference import dmt_contact_radius, jkr_contact_radius, surface_energy_from_hamaker
+
+    plt = _pyplot()
+    problem, scene = result.problem, result.scene
+    r_um = problem.grid.nodes * 1e6
+    fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
+    ax = ax.ravel()
+    first = next(iter(result.sweeps))
+    states = result.sweeps[first].states
+    pick = states[:: max(1, len(states) // max_profiles)]
+    cmap = plt.get_cmap("viridis")
+    for i, s in enumerate(pick):
+        c = cmap(i / max(1, len(pick) - 1))
+        lbl = f"{s.d * 1e9:.2f}"
+        ax[0].plot(r_um, s.w * 1e9, color=c, label=lbl)
+        ax[1].plot(r_um, s.p_effects.get("lj", 0 * s.w) * 1e-6, color=c)
+        ax[2].plot(r_um, s.p_contact * 1e-6, color=c)
+    ax[0].set(xlabel="r (µm)", ylabel="w (nm)", title=f"(a) disk deformation, {first}")
+    ax[0].legend(title="d (nm)", fontsize=6, ncol=2)
+    ax[1].set(xlabel="r (µm)", ylabel="P_LJ (MPa)", title="(b) LJ pressure")
+    ax[2].set(xlabel="r (µm)", ylabel="P_el (MPa)", title="(c) contact pressure")
+    styles = {"approach": "-o", "retract": "--s"}
+    for b in result.sweeps:
+        c = result.curve(b)
+        st = styles.get(b, "-")
+        ax[3].plot(c["d"] * 1e9, -c["F_LJ"] * 1e3, st, ms=3, label=f"-F_LJ {b}")
+        ax[3].plot(c["d"] * 1e9, -c["F_ex"] * 1e3, st, ms=3, label=f"-F_ex {b}")
+        ax[3].plot(c["d"] * 1e9, c["F_el"] * 1e3, st, ms=3, label=f"F_el {b}")
+        ax[4].plot(-c["F_ex"] * 1e3, c["r_c"] * 1e6, st, ms=3, label=f"femadh {b}")
+        sw = result.sweeps[b]
+        ax[5].plot([s.d * 1e9 for s in sw.states], [s.n_iter for s in sw.states], st, ms=3,
+                   label=f"iterations {b}")
+        ax[5].plot([s.d * 1e9 for s in sw.states],
+                   [-np.log10(max(s.residual / 1e-9, 1e-300)) for s in sw.states], st, ms=3,
+                   label=f"-log10(residual/nm) {b}")
+    for j in result.jumps:
+        ax[3].axvline(j.d_fold * 1e9, color="grey", lw=0.8, ls=":")
+    ax[3].set(xlabel="d (nm)", ylabel="force on slider (mN)", title="(d) forces vs separation")
+    ax[3].legend(fontsize=7)
+    if "lj" in scene.effects and scene.gap is not None:
+        lj = scene.effects["lj"]
+        dg = surface_energy_from_hamaker(lj.hamaker, scene.gap.sigma, lj.z0)  # eq 17
+        allF = np.concatenate([-result.curve(b)["F_ex"] for b in result.sweeps])
+        F = np.linspace(min(allF.min(), -2 * np.pi * scene.sphere.radius * dg), allF.max(), 200)
+        R, E = scene.sphere.radius, scene.e_star
+        ax[4].plot(F * 1e3, [jkr_contact_radius(f, R, E, dg) * 1e6 for f in F], "k-", lw=1,
+                   label="JKR (eq 17 Δγ)")
+        ax[4].plot(F * 1e3, [dmt_contact_radius(f, R, E, dg) * 1e6 for f in F], "k--", lw=1,
+                   label="DMT (eq 17 Δγ)")
+    ax[4].set(xlabel="-F_ex, force on slider (mN)", ylabel="r_c (µm)", title="(e) contact radius")
+    ax[4].legend(fontsize=7)
+    ax[5].set(xlabel="d (nm)", title="(f) iterations, -log10 residual")
+    ax[5].legend(fontsize=7)
+    fig.suptitle(f"{scene.name}: R = {scene.sphere.radius * 1e3:g} mm, "
+                 f"E* = {scene.e_star / 1e9:.1f} GPa, "
+                 + (f"σ = {scene.gap.sigma * 1e9:g} nm ({scene.gap.contact_model})"
+                    if scene.gap else "smooth sphere"))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,147 @@
+"""Run a scene: build the problem, trace its branches, stream results to disk, draw figures."""
+from dataclasses import dataclass, field
+import sys
+import time
+
+import numpy as np
+
+from . import __version__
+from .contact import trace
+from .errors import ConvergenceError
+from .output import SIGN_NOTE, RunWriter, state_forces, write_json
+from .scene import Scene, build_problem, load_scene
+
+
+@dataclass
+class RunResult:
+    """What :func:`run` returns.
+
+    Attributes
+    ----------
+    scene : Scene
+    problem : ContactProblem
+    sweeps : dict[str, Sweep]
+        ``"approach"`` / ``"retract"`` branches, each with its states and jumps.
+    status : str
+        ``"converged"`` or ``"failed"`` (then ``error`` holds the message).
+    wall_time : float
+        Seconds for the whole run, output included.
+    out_dir : str or None
+    """
+
+    scene: Scene
+    problem: object
+    sweeps: dict = field(default_factory=dict)
+    status: str = "converged"
+    error: str | None = None
+    wall_time: float = 0.0
+    out_dir: str | None = None
+
+    def curve(self, branch):
+        """Arrays d, h0, F_LJ, F_el, F_ex, r_c (SI) of one branch."""
+        states = self.sweeps[branch].states
+        f = np.array([state_forces(self.problem, s) for s in states]).reshape(-1, 3)
+        return {"d": np.array([s.d for s in states]), "h0": np.array([s.h0 for s in states]),
+                "F_LJ": f[:, 0], "F_el": f[:, 1], "F_ex": f[:, 2],
+                "r_c": np.array([s.r_c for s in states])}
+
+    @property
+    def jumps(self):
+        return [j for sw in self.sweeps.values() for j in sw.jumps]
+
+
+def _progress_bar(total, label, enabled):
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, desc=label, unit="step", leave=False, file=sys.stderr)
+
+
+def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
+    """Solve a scene's force-separation sweep.
+
+    Parameters
+    ----------
+    scene : Scene or str or Path
+        A loaded scene or the path of its TOML file.
+    out_dir : str, optional
+        Output folder (default: the scene's ``[output] dir``).
+    write : bool
+        Stream curve/diagnostics/fields csv and summary.json to ``out_dir``.
+    figures : bool
+        Draw the Fig 3-style panels (PNG) after the sweep.
+    progress : bool, optional
+        Progress bar on stderr; default: only when stderr is a terminal.
+
+    Returns
+    -------
+    RunResult
+        Also when a step fails to converge: then ``status == "failed"``, ``error`` says where,
+        and every state computed before it is in the result and on disk.
+    """
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    t0 = time.perf_counter()
+    problem = build_problem(scene)
+    result = RunResult(scene, problem, out_dir=(out_dir or scene.output_dir) if write else None)
+    writer = RunWriter(result.out_dir, problem) if write else None
+    if progress is None:
+        progress = sys.stderr.isatty()
+    d = scene.d_values
+    plan = []
+    if "approach" in scene.directions:
+        plan.append(("approach", d))
+        if "retract" in scene.directions:
+            plan.append(("retract", d[::-1]))
+    else:
+        plan.append(("retract", d))
+    start = None
+    try:
+        for branch, d_vals in plan:
+            bar = _progress_bar(len(d_vals) - 1, f"{scene.name} {branch}", progress)
+            on_state = (lambda s, b=branch: writer.write_state(b, s)) if writer else None
+            sweep = None
+            try:
+                sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
+                              max_iter=scene.max_iter, on_state=on_state,
+                              progress=(lambda k, bar=bar: bar.update(1)) if bar else None)
+            finally:
+                if bar:
+                    bar.close()
+            result.sweeps[branch] = sweep
+            start = sweep.states[-1]
+    except ConvergenceError as exc:
+        result.status, result.error = "failed", str(exc)
+    result.wall_time = time.perf_counter() - t0
+    if writer:
+        writer.close()
+        write_json(f"{result.out_dir}/summary.json", _summary(result))
+        if figures and result.sweeps:
+            from .plots import paper1_panels
+            paper1_panels(result, f"{result.out_dir}/fig3_panels.png")
+    return result
+
+
+def _summary(result):
+    scene = result.scene
+    jumps = [{"branch": j.branch, "d_fold_m": j.d_fold, "d_land_m": j.d_land,
+              "resolution_m": j.resolution,
+              "F_ex_before_N": state_forces(result.problem, j.before)[2],
+              "F_ex_after_N": state_forces(result.problem, j.after)[2],
+              "h0_before_m": j.before.h0, "h0_after_m": j.after.h0} for j in result.jumps]
+    branches = {}
+    for b, sw in result.sweeps.items():
+        c = result.curve(b)
+        k = int(np.argmax(c["F_ex"]))
+        branches[b] = {"n_states": len(sw.states), "n_solves": sw.n_solves,
+                       "wall_time_s": sw.wall_time, "max_F_ex_N": float(c["F_ex"][k]),
+                       "d_at_max_F_ex_m": float(c["d"][k]),
+                       "all_converged": all(s.converged for s in sw.states),
+                       "all_stable": all(s.stable for s in sw.states)}
+    return {"femadh_version": __version__, "scene_file": scene.path,
+            "status": result.status, "error": result.error, "sign_convention": SIGN_NOTE,
+            "scene": scene.resolved, "branches": branches, "jumps": jumps,
+            "wall_time_s": result.wall_time}

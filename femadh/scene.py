@@ -1,0 +1,288 @@
+"""Scene files (TOML) -> validated :class:`Scene` -> :class:`ContactProblem`.
+
+The scene file is the user-facing contract. Quantities are strings with units ("2 mm") or
+plain numbers in SI. Unknown keys, missing keys, wrong units and unphysical values raise
+:class:`SceneError` naming the file, the key, the value and what was expected. Only the effects
+a scene names are built.
+"""
+from dataclasses import dataclass, field
+import math
+from pathlib import Path
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python < 3.11
+    import tomli as tomllib
+
+from .effects import AsperityGap, LennardJones
+from .effects.gap import CONTACT_MODELS
+from .errors import SceneError, _MISSING
+from .indenter import PROFILES, Sphere
+from .materials import IsotropicMaterial, composite_modulus
+from .units import to_si
+
+METHODS = ("green",)
+DIRECTIONS = ("approach", "retract")
+
+_TOP = {"scene", "sphere", "materials", "effects", "solver", "sweep", "output"}
+_EFFECTS = {"lennard_jones", "asperity_gap"}
+
+
+@dataclass
+class Scene:
+    """A validated scene, all quantities in SI units.
+
+    Attributes mirror the TOML sections; ``raw`` keeps the file's own text values and
+    ``resolved`` the SI values written to summary.json.
+    """
+
+    name: str
+    path: str | None
+    sphere: Sphere
+    e_star: float
+    effects: dict
+    gap: AsperityGap | None
+    method: str
+    nodes: int
+    analysis_radius: float
+    tolerance: float
+    max_iter: int
+    d_values: list
+    directions: tuple
+    output_dir: str
+    raw: dict = field(repr=False, default_factory=dict)
+
+    @property
+    def resolved(self):
+        """Plain-dict SI view of the scene (for summary.json)."""
+        return {
+            "name": self.name,
+            "sphere": {"radius_m": self.sphere.radius, "profile": self.sphere.profile},
+            "composite_modulus_Pa": self.e_star,
+            "effects": {
+                name: {k: getattr(e, k) for k in e.__dataclass_fields__}
+                for name, e in self.effects.items()},
+            "asperity_gap": None if self.gap is None else
+            {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model},
+            "solver": {"method": self.method, "nodes": self.nodes,
+                       "analysis_radius_m": self.analysis_radius,
+                       "tolerance_m": self.tolerance, "max_iter": self.max_iter},
+            "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
+            "output_dir": self.output_dir,
+        }
+
+
+class _Reader:
+    """Reads one table with key-by-key checks; remembers the file for error messages."""
+
+    def __init__(self, file, table, prefix):
+        self.file, self.table, self.prefix = file, table, prefix
+        self.used = set()
+
+    def key(self, k):
+        return f"{self.prefix}.{k}" if self.prefix else k
+
+    def error(self, k, value, expected):
+        return SceneError(self.file, self.key(k), value, expected)
+
+    def raw(self, k, default=_MISSING):
+        self.used.add(k)
+        if k in self.table:
+            return self.table[k]
+        if default is _MISSING:
+            raise self.error(k, _MISSING, "this key (it is required)")
+        return default
+
+    def quantity(self, k, dim, *, default=_MISSING, positive=True):
+        v = self.raw(k, default)
+        x = to_si(v, dim, file=self.file, key=self.key(k))
+        if not math.isfinite(x):
+            raise self.error(k, v, "a finite value")
+        if positive and not x > 0:
+            raise self.error(k, v, f"a positive {dim.replace('_', ' ')}")
+        return x
+
+    def choice(self, k, options, default=_MISSING):
+        v = self.raw(k, default)
+        if v not in options:
+            raise self.error(k, v, "one of " + ", ".join(repr(o) for o in options))
+        return v
+
+    def integer(self, k, lo, default=_MISSING):
+        v = self.raw(k, default)
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise self.error(k, v, f"an integer >= {lo}")
+        return v
+
+    def table_at(self, k, default=_MISSING):
+        v = self.raw(k, default)
+        if v is not None and not isinstance(v, dict):
+            raise self.error(k, v, "a table")
+        return v
+
+    def done(self, allowed=None):
+        allowed = set(allowed or []) | self.used
+        for k in self.table:
+            if k not in allowed:
+                raise self.error(k, self.table[k], "no such key here; allowed keys are "
+                                 + ", ".join(sorted(allowed)))
+
+
+def load_scene(path):
+    """Read and validate a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        On any malformed, missing, unknown or unphysical entry.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise SceneError(str(path), "(file)", str(path), f"a readable file ({exc.strerror})") \
+            from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(str(path), "(file)", "(TOML text)", f"valid TOML ({exc})") from None
+    return scene_from_dict(data, str(path))
+
+
+def _material(r, k):
+    t = r.table_at(k)
+    m = _Reader(r.file, t, r.key(k))
+    E = m.quantity("youngs_modulus", "pressure")
+    nu = m.raw("poisson_ratio")
+    if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
+        raise m.error("poisson_ratio", nu, "a number in (-1, 0.5)")
+    m.done()
+    return IsotropicMaterial(E, float(nu))
+
+
+def scene_from_dict(data, file=None):
+    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`."""
+    top = _Reader(file, data, "")
+    top.used |= _TOP
+    top.done(_TOP)
+
+    s = _Reader(file, top.table_at("scene"), "scene")
+    name = s.raw("name")
+    if not isinstance(name, str) or not name:
+        raise s.error("name", name, "a non-empty string")
+    s.done()
+
+    sp = _Reader(file, top.table_at("sphere"), "sphere")
+    sphere = Sphere(sp.quantity("radius", "length"),
+                    sp.choice("profile", PROFILES, "paraboloid"))
+    sp.done()
+
+    mt = _Reader(file, top.table_at("materials"), "materials")
+    if "composite_modulus" in mt.table:
+        if "disk" in mt.table or "slider" in mt.table:
+            raise mt.error("composite_modulus", mt.table["composite_modulus"],
+                           "either composite_modulus or disk/slider, not both")
+        e_star = mt.quantity("composite_modulus", "pressure")
+    else:
+        disk = _material(mt, "disk")
+        slider = _material(mt, "slider") if "slider" in mt.table else None
+        e_star = composite_modulus(disk, slider)
+    mt.done()
+
+    ef = _Reader(file, top.table_at("effects", {}), "effects")
+    effects, gap = {}, None
+    lj_t = ef.table_at("lennard_jones", None)
+    if lj_t is not None:
+        lj = _Reader(file, lj_t, "effects.lennard_jones")
+        effects["lj"] = LennardJones(lj.quantity("hamaker", "energy"),
+                                     lj.quantity("equilibrium_distance", "length"))
+        lj.done()
+    gap_t = ef.table_at("asperity_gap", None)
+    if gap_t is not None:
+        g = _Reader(file, gap_t, "effects.asperity_gap")
+        gap = AsperityGap(g.quantity("sigma", "length"),
+                          g.choice("contact_model", CONTACT_MODELS, "complementarity"))
+        g.done()
+    ef.done(_EFFECTS)
+    if not effects:
+        raise SceneError(file, "effects", sorted(ef.table), "at least one surface force "
+                         "effect, e.g. [effects.lennard_jones]")
+    if gap is not None and gap.contact_model == "hertz-closure" and "lj" not in effects:
+        raise SceneError(file, "effects.asperity_gap.contact_model", gap.contact_model,
+                         "'complementarity' unless [effects.lennard_jones] is present")
+
+    so = _Reader(file, top.table_at("solver", {}), "solver")
+    method = so.choice("method", METHODS, "green")
+    nodes = so.integer("nodes", 8, 200)
+    ar = so.raw("analysis_radius", {"delta": "10 nm"})
+    if isinstance(ar, dict):
+        arr = _Reader(file, ar, "solver.analysis_radius")
+        delta = arr.quantity("delta", "length")
+        arr.done()
+        a = math.sqrt(2.0 * sphere.radius * delta)  # paper 1 sec 4: delta = a^2 / 2R
+    else:
+        a = so.quantity("analysis_radius", "length")
+    if sphere.profile == "sphere" and a >= sphere.radius:
+        raise so.error("analysis_radius", ar, f"less than the sphere radius {sphere.radius} m")
+    tol = so.quantity("tolerance", "length", default="1e-10 nm")
+    max_iter = so.integer("max_iter", 1, 40)
+    so.done()
+
+    sw = _Reader(file, top.table_at("sweep"), "sweep")
+    start = sw.quantity("start", "length", positive=False)
+    stop = sw.quantity("stop", "length", positive=False)
+    step = sw.quantity("step", "length")
+    dirs = sw.raw("directions", ["approach", "retract"])
+    if (not isinstance(dirs, list) or not dirs or any(x not in DIRECTIONS for x in dirs)
+            or len(set(dirs)) != len(dirs)):
+        raise sw.error("directions", dirs, "a list drawn from ['approach', 'retract']")
+    if "approach" in dirs and not stop < start:
+        raise sw.error("stop", sw.table["stop"], f"a separation below start "
+                       f"({sw.table['start']}) for an approach")
+    if dirs == ["retract"] and not stop > start:
+        raise sw.error("stop", sw.table["stop"], f"a separation above start "
+                       f"({sw.table['start']}) for a retract-only sweep")
+    n_steps = abs(stop - start) / step
+    if n_steps > 100000:
+        raise sw.error("step", sw.table["step"], "a step giving at most 100000 separations")
+    k = round(n_steps)
+    if abs(n_steps - k) > 1e-6:
+        raise sw.error("step", sw.table["step"], f"a step that divides |stop - start| = "
+                       f"{abs(stop - start):.6g} m into whole steps")
+    sign = -1.0 if stop < start else 1.0
+    d_values = [start + sign * i * step for i in range(k + 1)]
+    sw.done()
+    if gap is None and d_values[0] <= 0:
+        raise SceneError(file, "sweep.start", sw.table["start"], "a positive separation for a "
+                         "smooth sphere (no [effects.asperity_gap]): the sweep starts from the "
+                         "undeformed surface, which the tip must not touch")
+
+    ou = _Reader(file, top.table_at("output", {}), "output")
+    out_dir = ou.raw("dir", f"out/{name}")
+    if not isinstance(out_dir, str) or not out_dir:
+        raise ou.error("dir", out_dir, "a folder path")
+    ou.done()
+
+    return Scene(name=name, path=file, sphere=sphere, e_star=e_star, effects=effects, gap=gap,
+                 method=method, nodes=nodes, analysis_radius=a, tolerance=tol,
+                 max_iter=max_iter, d_values=d_values, directions=tuple(dirs),
+                 output_dir=out_dir, raw=data)
+
+
+def build_problem(scene):
+    """The :class:`ContactProblem` of a scene; only the effects it names are built."""
+    from .contact import ContactProblem
+    from .elastic import GreenOperator, RadialGrid
+
+    grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+    operator = GreenOperator(grid, scene.e_star)
+    return ContactProblem(operator, scene.sphere, dict(scene.effects), scene.gap)

@@ -1,0 +1,64 @@
+"""Green-function surface operator: exact identities and convergence against Hertz."""
+import math
+
+import numpy as np
+import pytest
+from scipy import special
+
+from femadh.elastic import GreenOperator, RadialGrid, disk_displacement
+from femadh.reference import hertz_annulus_force, hertz_displacement
+
+from conftest import E_STAR, observed_order
+
+
+def test_disk_displacement_matches_elliptic_form_and_limits():
+    a = 1.0
+    r = np.array([0.0, 0.3, 0.999, 1.0, 1.001, 2.0, 50.0])
+    w = disk_displacement(r, a, E_STAR)
+    inside = r <= a
+    ref_in = 4 * a / (math.pi * E_STAR) * special.ellipe((r[inside] / a) ** 2)
+    m = (a / r[~inside]) ** 2
+    ref_out = 4 * r[~inside] / (math.pi * E_STAR) * (special.ellipe(m) - (1 - m) * special.ellipk(m))
+    # 1e-12: both are double-precision evaluations of the same closed form
+    assert np.allclose(w[inside], ref_in, rtol=1e-12)
+    assert np.allclose(w[~inside], ref_out, rtol=1e-9)  # E - (1-m)K loses digits for r >> a
+    assert w[0] == pytest.approx(2 * a / E_STAR, rel=1e-14)  # centre: 2 p a / E*
+    # far field: a point load pi a^2 gives a^2 / (E* r); next term is O((a/r)^2)
+    assert disk_displacement(1e4, a, E_STAR) == pytest.approx(a * a / (E_STAR * 1e4), rel=1e-7)
+
+
+def test_uniform_disk_is_reproduced_exactly_by_annuli():
+    """Superposition identity: annuli 0..k with unit pressure are the disk of radius e_k+1."""
+    g = RadialGrid.uniform(1e-6, 120)
+    op = GreenOperator(g, E_STAR)
+    k = 47
+    p = np.zeros(g.n)
+    p[: k + 1] = 1.0
+    exact = disk_displacement(g.nodes, g.edges[k + 1], E_STAR)
+    # 1e-12: only round-off of the telescoping sum separates them
+    assert np.max(np.abs(op.displacement(p) - exact)) <= 1e-12 * exact.max()
+
+
+def test_stiffness_inverts_compliance():
+    op = GreenOperator(RadialGrid.uniform(1e-6, 80), E_STAR)
+    # 1e-10: condition number of C is O(N) ~ 1e2, times double precision
+    assert np.allclose(op.stiffness @ op.compliance, np.eye(80), atol=1e-10)
+
+
+def test_hertz_displacement_converges_with_observed_order():
+    a_c, R = 1.0e-6, 1.0e-3
+    p0 = 2 * E_STAR * a_c / (math.pi * R)
+    ns = [50, 100, 200, 400]
+    err_max, err_axis, hs = [], [], []
+    for n in ns:
+        g = RadialGrid.uniform(2 * a_c, n)
+        p = hertz_annulus_force(g.edges, a_c, R, E_STAR) / g.areas
+        w = GreenOperator(g, E_STAR).displacement(p)
+        exact = hertz_displacement(g.nodes, a_c, p0, E_STAR)
+        err_max.append(np.max(np.abs(w - exact)) / exact[0])
+        err_axis.append(abs(w[0] - exact[0]) / exact[0])
+        hs.append(g.nodes[1])
+    # the sqrt edge of the Hertz pressure limits the max-norm order to ~1.5; smooth parts: 2
+    assert observed_order(hs, err_max) > 1.3
+    assert observed_order(hs, err_axis) > 1.9
+    assert err_max[-1] < 1e-4
