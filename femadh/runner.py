@@ -115,6 +115,9 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
             start = sweep.states[-1]
     except ConvergenceError as exc:
         result.status, result.error = "failed", str(exc)
+        partial = getattr(exc, "sweep", None)
+        if partial is not None and partial.states:
+            result.sweeps[partial.branch] = partial
     result.wall_time = time.perf_counter() - t0
     if writer:
         writer.close()

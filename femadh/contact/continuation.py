@@ -164,7 +164,7 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
             state = land(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
                          max_iter=max_iter)
             sweep.n_solves += 1
-        _check(state, "first state", tol)
+        _check(state, "first state", tol, sweep)
     else:
         state = start
     sweep.states.append(state)
@@ -194,7 +194,7 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
             # Fold: no stable state continues the branch beyond state.d.
             landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
             sweep.n_solves += 1
-            _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol)
+            _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol, sweep)
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
             prev, state = None, landed
         sweep.states.append(state)
@@ -206,11 +206,14 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
     return sweep
 
 
-def _check(state, what, tol):
+def _check(state, what, tol, sweep):
+    """Raise ConvergenceError (carrying the partial ``sweep``) unless state is converged+stable."""
+    if state.converged and state.stable:
+        return
     if not state.converged:
-        raise ConvergenceError(f"{what}: Newton did not reach the tolerance {tol:.3g} m",
-                               d=state.d, residual=state.residual, n_iter=state.n_iter)
-    if not state.stable:
-        raise ConvergenceError(f"{what}: the converged state is unstable (not an energy "
-                               "minimum)", d=state.d, residual=state.residual,
-                               n_iter=state.n_iter)
+        msg = f"{what}: Newton did not reach the tolerance {tol:.3g} m"
+    else:
+        msg = f"{what}: the converged state is unstable (not an energy minimum)"
+    exc = ConvergenceError(msg, d=state.d, residual=state.residual, n_iter=state.n_iter)
+    exc.sweep = sweep
+    raise exc
