@@ -1,6 +1,5 @@
 """Paper 1 claims, asserted on the validation cases (quick mesh, N = 100)."""
 import numpy as np
-import pytest
 
 from femadh.reference import max_rigid_lj_force
 from femadh.runner import run

@@ -47,7 +47,6 @@ def main(argv=None):
         rows.append((n,) + best)
         print(f"N={n}: {best[0]:.3f} s", flush=True)
     vals = np.array([[r[2], r[3]] for r in rows])
-    h = np.array([1.0 / n for n in ns])
     # Richardson: order from the three finest, extrapolate the finest pair
     p = np.log(np.abs(vals[-3] - vals[-2]) / np.abs(vals[-2] - vals[-1])) / np.log(2)
     ref = vals[-1] + (vals[-1] - vals[-2]) / (2.0**p - 1)

@@ -61,7 +61,7 @@ def _r_c_at_zero_force(c):
 
 def measure(res):
     """The table's quantities for one run (approach branch unless stated)."""
-    sc, p = res.scene, res.problem
+    sc = res.scene
     lj = sc.effects["lj"]
     row = {"status": res.status, "wall_s": res.wall_time}
     if "approach" not in res.sweeps:

@@ -1,5 +1,4 @@
 """Lennard-Jones force between a rigid sphere and a flat (paper 1 eqs 14-15)."""
-import math
 
 
 def rigid_sphere_lj_force(h0, hamaker, z0, radius):
