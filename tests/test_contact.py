@@ -98,6 +98,15 @@ def test_fold_detected_with_hysteresis(fig4_sweeps):
     assert fa[1] > 1.5 * fa[0]
 
 
+def test_pivot_stability_agrees_with_hessian_cholesky(fig4_sweeps):
+    """The fast stability test (trailing-block pivots) agrees with Cholesky of the Hessian."""
+    from femadh.contact.newton import hessian_is_positive_definite
+
+    p, a, r = fig4_sweeps
+    for s in a.states + r.states + [j.before for j in a.jumps + r.jumps]:
+        assert s.stable == hessian_is_positive_definite(p, s)
+
+
 def test_each_state_is_energy_minimum_under_perturbation(fig4_sweeps):
     """Stability check is not assumed: perturbing a stable state raises the energy."""
     p, a, _ = fig4_sweeps

@@ -69,6 +69,65 @@ def solve_state(problem, d, w0, *, tol, max_iter=50, active0=None, r_c0=None, fa
                                   factor=factor)
 
 
+class TrailingLU:
+    """One LU that solves every trailing block (K + D)[m:, m:] for m >= m0.
+
+    When the contact set is a disk (nodes 0..m-1), the free-node Jacobian is the trailing block
+    from m. Factorised in reversed node order, every trailing block is a *leading* block, and
+    the LU of a leading block is the leading part of the full LU as long as partial pivoting
+    made no row swap before it (checked: ``k_valid``). So moving the contact edge costs a
+    triangular solve, not a new factorisation, and the pivots' signs give the block's inertia
+    (the stability test) for free.
+    """
+
+    def __init__(self, K, D, m0):
+        n = K.shape[0]
+        idx = np.arange(n - 1, m0 - 1, -1)
+        M = K[idx[:, None], idx]
+        M[np.diag_indices_from(M)] += D[idx]
+        self.n, self.m0 = n, m0
+        self.lu, self.piv = linalg.lu_factor(M, check_finite=False)
+        swaps = np.flatnonzero(self.piv != np.arange(idx.size))
+        self.k_valid = int(swaps[0]) if swaps.size else idx.size
+        self.rel_pivots = np.diag(self.lu) / np.diag(M)
+        self._block = (None, None)
+
+    def covers(self, m):
+        return m >= self.m0 and self.n - m <= self.k_valid
+
+    def _lu_block(self, m):
+        k = self.n - m
+        if self._block[0] != k:
+            lu = self.lu if k == self.lu.shape[0] else np.ascontiguousarray(self.lu[:k, :k])
+            self._block = (k, (lu, self.piv[:k]))
+        return self._block[1]
+
+    def solve(self, m, rhs):
+        """x with (K + D)[m:, m:] x = rhs (rhs in natural node order m..n-1)."""
+        if m >= self.n:
+            return np.zeros(0)
+        if not self.covers(m):  # a pivot from outside the block: LAPACK would read past it
+            raise ValueError(f"trailing block from node {m} is not covered (m0 = {self.m0}, "
+                             f"valid leading size {self.k_valid})")
+        return linalg.lu_solve(self._lu_block(m), rhs[::-1], check_finite=False)[::-1]
+
+    def min_rel_pivot(self, m):
+        return float(np.min(self.rel_pivots[: self.n - m])) if m < self.n else math.inf
+
+
+def _disk_size(A):
+    """m if the active set is exactly the nodes 0..m-1, else None."""
+    m = int(A.sum())
+    return m if A[:m].all() else None
+
+
+#: extra nodes factorised inside the contact edge so a shrinking contact stays covered
+DISK_MARGIN_FRACTION = 0.05
+#: a stale factorisation's pivots are trusted for the stability test only above this
+#: (relative) size; closer to a fold the converged state is refactorised
+STALE_PIVOT_MARGIN = 0.05
+
+
 def _solve_complementarity(problem, d, w0, *, tol, max_iter, active0, constrained=True,
                            factor=None, load=None):
     """Semismooth Newton; with ``constrained=False`` the gap constraint is ignored (eq 6).
@@ -93,7 +152,11 @@ def _solve_complementarity(problem, d, w0, *, tol, max_iter, active0, constraine
     else:
         A = b - w < sigma
     seen = set()
-    lu, lu_I = factor if factor is not None else (None, None)
+    if isinstance(factor, TrailingLU):
+        lu, lu_I = factor, None
+    else:
+        lu, lu_I = factor if factor is not None else (None, None)
+    fresh = False
     res, res_prev, it = math.inf, math.inf, 0
     for it in range(1, max_iter + 1):
         if sigma is not None:
@@ -104,15 +167,32 @@ def _solve_complementarity(problem, d, w0, *, tol, max_iter, active0, constraine
             break  # the guess put the surfaces through each other: hopeless, report failure
         P = problem.pressure(h) - load
         F_I = (K @ w)[I] - P[I]
-        if lu is None or not np.array_equal(I, lu_I) or res > CHORD_RATE * res_prev:
-            idx = np.flatnonzero(I)
-            M = K[idx[:, None], idx]
-            M[np.diag_indices_from(M)] += problem.dpressure(h[I])
-            lu, lu_I = linalg.lu_factor(M, check_finite=False), I
-            res_prev = math.inf
+        m = _disk_size(A)
+        stalled = res > CHORD_RATE * res_prev
+        if m is not None:
+            if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
+                m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+                cand = TrailingLU(K, problem.dpressure(h), m0)
+                if cand.covers(m):
+                    lu, lu_I, fresh = cand, None, True
+                    res_prev = math.inf
+                else:  # pivoting swapped rows inside the block: use the general path
+                    m = None
+            else:
+                res_prev = res
+        if m is not None:
+            dw = -lu.solve(m, F_I)
         else:
-            res_prev = res
-        dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+            if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
+                    or stalled:
+                idx = np.flatnonzero(I)
+                M = K[idx[:, None], idx]
+                M[np.diag_indices_from(M)] += problem.dpressure(h[I])
+                lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+                res_prev = math.inf
+            else:
+                res_prev = res
+            dw = -linalg.lu_solve(lu, F_I, check_finite=False)
         alpha = _damping(h[I], dw)
         w[I] += alpha * dw
         h = b - w
@@ -125,7 +205,8 @@ def _solve_complementarity(problem, d, w0, *, tol, max_iter, active0, constraine
             new_A = A
         res = _residual(problem, w, P - pc)
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
-            return _finish(problem, d, w, h, pc + load, A, it, res, (lu, lu_I))
+            factor = lu if isinstance(lu, TrailingLU) else (lu, lu_I)
+            return _finish(problem, d, w, h, pc + load, A, it, res, factor, fresh)
         key = new_A.tobytes()
         if key in seen and not np.array_equal(new_A, A):
             # The active set cycles (non-convex LJ near the contact edge): accept only the
@@ -157,14 +238,38 @@ def _area_radius(problem, A):
     return math.sqrt(float(problem.areas[A].sum()) / math.pi)
 
 
-def _finish(problem, d, w, h, pc, A, it, res, factor):
+def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
+    """Package a converged state and test its stability.
+
+    Stable means: the energy Hessian on the free nodes, sym(S)_II + diag(area_I P'(h_I)), is
+    positive definite. With a disk-shaped contact the test reads the signs of the trailing-block
+    pivots (the inertia of the area-scaled Jacobian, equal to the Hessian's up to the O(h)
+    asymmetry of collocation); a factorisation from an earlier iterate is trusted only while its
+    smallest relative pivot is above STALE_PIVOT_MARGIN, else the state is refactorised.
+    Otherwise a Cholesky factorisation of the Hessian decides.
+    """
     I = ~A
-    D = problem.dpressure(h)
-    H = problem.S_sym[np.ix_(I, I)]
-    H[np.diag_indices_from(H)] += problem.areas[I] * D[I]
-    stable = _is_positive_definite(H) if H.size else True
+    m = _disk_size(A)
+    if isinstance(factor, TrailingLU) and m is not None and factor.covers(m):
+        if not fresh and factor.min_rel_pivot(m) < STALE_PIVOT_MARGIN:
+            factor = TrailingLU(problem.K, problem.dpressure(h), factor.m0 if factor.m0 <= m
+                                else m)
+        stable = factor.min_rel_pivot(m) > 0 if m < h.size else True
+    else:
+        D = problem.dpressure(h)
+        H = problem.S_sym[np.ix_(I, I)]
+        H[np.diag_indices_from(H)] += problem.areas[I] * D[I]
+        stable = _is_positive_definite(H) if H.size else True
     return State(d, w, h, _effect_pressures(problem, h), pc, A.copy(),
                  _area_radius(problem, A), it, res, True, stable, factor)
+
+
+def hessian_is_positive_definite(problem, state):
+    """The reference stability test (Cholesky of the free-node energy Hessian)."""
+    I = ~state.active
+    H = problem.S_sym[np.ix_(I, I)]
+    H[np.diag_indices_from(H)] += problem.areas[I] * problem.dpressure(state.h[I])
+    return _is_positive_definite(H) if H.size else True
 
 
 def tangent(problem, state):
@@ -173,11 +278,20 @@ def tangent(problem, state):
     From K w = P(b - w) - p_c with db/dd = 1: on A, dw/dd = 1; on I,
     (K_II + D_I) t_I = D_I - K_IA 1. Reuses the corrector's factorisation.
     """
-    lu, I = state.lu
-    A = ~I
+    A = state.active
+    I = ~A
     t = np.ones(state.w.size)
     D = problem.dpressure(state.h)
     rhs = D[I] - problem.K[np.ix_(I, A)].sum(axis=1)
+    m = _disk_size(A)
+    if isinstance(state.lu, TrailingLU) and m is not None and state.lu.covers(m):
+        t[I] = state.lu.solve(m, rhs)
+        return t
+    if isinstance(state.lu, TrailingLU) or state.lu is None:
+        return np.zeros(state.w.size)  # no factorisation of this set at hand: zeroth order
+    lu, lu_I = state.lu
+    if lu_I is None or not np.array_equal(lu_I, I):
+        return np.zeros(state.w.size)  # no factorisation of this set at hand: zeroth order
     t[I] = linalg.lu_solve(lu, rhs, check_finite=False)
     return t
 
