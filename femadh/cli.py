@@ -21,6 +21,19 @@ def _parser():
     r.add_argument("--quiet", action="store_true", help="no progress bar or summary lines")
     c = sub.add_parser("check", help="validate a scene file without solving it")
     c.add_argument("scene", help="scene file (TOML)")
+    m = sub.add_parser("mesh", help="build (or fetch from cache) the FE mesh of a scene",
+                       description="Mesh the half-space of a scene with gmsh (cached by a hash "
+                                   "of its parameters) and write it as .msh and .vtu.")
+    m.add_argument("scene", help="scene file (TOML)")
+    m.add_argument("--out", help="output folder (default: the scene's [output] dir)")
+    s = sub.add_parser("study", help="convergence and accuracy-vs-time studies",
+                       description="convergence: the FE mesh ladder against the Green function "
+                                   "on the scene's nodes, and the Green function in N; writes "
+                                   "convergence.csv/.md/.png.")
+    s.add_argument("kind", choices=["convergence"])
+    s.add_argument("scene", help="scene file (TOML)")
+    s.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
+    s.add_argument("--out", help="output folder (default: <scene output dir>/study)")
     return p
 
 
@@ -33,7 +46,19 @@ def main(argv=None):
         scene = load_scene(args.scene)
         if args.command == "check":
             print(f"{args.scene}: ok ({len(scene.d_values)} separations, "
-                  f"{', '.join(scene.directions)}, {scene.nodes} nodes)")
+                  f"{', '.join(scene.directions)}, {scene.nodes} nodes, {scene.method})")
+            return 0
+        if args.command == "mesh":
+            return _mesh(scene, args.out)
+        if args.command == "study":
+            from .studies import convergence, default_progress, write_convergence
+
+            if not 1 <= args.levels <= 4:
+                print("femadh: error: --levels must be 1 to 4", file=sys.stderr)
+                return 2
+            rows = convergence(scene, levels=args.levels, progress=default_progress())
+            path = write_convergence(rows, args.out or f"{scene.output_dir}/study", scene.name)
+            print(path.read_text())
             return 0
         res = run(scene, args.out, figures=not args.no_figures,
                   progress=False if args.quiet else None)
@@ -56,6 +81,32 @@ def main(argv=None):
         print(f"femadh: error: {res.error}; states computed before it are kept in "
               f"{res.out_dir}", file=sys.stderr)
         return 3
+    return 0
+
+
+def _mesh(scene, out):
+    from pathlib import Path
+    import shutil
+
+    import meshio
+
+    from .elastic import RadialGrid
+    from .elastic.fe import FESettings
+    from .elastic.mesh import MeshSpec, cached_mesh, read_mesh, surface_points_of
+
+    st = scene.fe_settings or FESettings()
+    grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+    spec = MeshSpec(surface_points_of(grid), st.outer_factor * grid.radius, st.growth,
+                    st.surface_fraction * float(grid.nodes[1]))
+    src = cached_mesh(spec, progress=lambda m: print(m, file=sys.stderr))
+    out = Path(out or scene.output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    shutil.copy(src, out / "mesh.msh")
+    p, tri = read_mesh(src, scale=grid.radius)
+    pts = __import__("numpy").column_stack([p, 0 * p[:, 0]])
+    meshio.write(out / "mesh.vtu", meshio.Mesh(pts, [("triangle", tri)]))
+    print(f"{len(p)} vertices, {len(tri)} triangles (P2: {2 * (len(p) + len(p) + len(tri))} "
+          f"DOFs approx.); mesh {spec.key()} -> {out / 'mesh.msh'} (cached at {src})")
     return 0
 
 

@@ -34,10 +34,12 @@ def state_forces(problem, state):
 class RunWriter:
     """Streams curve.csv, diagnostics.csv and fields.csv rows into an output folder."""
 
-    def __init__(self, out_dir, problem):
+    def __init__(self, out_dir, problem, vtk=False):
         self.dir = Path(out_dir)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.problem = problem
+        self.vtk = vtk
+        self._pvd = {}
         self._files = {}
         self._writers = {}
         for name, header in (("curve", CURVE_HEADER), ("diagnostics", DIAG_HEADER),
@@ -67,6 +69,14 @@ class RunWriter:
             fw.writerow([branch] + [_g(x) for x in row])
         for f in self._files.values():
             f.flush()
+        if self.vtk:
+            from .vtk import write_pvd, write_state
+
+            entries = self._pvd.setdefault(branch, [])
+            vol, surf = write_state(self.dir, branch, len(entries) // 2, state, p)
+            t = round(state.d * 1e9, 9)
+            entries += [(t, vol, 0), (t, surf, 1)]
+            write_pvd(self.dir / f"{branch}.pvd", entries)
 
     def close(self):
         for f in self._files.values():

@@ -2,6 +2,7 @@
 from dataclasses import dataclass, field
 import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -10,6 +11,14 @@ from .contact import trace
 from .errors import ConvergenceError
 from .output import SIGN_NOTE, RunWriter, state_forces, write_json
 from .scene import Scene, build_problem, load_scene
+
+
+#: surface-force stiffness over single-node stiffness above which a run warns
+STIFFNESS_WARNING = 0.5
+
+
+class MeshResolutionWarning(UserWarning):
+    """The discretisation is too coarse for the surface forces' stiffness."""
 
 
 @dataclass
@@ -36,6 +45,7 @@ class RunResult:
     error: str | None = None
     wall_time: float = 0.0
     out_dir: str | None = None
+    stiffness_ratio: float = 0.0
 
     def curve(self, branch):
         """Arrays d, h0, F_LJ, F_el, F_ex, r_c (SI) of one branch."""
@@ -85,11 +95,21 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     t0 = time.perf_counter()
-    problem = build_problem(scene)
-    result = RunResult(scene, problem, out_dir=(out_dir or scene.output_dir) if write else None)
-    writer = RunWriter(result.out_dir, problem) if write else None
     if progress is None:
         progress = sys.stderr.isatty()
+    say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
+    problem = build_problem(scene, progress=say)
+    ratio, h_at, soft, k_node = problem.surface_force_stiffness()
+    if ratio > STIFFNESS_WARNING:
+        warnings.warn(
+            f"{scene.path or scene.name}: the surface forces' stiffness -dP/dh = {soft:.3g} Pa/m "
+            f"at h = {h_at * 1e9:.3g} nm is {ratio:.2f} x the stiffness of one surface node "
+            f"({k_node:.3g} Pa/m): single nodes can snap on their own and the result depends on "
+            f"the mesh. Use [solver] nodes >= {int(scene.nodes * ratio / STIFFNESS_WARNING) + 1}.",
+            MeshResolutionWarning, stacklevel=2)
+    result = RunResult(scene, problem, out_dir=(out_dir or scene.output_dir) if write else None)
+    result.stiffness_ratio = ratio
+    writer = RunWriter(result.out_dir, problem, vtk=scene.vtk) if write else None
     d = scene.d_values
     plan = []
     if "approach" in scene.directions:
@@ -147,4 +167,8 @@ def _summary(result):
     return {"femadh_version": __version__, "scene_file": scene.path,
             "status": result.status, "error": result.error, "sign_convention": SIGN_NOTE,
             "scene": scene.resolved, "branches": branches, "jumps": jumps,
+            "surface_force_stiffness_over_node_stiffness": result.stiffness_ratio,
+            "operator": {"name": result.problem.operator.name,
+                         "timings_s": getattr(result.problem.operator, "timings", {}),
+                         "n_dofs": getattr(result.problem.operator, "n_dofs", None)},
             "wall_time_s": result.wall_time}

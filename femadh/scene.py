@@ -21,7 +21,7 @@ from .indenter import PROFILES, Sphere
 from .materials import IsotropicMaterial, composite_modulus
 from .units import to_si
 
-METHODS = ("green",)
+METHODS = ("green", "fe")
 DIRECTIONS = ("approach", "retract")
 
 _TOP = {"scene", "sphere", "materials", "effects", "solver", "sweep", "output"}
@@ -47,9 +47,12 @@ class Scene:
     analysis_radius: float
     tolerance: float
     max_iter: int
+    fe_settings: object | None
     d_values: list
     directions: tuple
     output_dir: str
+    fe_poisson_ratio: float = 0.3
+    vtk: bool = False
     raw: dict = field(repr=False, default_factory=dict)
 
     @property
@@ -66,7 +69,13 @@ class Scene:
             {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model},
             "solver": {"method": self.method, "nodes": self.nodes,
                        "analysis_radius_m": self.analysis_radius,
-                       "tolerance_m": self.tolerance, "max_iter": self.max_iter},
+                       "tolerance_m": self.tolerance, "max_iter": self.max_iter,
+                       "mesh": None if self.fe_settings is None else {
+                           "outer_factor": self.fe_settings.outer_factor,
+                           "growth": self.fe_settings.growth,
+                           "surface_fraction": self.fe_settings.surface_fraction,
+                           "far_field": self.fe_settings.far_field,
+                           "poisson_ratio": self.fe_poisson_ratio}},
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
             "output_dir": self.output_dir,
         }
@@ -187,6 +196,7 @@ def scene_from_dict(data, file=None):
     sp.done()
 
     mt = _Reader(file, top.table_at("materials"), "materials")
+    disk = None
     if "composite_modulus" in mt.table:
         if "disk" in mt.table or "slider" in mt.table:
             raise mt.error("composite_modulus", mt.table["composite_modulus"],
@@ -235,6 +245,28 @@ def scene_from_dict(data, file=None):
         raise so.error("analysis_radius", ar, f"less than the sphere radius {sphere.radius} m")
     tol = so.quantity("tolerance", "length", default="1e-10 nm")
     max_iter = so.integer("max_iter", 1, 40)
+    fe_settings, fe_nu = None, (disk.poisson_ratio if disk is not None else 0.3)
+    mesh_t = so.table_at("mesh", None)
+    if method == "fe":
+        from .elastic.fe import FESettings
+
+        ms = _Reader(file, mesh_t or {}, "solver.mesh")
+        d0 = FESettings()
+        outer = ms.raw("outer_factor", d0.outer_factor)
+        growth = ms.raw("growth", d0.growth)
+        surf = ms.raw("surface_fraction", d0.surface_fraction)
+        for k, v, lo, hi in (("outer_factor", outer, 1.0, 1e7), ("growth", growth, 0.0, 2.0),
+                             ("surface_fraction", surf, 0.0, 1.0)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
+                raise ms.error(k, v, f"a number in ({lo:g}, {hi:g}]")
+        far = ms.choice("far_field", ("boussinesq", "fixed"), d0.far_field)
+        nu = ms.raw("poisson_ratio", fe_nu)
+        if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1 < nu < 0.5:
+            raise ms.error("poisson_ratio", nu, "a number in (-1, 0.5)")
+        ms.done()
+        fe_settings, fe_nu = FESettings(float(outer), float(growth), float(surf), far), float(nu)
+    elif mesh_t is not None:
+        raise so.error("mesh", mesh_t, "no [solver] mesh table unless method = \"fe\"")
     so.done()
 
     sw = _Reader(file, top.table_at("sweep"), "sweep")
@@ -270,19 +302,40 @@ def scene_from_dict(data, file=None):
     out_dir = ou.raw("dir", f"out/{name}")
     if not isinstance(out_dir, str) or not out_dir:
         raise ou.error("dir", out_dir, "a folder path")
+    vtk = ou.raw("vtk", method == "fe")
+    if not isinstance(vtk, bool):
+        raise ou.error("vtk", vtk, "true or false")
+    if vtk and method != "fe":
+        raise ou.error("vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
+                       "operator has no interior field to write)")
     ou.done()
 
     return Scene(name=name, path=file, sphere=sphere, e_star=e_star, effects=effects, gap=gap,
                  method=method, nodes=nodes, analysis_radius=a, tolerance=tol,
-                 max_iter=max_iter, d_values=d_values, directions=tuple(dirs),
-                 output_dir=out_dir, raw=data)
+                 max_iter=max_iter, fe_settings=fe_settings, d_values=d_values,
+                 directions=tuple(dirs), output_dir=out_dir, fe_poisson_ratio=fe_nu, vtk=vtk,
+                 raw=data)
 
 
-def build_problem(scene):
-    """The :class:`ContactProblem` of a scene; only the effects it names are built."""
-    from .contact import ContactProblem
+def build_operator(scene, progress=None):
+    """The scene's SurfaceOperator: Green function or condensed FE, on the scene's grid."""
     from .elastic import GreenOperator, RadialGrid
 
     grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
-    operator = GreenOperator(grid, scene.e_star)
+    if scene.method == "fe":
+        from .elastic.fe import FEOperator
+
+        return FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, scene.fe_settings,
+                          progress=progress)
+    return GreenOperator(grid, scene.e_star)
+
+
+def build_problem(scene, operator=None, progress=None):
+    """The :class:`ContactProblem` of a scene; only the effects it names are built.
+
+    Pass ``operator`` to reuse an already built (e.g. factorised FE) operator.
+    """
+    from .contact import ContactProblem
+
+    operator = operator or build_operator(scene, progress)
     return ContactProblem(operator, scene.sphere, dict(scene.effects), scene.gap)

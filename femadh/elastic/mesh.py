@@ -1,0 +1,160 @@
+"""gmsh builder of the axisymmetric half-space mesh (r, z), z <= 0, and its cache.
+
+Domain: the quarter disk r^2 + z^2 <= L^2 with r, -z >= 0. Boundaries: ``surface`` (z = 0),
+``axis`` (r = 0), ``far`` (the arc). On the loaded part of the surface, 0 <= r <= a, the mesh
+has a vertex at every collocation node *and* every annulus edge of the RadialGrid, so each
+surface facet lies inside one pressure annulus (the load is integrated exactly) and the nodal
+displacements are mesh values. The element size grows linearly with the distance from the
+loaded segment (gmsh Distance + MathEval fields), so L can be 1e4-1e5 times a for a few
+percent more elements.
+"""
+from dataclasses import dataclass
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+
+#: cache folder for meshes built on demand (override with FEMADH_MESH_CACHE)
+DEFAULT_CACHE = Path.home() / ".cache" / "femadh" / "meshes"
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Parameters of a half-space mesh (SI units).
+
+    Attributes
+    ----------
+    surface_points : tuple of float
+        Sorted radii of the surface vertices on the loaded segment [0, a] (nodes and annulus
+        edges of the RadialGrid), first 0, last a.
+    outer_radius : float
+        L, radius of the far boundary (m).
+    growth : float
+        Element size growth rate: h = h_s + growth * distance from the loaded segment.
+    surface_size : float
+        h_s, element size at the loaded segment (m).
+    """
+
+    surface_points: tuple
+    outer_radius: float
+    growth: float
+    surface_size: float
+
+    @property
+    def loaded_radius(self):
+        return self.surface_points[-1]
+
+    def normalised(self):
+        """The spec in units of the loaded radius a (what gmsh meshes and the file stores)."""
+        a = self.loaded_radius
+        return {"surface_points": [round(x / a, 12) for x in self.surface_points],
+                "outer_factor": round(self.outer_radius / a, 9),
+                "growth": round(self.growth, 12),
+                "surface_size": round(self.surface_size / a, 12)}
+
+    def key(self):
+        """Content hash of the normalised parameters: the cache file name. Scale-free, so one
+        committed mesh serves every analysis radius with the same relative node layout."""
+        blob = json.dumps(self.normalised(), sort_keys=True).encode()
+        return hashlib.sha1(blob).hexdigest()[:16]
+
+
+def surface_points_of(grid):
+    """Sorted union of a RadialGrid's nodes and annulus edges."""
+    return tuple(float(x) for x in np.unique(np.concatenate([grid.nodes, grid.edges])))
+
+
+def build_mesh(spec: MeshSpec, path):
+    """Mesh ``spec`` with gmsh (linear triangles) and write it to ``path`` (.msh).
+
+    Returns the path. gmsh runs headless and quiet; it is initialised and finalised here.
+    """
+    import gmsh
+
+    # gmsh works in units of the loaded radius a: its geometric tolerances are absolute
+    # (1e-8), which SI micrometre coordinates would fall below
+    a = float(spec.surface_points[-1])
+    pts = np.asarray(spec.surface_points) / a
+    L = float(spec.outer_radius) / a
+    if not L > 1:
+        raise ValueError(f"outer radius {spec.outer_radius} m must exceed the loaded radius "
+                         f"{a} m")
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("halfspace")
+        geo = gmsh.model.geo
+        lc_far = L / 4
+        tags = [geo.addPoint(r, 0.0, 0.0, lc_far) for r in pts]
+        p_far_r = geo.addPoint(L, 0.0, 0.0, lc_far)
+        p_far_z = geo.addPoint(0.0, -L, 0.0, lc_far)
+        center = tags[0]
+        loaded = [geo.addLine(tags[i], tags[i + 1]) for i in range(len(tags) - 1)]
+        free = geo.addLine(tags[-1], p_far_r)
+        arc = geo.addCircleArc(p_far_r, center, p_far_z)
+        axis = geo.addLine(p_far_z, center)
+        loop = geo.addCurveLoop(loaded + [free, arc, axis])
+        surf = geo.addPlaneSurface([loop])
+        geo.synchronize()
+        gmsh.model.addPhysicalGroup(1, loaded + [free], name="surface")
+        gmsh.model.addPhysicalGroup(1, [axis], name="axis")
+        gmsh.model.addPhysicalGroup(1, [arc], name="far")
+        gmsh.model.addPhysicalGroup(2, [surf], name="solid")
+        f = gmsh.model.mesh.field
+        dist = f.add("Distance")
+        f.setNumbers(dist, "CurvesList", loaded)
+        f.setNumber(dist, "Sampling", 4)  # per curve: each loaded curve is one short segment
+        size = f.add("MathEval")
+        f.setString(size, "F", f"{spec.surface_size / a:.12f} + {spec.growth:.12f} * F{dist}")
+        f.setAsBackgroundMesh(size)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: good grading
+        gmsh.model.mesh.generate(2)
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return Path(path)
+
+
+def read_mesh(path, scale=1.0):
+    """Read a .msh with meshio; returns (points (n, 2) times ``scale``, triangles (m, 3)).
+
+    Meshes are stored in units of the loaded radius; pass scale = a for SI coordinates.
+    """
+    import meshio
+
+    m = meshio.read(str(path))
+    tri = np.concatenate([c.data for c in m.cells if c.type == "triangle"])
+    used = np.unique(tri)
+    # drop points not used by triangles (gmsh keeps geometry points such as the arc centre)
+    remap = -np.ones(len(m.points), int)
+    remap[used] = np.arange(used.size)
+    return m.points[used, :2] * scale, remap[tri]
+
+
+def cached_mesh(spec: MeshSpec, cache_dir=None, *, progress=None):
+    """Path of the mesh for ``spec``, built with gmsh on first use and cached by content hash.
+
+    The committed ladder in ``meshes/`` (see meshes/manifest.json) is searched first.
+    """
+    import os
+
+    repo_meshes = Path(__file__).resolve().parents[2] / "meshes"
+    name = f"halfspace-{spec.key()}.msh"
+    if (repo_meshes / name).exists():
+        return repo_meshes / name
+    cache = Path(cache_dir or os.environ.get("FEMADH_MESH_CACHE") or DEFAULT_CACHE)
+    path = cache / name
+    if not path.exists():
+        if progress:
+            progress(f"meshing ({len(spec.surface_points)} surface points, L = "
+                     f"{spec.outer_radius:.3g} m) -> {path}")
+        tmp = path.with_suffix(".tmp.msh")
+        build_mesh(spec, tmp)
+        tmp.replace(path)  # atomic: a killed run never leaves a half-written cache entry
+    return path

@@ -1,0 +1,143 @@
+"""Studies: mesh convergence and accuracy vs time of the FE operator against the Green
+function (same nodes, same pressures, same solver), and of the Green function in N.
+"""
+import csv
+from dataclasses import replace
+from pathlib import Path
+import sys
+import time
+
+import numpy as np
+
+#: FE mesh ladder, coarse -> fine: (growth, surface_fraction); each level halves both sizes
+FE_LEVELS = ((0.5, 1.0), (0.25, 0.5), (0.125, 0.25), (0.0625, 0.125))
+
+
+def _sweep(problem, scene):
+    from .contact import trace
+    from .output import state_forces
+
+    t0 = time.perf_counter()
+    a = trace(problem, scene.d_values, branch="approach", tol=scene.tolerance,
+              max_iter=scene.max_iter)
+    states = list(a.states)
+    if "retract" in scene.directions:
+        r = trace(problem, scene.d_values[::-1], branch="retract", tol=scene.tolerance,
+                  start=a.states[-1], max_iter=scene.max_iter)
+        states += r.states
+    wall = time.perf_counter() - t0
+    f = np.array([state_forces(problem, s) for s in states])
+    return f, wall
+
+
+def convergence(scene, *, levels=3, green_factors=(0.25, 0.5, 1, 2), reference_factor=4,
+                progress=None):
+    """FE mesh ladder vs the Green function on the scene's nodes, and the Green function in N.
+
+    Returns a list of row dicts: method, level/N, dofs, error of F_ex over the sweep relative
+    to the peak |F_ex| of the reference, compliance error, and the wall time split into
+    mesh / assembly / factorisation / condensation / sweep (s).
+    """
+    from .elastic import GreenOperator, RadialGrid
+    from .elastic.fe import FEOperator, FESettings
+    from .scene import build_problem
+
+    say = progress or (lambda msg: None)
+    base = FESettings() if scene.fe_settings is None else scene.fe_settings
+    rows = []
+    grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+    say(f"Green reference on N = {scene.nodes}")
+    t0 = time.perf_counter()
+    green = GreenOperator(grid, scene.e_star)
+    t_op = time.perf_counter() - t0
+    f_ref, t_sw = _sweep(build_problem(scene, green), scene)
+    peak = np.abs(f_ref[:, 2]).max()
+    for k, (growth, frac) in enumerate(FE_LEVELS[:levels]):
+        settings = replace(base, growth=growth, surface_fraction=frac)
+        say(f"FE level {k}: growth {growth}, surface fraction {frac}")
+        op = FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, settings)
+        f, wall = _sweep(build_problem(scene, op), scene)
+        rows.append({"method": "fe", "level": k, "N": scene.nodes, "dofs": op.n_dofs,
+                     "error_F_ex": float(np.abs(f[:, 2] - f_ref[:, 2]).max() / peak),
+                     "error_compliance": float(np.abs(op.compliance - green.compliance).max()
+                                               / np.abs(green.compliance).max()),
+                     **{f"t_{k2}": v for k2, v in op.timings.items()}, "t_sweep": wall})
+    # Green function in N against a finer Green reference (its own discretisation error)
+    n_ref = int(scene.nodes * reference_factor)
+    say(f"Green N-ladder against N = {n_ref}")
+    f_fine, _ = _sweep(build_problem(replace(scene, nodes=n_ref, method="green")), scene)
+    peak_fine = np.abs(f_fine[:, 2]).max()
+    for fac in green_factors:
+        n = max(8, int(scene.nodes * fac))
+        t0 = time.perf_counter()
+        op = GreenOperator(RadialGrid.uniform(scene.analysis_radius, n), scene.e_star)
+        t_op = time.perf_counter() - t0
+        f, wall = _sweep(build_problem(replace(scene, nodes=n, method="green"), op), scene)
+        rows.append({"method": "green", "level": "", "N": n, "dofs": n,
+                     "error_F_ex": float(np.abs(f[:, 2] - f_fine[:, 2]).max() / peak_fine),
+                     "error_compliance": "", "t_mesh": 0.0, "t_assembly": t_op,
+                     "t_factorisation": 0.0, "t_condensation": 0.0, "t_sweep": wall})
+    return rows
+
+
+COLUMNS = ["method", "level", "N", "dofs", "error_F_ex", "error_compliance", "t_mesh",
+           "t_assembly", "t_factorisation", "t_condensation", "t_sweep"]
+
+
+def write_convergence(rows, out_dir, title=""):
+    """convergence.csv, convergence.md and convergence.png (error vs DOFs, vs time)."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "convergence.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, COLUMNS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in COLUMNS})
+    lines = ["| " + " | ".join(COLUMNS) + " | total (s) |", "|" + "---|" * (len(COLUMNS) + 1)]
+    for r in rows:
+        tot = sum(r[k] for k in COLUMNS if k.startswith("t_"))
+        cells = [f"{r[k]:.3g}" if isinstance(r[k], float) else str(r[k]) for k in COLUMNS]
+        lines.append("| " + " | ".join(cells) + f" | {tot:.3g} |")
+    (out / "convergence.md").write_text(f"# Convergence study {title}\n\n" + "\n".join(lines)
+                                        + "\n")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    for meth, mk in (("fe", "o-"), ("green", "s--")):
+        rr = [r for r in rows if r["method"] == meth]
+        if not rr:
+            continue
+        ax[0].loglog([r["dofs"] for r in rr], [r["error_F_ex"] for r in rr], mk,
+                     label="FE vs Green (same nodes)" if meth == "fe" else "Green vs 4N")
+        tot = [sum(r[k] for k in COLUMNS if k.startswith("t_")) for r in rr]
+        ax[1].loglog(tot, [r["error_F_ex"] for r in rr], mk, label=meth)
+    ax[0].set(xlabel="degrees of freedom", ylabel="max |ΔF_ex| / peak |F_ex|",
+              title="error vs size")
+    ax[1].set(xlabel="wall time (s)", ylabel="max |ΔF_ex| / peak |F_ex|", title="error vs time")
+    for a in ax:
+        a.grid(True, which="both", alpha=0.3)
+        a.legend()
+    # stacked time split of the FE levels
+    fe = [r for r in rows if r["method"] == "fe"]
+    if fe:
+        ins = ax[1].inset_axes([0.58, 0.55, 0.4, 0.42])
+        bottom = np.zeros(len(fe))
+        for k in ("t_mesh", "t_assembly", "t_factorisation", "t_condensation", "t_sweep"):
+            v = np.array([r[k] for r in fe])
+            ins.bar(range(len(fe)), v, bottom=bottom, label=k[2:])
+            bottom += v
+        ins.set_xticks(range(len(fe)), [f"L{r['level']}" for r in fe])
+        ins.set_ylabel("s", fontsize=7)
+        ins.tick_params(labelsize=7)
+        ins.legend(fontsize=6)
+    fig.suptitle(f"Convergence {title}")
+    fig.tight_layout()
+    fig.savefig(out / "convergence.png", dpi=110)
+    plt.close(fig)
+    return out / "convergence.md"
+
+
+def default_progress():
+    return (lambda msg: print(msg, file=sys.stderr)) if sys.stderr.isatty() else None

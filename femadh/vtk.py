@@ -1,0 +1,74 @@
+"""VTK output of FE states for ParaView/PyVista (written with meshio).
+
+Per state: ``vtk/<branch>_<k>.vtu`` with the (r, z) mesh (x = r, y = z), the displacement as a
+3-component vector (u_r, u_z, 0) for ParaView's "Warp By Vector", the stresses sigma_rr,
+sigma_zz, sigma_tt, sigma_rz and von Mises (Pa, L2-projected onto P1), and
+``vtk/<branch>_surface_<k>.vtu`` with the surface polyline: w, gap h, P_LJ, contact pressure.
+``<branch>.pvd`` collects them with the timestep = d in nm.
+"""
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+
+def fe_point_fields(operator, u):
+    """Vertex fields of a full displacement DOF vector u of an FEOperator."""
+    from skfem import ElementTriP1
+
+    b = operator.basis
+    E, nu = operator.youngs, operator.nu
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = E / (2 * (1 + nu))
+    uh = b.interpolate(u)
+    r = b.global_coordinates().value[0]
+    g, v = uh.grad, uh.value
+    e_rr, e_zz, e_tt = g[0, 0], g[1, 1], v[0] / r
+    e_rz = 0.5 * (g[0, 1] + g[1, 0])
+    tr = e_rr + e_zz + e_tt
+    s = {"sigma_rr": lam * tr + 2 * mu * e_rr, "sigma_zz": lam * tr + 2 * mu * e_zz,
+         "sigma_tt": lam * tr + 2 * mu * e_tt, "sigma_rz": 2 * mu * e_rz}
+    b1 = b.with_element(ElementTriP1())
+    out = {k: b1.project(val) for k, val in s.items()}
+    out["von_mises"] = np.sqrt(0.5 * ((out["sigma_rr"] - out["sigma_zz"]) ** 2
+                                      + (out["sigma_zz"] - out["sigma_tt"]) ** 2
+                                      + (out["sigma_tt"] - out["sigma_rr"]) ** 2)
+                               + 3 * out["sigma_rz"] ** 2)
+    nd = b.nodal_dofs
+    disp = np.zeros((b.mesh.p.shape[1], 3))
+    disp[:, 0], disp[:, 1] = u[nd[0]], u[nd[1]]
+    out["displacement"] = disp
+    return out
+
+
+def write_state(out_dir, branch, index, state, problem):
+    """Write the volume and surface .vtu of one state; returns their paths (relative)."""
+    import meshio
+
+    op = problem.operator
+    vdir = Path(out_dir) / "vtk"
+    vdir.mkdir(parents=True, exist_ok=True)
+    u = op.full_field(state.p_total)
+    fields = fe_point_fields(op, u)
+    p = op.mesh.p
+    pts = np.column_stack([p[0], p[1], np.zeros(p.shape[1])])
+    vol = f"{branch}_{index:04d}.vtu"
+    meshio.write(vdir / vol, meshio.Mesh(pts, [("triangle", op.mesh.t.T)], point_data=fields))
+    r = problem.grid.nodes
+    spts = np.column_stack([r, state.w, np.zeros_like(r)])
+    lines = np.column_stack([np.arange(r.size - 1), np.arange(1, r.size)])
+    sdata = {"w": state.w, "gap": state.h, "P_contact": state.p_contact,
+             "P_net": state.p_total}
+    for name, pr in state.p_effects.items():
+        sdata[f"P_{name}"] = pr
+    surf = f"{branch}_surface_{index:04d}.vtu"
+    meshio.write(vdir / surf, meshio.Mesh(spts, [("line", lines)], point_data=sdata))
+    return f"vtk/{vol}", f"vtk/{surf}"
+
+
+def write_pvd(path, entries):
+    """ParaView collection: entries = [(timestep, file, part)]; rewritten whole each time."""
+    rows = "\n".join(f'    <DataSet timestep="{t!r}" group="" part="{part}" file={quoteattr(f)}/>'
+                     for t, f, part in entries)
+    Path(path).write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+                          f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
