@@ -21,8 +21,8 @@ def fe_point_fields(operator, u):
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
     uh = b.interpolate(u)
-    r = b.global_coordinates().value[0]
-    g, v = uh.grad, uh.value
+    r = b.global_coordinates()[0]
+    g, v = uh.grad, uh
     e_rr, e_zz, e_tt = g[0, 0], g[1, 1], v[0] / r
     e_rz = 0.5 * (g[0, 1] + g[1, 0])
     tr = e_rr + e_zz + e_tt

@@ -43,7 +43,7 @@ def axisymmetric_elasticity(lam, mu):
 
 def _strains(u, r):
     g = u.grad
-    return g[0, 0], g[1, 1], u.value[0] / r, 0.5 * (g[0, 1] + g[1, 0])
+    return g[0, 0], g[1, 1], u[0] / r, 0.5 * (g[0, 1] + g[1, 0])
 
 
 def boussinesq(r, z, youngs, nu):
@@ -226,18 +226,26 @@ class FEOperator:
         return np.concatenate([dofs.nodal["u^1"], dofs.facet["u^1"]])
 
     def _surface_rows(self):
-        """Row of each grid node's vertical displacement in the free-DOF solution."""
+        """Row of each grid node's vertical displacement in the free-DOF solution.
+
+        Also sets ``surface_vertices``: the mesh vertex of each grid node (nearest surface
+        vertex: coordinates come back through the mesh file in units of a, so equality is
+        only to round-off; the mesh was built with a vertex at every node).
+        """
         p = self.mesh.p
-        rows = np.empty(self.grid.n, int)
         surf = np.flatnonzero(p[1] == 0.0)
-        pos = {float(r): i for r, i in zip(p[0, surf], surf)}
-        where = np.searchsorted(self.free, self.basis.nodal_dofs[1])
-        for k, r in enumerate(self.grid.nodes):
-            v = pos.get(float(r))
-            if v is None:  # float round trip through the mesh file: nearest surface vertex
-                v = surf[np.argmin(np.abs(p[0, surf] - r))]
-            rows[k] = where[v]
-        return rows
+        order = np.argsort(p[0, surf])
+        rs = p[0, surf][order]
+        k = np.clip(np.searchsorted(rs, self.grid.nodes), 1, rs.size - 1)
+        pick = np.where(np.abs(rs[k - 1] - self.grid.nodes) <= np.abs(rs[k] - self.grid.nodes),
+                        k - 1, k)
+        self.surface_vertices = surf[order][pick]
+        gap = np.max(np.abs(p[0, self.surface_vertices] - self.grid.nodes))
+        if gap > 1e-9 * self.grid.radius:
+            raise ValueError(f"mesh has no vertex at a grid node (off by {gap:.3g} m): the mesh "
+                             f"does not belong to this grid")
+        where = np.searchsorted(self.free, self.basis.nodal_dofs[1, self.surface_vertices])
+        return where
 
     # ------------------------------------------------------------------ interface
     @property
