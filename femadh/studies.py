@@ -118,7 +118,7 @@ def write_convergence(rows, out_dir, title=""):
     ax[1].set(xlabel="wall time (s)", ylabel="max |ΔF_ex| / peak |F_ex|", title="error vs time")
     for a in ax:
         a.grid(True, which="both", alpha=0.3)
-        a.legend()
+        a.legend(loc="lower left")
     # stacked time split of the FE levels
     fe = [r for r in rows if r["method"] == "fe"]
     if fe:
