@@ -45,8 +45,13 @@ def main(argv=None):
     try:
         scene = load_scene(args.scene)
         if args.command == "check":
-            print(f"{args.scene}: ok ({len(scene.d_values)} separations, "
-                  f"{', '.join(scene.directions)}, {scene.nodes} nodes, {scene.method})")
+            if hasattr(scene, "p_ratios"):
+                print(f"{args.scene}: ok (meniscus: {len(scene.liquids)} liquids, "
+                      f"{len(scene.radii)} radii, {len(scene.p_ratios)} p/psat, "
+                      f"methods {', '.join(scene.methods)})")
+            else:
+                print(f"{args.scene}: ok ({len(scene.d_values)} separations, "
+                      f"{', '.join(scene.directions)}, {scene.nodes} nodes, {scene.method})")
             return 0
         if args.command == "mesh":
             return _mesh(scene, args.out)
@@ -60,6 +65,8 @@ def main(argv=None):
             path = write_convergence(rows, args.out or f"{scene.output_dir}/study", scene.name)
             print(path.read_text())
             return 0
+        if args.command == "run" and hasattr(scene, "p_ratios"):
+            return _run_meniscus(scene, args)
         res = run(scene, args.out, figures=not args.no_figures,
                   progress=False if args.quiet else None)
     except FemadhError as exc:
@@ -81,6 +88,27 @@ def main(argv=None):
         print(f"femadh: error: {res.error}; states computed before it are kept in "
               f"{res.out_dir}", file=sys.stderr)
         return 3
+    return 0
+
+
+def _run_meniscus(scene, args):
+    from .meniscus.run import run_meniscus
+
+    results, errors, wall = run_meniscus(scene, args.out, figures=not args.no_figures)
+    if not args.quiet:
+        for (liq, R, meth), res in results.items():
+            ok = [r for r in res if not isinstance(r, Exception)]
+            if ok:
+                best = max(ok, key=lambda r: r.force_over_4piRgamma)
+                print(f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: max F/4piRgamma = "
+                      f"{best.force_over_4piRgamma:.4f} at h = {best.film * 1e9:.3f} nm, "
+                      f"r_K = {best.kelvin_radius * 1e9:.3f} nm"
+                      + (f"  ({len(res) - len(ok)} p/psat without meniscus)" if len(ok) < len(res)
+                         else ""))
+        print(f"results in {args.out or scene.output_dir} ({wall:.2f} s)")
+    for e in errors[:5]:
+        print(f"femadh: note: no meniscus for {e['liquid']} R = {e['tip_radius_m']:g} m "
+              f"{e['method']} at p/psat = {e['p_ratio']:g}: {e['error']}", file=sys.stderr)
     return 0
 
 

@@ -92,8 +92,12 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
         Also when a step fails to converge: then ``status == "failed"``, ``error`` says where,
         and every state computed before it is in the result and on disk.
     """
-    if not isinstance(scene, Scene):
+    if not isinstance(scene, Scene) and not hasattr(scene, "p_ratios"):
         scene = load_scene(scene)
+    if hasattr(scene, "p_ratios"):  # a [meniscus] scene (paper 2)
+        from .meniscus.run import run_meniscus
+
+        return run_meniscus(scene, out_dir, write=write, figures=figures)
     t0 = time.perf_counter()
     if progress is None:
         progress = sys.stderr.isatty()

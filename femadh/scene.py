@@ -179,8 +179,16 @@ def _material(r, k):
 
 
 def scene_from_dict(data, file=None):
-    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`."""
+    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`.
+
+    A scene with a ``[meniscus]`` table is a capillary (paper 2) scene and returns a
+    :class:`~femadh.meniscus.scene.MeniscusScene`; otherwise a contact :class:`Scene`.
+    """
     top = _Reader(file, data, "")
+    if "meniscus" in data:
+        from .meniscus.scene import parse_meniscus
+
+        return parse_meniscus(top, file)
     top.used |= _TOP
     top.done(_TOP)
 
