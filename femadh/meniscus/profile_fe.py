@@ -81,9 +81,9 @@ class MeridianFE:
         self.U = Basis(m, ElementLineP2(), intorder=6)
         V = Basis(m, ElementDG(ElementLineP1()), intorder=6)
         self.nU, self.nV = self.U.N, V.N
-        self.phiU = np.array([b[0].value for b in self.U.basis])       # (iU, e, q)
+        self.phiU = np.array([np.asarray(b[0]) for b in self.U.basis])       # (iU, e, q)
         self.dphiU = np.array([b[0].grad[0] for b in self.U.basis])
-        self.vV = np.array([b[0].value for b in V.basis])              # (jV, e, q)
+        self.vV = np.array([np.asarray(b[0]) for b in V.basis])              # (jV, e, q)
         self.dx = self.U.dx                                            # (e, q)
         self.eU, self.eV = self.U.element_dofs, V.element_dofs          # (loc, e)
         self.i0 = int(self.U.nodal_dofs[0][0])

@@ -59,6 +59,17 @@ class MeniscusResult:
     state: object = field(default=None, repr=False)
 
 
+def _circle_guess(fe, geo):
+    """FE initial guess from the circular approximation; past its own limits (no neck below the
+    equator) the circle is still a usable starting shape, so the FE solve can report where the
+    exact meniscus goes instead of failing on the approximation's limit."""
+    try:
+        phi_c, rho, _ = solve_circular(geo)
+    except DomainError:
+        phi_c, rho, _ = solve_circular(geo, phi_max=0.95 * math.pi)
+    return fe.initial_from_circle(geo, phi_c, rho)
+
+
 def _fe_solver(n, cache={}):
     if n not in cache:
         cache[n] = MeridianFE(n)
@@ -127,15 +138,13 @@ def meniscus(method, radius, gamma, r_k, film=0.0, separation=None, *, elements=
     if warm is not None and isinstance(warm.state, tuple) and warm.state[0] == elements:
         init = warm.state[1]
     if init is None:
-        phi_c, rho, _ = solve_circular(geo)
-        init = fe.initial_from_circle(geo, phi_c, rho)
+        init = _circle_guess(fe, geo)
     try:
         sol = fe.solve(geo, init)
     except ConvergenceError:
         if warm is None:
             raise
-        phi_c, rho, _ = solve_circular(geo)  # continuation failed: restart from the circle
-        sol = fe.solve(geo, fe.initial_from_circle(geo, phi_c, rho))
+        sol = fe.solve(geo, _circle_guess(fe, geo))  # continuation failed: restart
     F = sol.force_contact(geo) * scale
     neck = sol.neck(geo)
     r, z, _ = sol.profile()
