@@ -23,12 +23,19 @@ SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ 
 
 
 def state_forces(problem, state):
-    """(F_LJ, F_el, F_ex) in N for a state (eqs 11-13 with 2 pi r dr area weights)."""
+    """(F_LJ, F_el, F_ex) in N for a state (eqs 11-13 with 2 pi r dr area weights).
+
+    F_ex sums every effect (LJ, capillary, ...) minus the contact force.
+    """
     g = problem.grid
     f_lj = g.force(state.p_effects["lj"]) if "lj" in state.p_effects else 0.0
     f_eff = sum(g.force(p) for p in state.p_effects.values())
     f_el = g.force(state.p_contact)
     return f_lj, f_el, f_eff - f_el
+
+
+#: extra curve.csv columns, by effect name (only for the effects a scene names)
+EFFECT_COLUMNS = {"capillary": "F_cap_N"}
 
 
 class RunWriter:
@@ -42,7 +49,9 @@ class RunWriter:
         self._pvd = {}
         self._files = {}
         self._writers = {}
-        for name, header in (("curve", CURVE_HEADER), ("diagnostics", DIAG_HEADER),
+        self.extra = [k for k in EFFECT_COLUMNS if k in problem.effects]
+        curve_header = CURVE_HEADER + [EFFECT_COLUMNS[k] for k in self.extra]
+        for name, header in (("curve", curve_header), ("diagnostics", DIAG_HEADER),
                              ("fields", FIELD_HEADER)):
             f = open(self.dir / f"{name}.csv", "w", newline="")
             w = csv.writer(f)
@@ -54,7 +63,8 @@ class RunWriter:
         f_lj, f_el, f_ex = state_forces(p, state)
         self._writers["curve"].writerow([
             branch, _g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
-            state.n_iter, _g(state.residual), state.converged])
+            state.n_iter, _g(state.residual), state.converged]
+            + [_g(p.grid.force(state.p_effects[k])) for k in self.extra])
         sigma = p.sigma
         self._writers["diagnostics"].writerow([
             branch, _g(state.d), state.stable, int(state.active.sum()),

@@ -25,7 +25,7 @@ METHODS = ("green", "fe")
 DIRECTIONS = ("approach", "retract")
 
 _TOP = {"scene", "sphere", "materials", "effects", "solver", "sweep", "output"}
-_EFFECTS = {"lennard_jones", "asperity_gap"}
+_EFFECTS = {"lennard_jones", "asperity_gap", "capillary"}
 
 
 @dataclass
@@ -137,6 +137,36 @@ class _Reader:
                                  + ", ".join(sorted(allowed)))
 
 
+def _capillary(file, table):
+    """[effects.capillary]: liquid, temperature, relative_pressure, isotherm, smoothing."""
+    from .effects import CapillaryCondensate
+    from .meniscus.kelvin import kelvin_radius
+    from .meniscus.scene import _isotherm, _liquid
+    from .meniscus.isotherms import default_isotherm
+    from .meniscus.liquids import LIQUIDS
+
+    c = _Reader(file, table, "effects.capillary")
+    liquid = _liquid(c, c.raw("liquid"))
+    temperature = c.quantity("temperature", "temperature", default="298.15 K")
+    x = c.raw("relative_pressure")
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 < x < 1:
+        raise c.error("relative_pressure", x, "a number in (0, 1)")
+    iso_raw = c.raw("isotherm", None)
+    if iso_raw is None:
+        iso = default_isotherm(liquid.name) if liquid.name in LIQUIDS else None
+    else:
+        iso = _isotherm(c, iso_raw)
+    smoothing = c.raw("smoothing", 0.02)
+    if isinstance(smoothing, bool) or not isinstance(smoothing, (int, float)) \
+            or not 0 < smoothing <= 0.5:
+        raise c.error("smoothing", smoothing, "a fraction in (0, 0.5] of the filled gap")
+    c.done()
+    r_k = kelvin_radius(liquid, float(x), temperature)
+    film = 0.0 if iso is None else float(iso(float(x)))
+    fill = 2 * abs(r_k) + 2 * film
+    return CapillaryCondensate(liquid.surface_tension, r_k, film, float(smoothing) * fill)
+
+
 def load_scene(path):
     """Read and validate a scene file.
 
@@ -230,6 +260,9 @@ def scene_from_dict(data, file=None):
         gap = AsperityGap(g.quantity("sigma", "length"),
                           g.choice("contact_model", CONTACT_MODELS, "complementarity"))
         g.done()
+    cap_t = ef.table_at("capillary", None)
+    if cap_t is not None:
+        effects["capillary"] = _capillary(file, cap_t)
     ef.done(_EFFECTS)
     if not effects:
         raise SceneError(file, "effects", sorted(ef.table), "at least one surface force "
@@ -277,6 +310,14 @@ def scene_from_dict(data, file=None):
         raise so.error("mesh", mesh_t, "no [solver] mesh table unless method = \"fe\"")
     so.done()
 
+    cap = effects.get("capillary")
+    delta_a = a * a / (2 * sphere.radius)
+    if cap is not None and cap.fill_gap >= delta_a:
+        raise SceneError(file, "solver.analysis_radius", ar, f"an analysis radius whose gap "
+                         f"a^2/2R = {delta_a * 1e9:.4g} nm exceeds the condensate's filled gap "
+                         f"2|r_K| + 2h = {cap.fill_gap * 1e9:.4g} nm, so that the meniscus lies "
+                         f"inside it (e.g. analysis_radius = {{ delta = "
+                         f"\"{2 * cap.fill_gap * 1e9:.3g} nm\" }})")
     sw = _Reader(file, top.table_at("sweep"), "sweep")
     start = sw.quantity("start", "length", positive=False)
     stop = sw.quantity("stop", "length", positive=False)

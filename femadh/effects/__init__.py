@@ -6,5 +6,6 @@ with ``pressure = d energy / dh``). The solver sums only the effects a scene nam
 """
 from .lj import LennardJones
 from .gap import AsperityGap
+from .capillary import CapillaryCondensate
 
-__all__ = ["LennardJones", "AsperityGap"]
+__all__ = ["LennardJones", "AsperityGap", "CapillaryCondensate"]
