@@ -17,9 +17,11 @@ DIAG_HEADER = ["branch", "d_m", "stable", "n_active", "min_gap_minus_sigma_m",
 FIELD_HEADER = ["branch", "d_m", "r_m", "w_m", "h_m", "P_LJ_Pa", "P_el_Pa"]
 
 SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ = sum P_LJ dA "
-             "(attractive positive), F_el = contact (asperity elastic) force, repulsive "
-             "positive, F_ex = F_LJ - F_el. The force on the sphere is -F_ex; adhesion shows as "
-             "F_ex > 0.")
+             "(attractive positive), F_el = sigma-gap contact force, repulsive positive; "
+             "optional F_cap (capillary), F_LJa (asperity adhesion) attractive positive and "
+             "F_ela (Greenwood-Williamson asperity elasticity) repulsive positive; "
+             "F_ex = F_LJ + F_cap + F_LJa - F_ela - F_el. The force on the sphere is -F_ex; "
+             "adhesion shows as F_ex > 0.")
 
 
 def state_forces(problem, state):
@@ -34,8 +36,10 @@ def state_forces(problem, state):
     return f_lj, f_el, f_eff - f_el
 
 
-#: extra curve.csv columns, by effect name (only for the effects a scene names)
-EFFECT_COLUMNS = {"capillary": "F_cap_N"}
+#: extra curve.csv columns, by effect name (only for the effects a scene names), with the sign
+#: that makes them positive in their own sense (attractive, or repulsive for asperity_elastic)
+EFFECT_COLUMNS = {"capillary": ("F_cap_N", 1.0), "asperity_adhesion": ("F_LJa_N", 1.0),
+                  "asperity_elastic": ("F_ela_N", -1.0)}
 
 
 class RunWriter:
@@ -50,7 +54,7 @@ class RunWriter:
         self._files = {}
         self._writers = {}
         self.extra = [k for k in EFFECT_COLUMNS if k in problem.effects]
-        curve_header = CURVE_HEADER + [EFFECT_COLUMNS[k] for k in self.extra]
+        curve_header = CURVE_HEADER + [EFFECT_COLUMNS[k][0] for k in self.extra]
         for name, header in (("curve", curve_header), ("diagnostics", DIAG_HEADER),
                              ("fields", FIELD_HEADER)):
             f = open(self.dir / f"{name}.csv", "w", newline="")
@@ -64,7 +68,7 @@ class RunWriter:
         self._writers["curve"].writerow([
             branch, _g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
             state.n_iter, _g(state.residual), state.converged]
-            + [_g(p.grid.force(state.p_effects[k])) for k in self.extra])
+            + [_g(EFFECT_COLUMNS[k][1] * p.grid.force(state.p_effects[k])) for k in self.extra])
         sigma = p.sigma
         self._writers["diagnostics"].writerow([
             branch, _g(state.d), state.stable, int(state.active.sum()),

@@ -5,7 +5,7 @@ plain numbers in SI. Unknown keys, missing keys, wrong units and unphysical valu
 :class:`SceneError` naming the file, the key, the value and what was expected. Only the effects
 a scene names are built.
 """
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 import math
 from pathlib import Path
 
@@ -25,7 +25,8 @@ METHODS = ("green", "fe")
 DIRECTIONS = ("approach", "retract")
 
 _TOP = {"scene", "sphere", "materials", "effects", "solver", "sweep", "output"}
-_EFFECTS = {"lennard_jones", "asperity_gap", "capillary"}
+_EFFECTS = {"lennard_jones", "asperity_gap", "capillary", "asperity_adhesion",
+            "asperity_contact"}
 
 
 @dataclass
@@ -62,9 +63,7 @@ class Scene:
             "name": self.name,
             "sphere": {"radius_m": self.sphere.radius, "profile": self.sphere.profile},
             "composite_modulus_Pa": self.e_star,
-            "effects": {
-                name: {k: getattr(e, k) for k in e.__dataclass_fields__}
-                for name, e in self.effects.items()},
+            "effects": {name: asdict(e) for name, e in self.effects.items()},
             "asperity_gap": None if self.gap is None else
             {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model},
             "solver": {"method": self.method, "nodes": self.nodes,
@@ -167,6 +166,45 @@ def _capillary(file, table):
     return CapillaryCondensate(liquid.surface_tension, r_k, film, float(smoothing) * fill)
 
 
+def _asperity_adhesion(file, table, sigma):
+    """[effects.asperity_adhesion]: eq 20 over the contact region."""
+    from .effects import AsperityAdhesion
+
+    t = _Reader(file, table, "effects.asperity_adhesion")
+    Ra = t.quantity("asperity_radius", "length")
+    dg = t.quantity("surface_energy", "surface_energy")
+    rho = t.quantity("density", "areal_density", positive=False)
+    if rho < 0:
+        raise t.error("density", table["density"], "a density >= 0")
+    p = t.raw("contact_probability", 0.5)
+    if isinstance(p, bool) or not isinstance(p, (int, float)) or not 0 <= p <= 1:
+        raise t.error("contact_probability", p, "a number in [0, 1]")
+    sm = t.raw("smoothing", 0.02)
+    if isinstance(sm, bool) or not isinstance(sm, (int, float)) or not 0 < sm <= 0.2:
+        raise t.error("smoothing", sm, "a fraction in (0, 0.2] of sigma")
+    t.done()
+    return AsperityAdhesion.from_asperities(Ra, dg, rho, float(p), sigma, float(sm))
+
+
+def _asperity_contact(file, table, e_star):
+    """[effects.asperity_contact] model = "greenwood-williamson": eqs 23-24 as gap laws."""
+    from .effects import GWAdhesion, GWElastic
+    from .reference.gw import Roughness
+
+    t = _Reader(file, table, "effects.asperity_contact")
+    t.choice("model", ("greenwood-williamson",))
+    rough = Roughness(t.quantity("rms_height", "length"),
+                      t.quantity("mean_height", "length", positive=False),
+                      t.quantity("asperity_radius", "length"),
+                      t.quantity("density", "areal_density"))
+    dg = t.quantity("surface_energy", "surface_energy", default=0.0, positive=False)
+    t.done()
+    out = {"asperity_elastic": GWElastic(rough, e_star)}
+    if dg > 0:
+        out["asperity_adhesion"] = GWAdhesion(rough, dg)
+    return out
+
+
 def load_scene(path):
     """Read and validate a scene file.
 
@@ -263,6 +301,18 @@ def scene_from_dict(data, file=None):
     cap_t = ef.table_at("capillary", None)
     if cap_t is not None:
         effects["capillary"] = _capillary(file, cap_t)
+    ad_t = ef.table_at("asperity_adhesion", None)
+    if ad_t is not None:
+        if gap is None:
+            raise SceneError(file, "effects.asperity_adhesion", ad_t, "an [effects.asperity_gap]"
+                             " as well: eq 20 acts over the sigma-gap contact region")
+        effects["asperity_adhesion"] = _asperity_adhesion(file, ad_t, gap.sigma)
+    gw_t = ef.table_at("asperity_contact", None)
+    if gw_t is not None:
+        if gap is not None:
+            raise SceneError(file, "effects.asperity_contact", gw_t, "no [effects.asperity_gap]"
+                             ": the Greenwood-Williamson model replaces the hard sigma-gap")
+        effects.update(_asperity_contact(file, gw_t, e_star))
     ef.done(_EFFECTS)
     if not effects:
         raise SceneError(file, "effects", sorted(ef.table), "at least one surface force "

@@ -5,16 +5,15 @@ a secant otherwise) and the Newton corrector. A step is accepted only if the cor
 converges to a *stable* state close to the prediction; otherwise the step is halved. When even
 the smallest step fails, the branch has folded (the stable equilibrium ceased to exist: jump-in
 on approach, jump-out on retract). The fold is reported at the last stable d, and the surface
-is then landed on the other branch by minimising the total energy from the last state
-(L-BFGS-B with the gap bound h >= sigma), which is where a quasi-static surface would snap to,
-and polished by Newton.
+is then landed on the other branch by descending the total energy from the last state
+(Levenberg-Marquardt with the gap bound h >= sigma), which is where a quasi-static surface would
+snap to, and polished by Newton.
 """
 from dataclasses import dataclass, field
 import math
 import time
 
 import numpy as np
-from scipy import optimize
 
 from ..errors import ConvergenceError
 from .newton import solve_state, tangent
@@ -89,40 +88,78 @@ def _predict(problem, state, prev, d):
     return w, state.active | (problem.contour(d) - w < problem.sigma)
 
 
+def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
+    """Levenberg-Marquardt descent of the total energy from w (projected onto h >= h_floor).
+
+    Steps solve (H + lam diag(H_el)) dw = -grad with H the symmetric energy Hessian; lam grows
+    until the energy decreases and shrinks after each success, so the iteration slides
+    downhill like an overdamped surface and ends in the basin it rolls into (the physical
+    landing after a fold). Returns the final w and whether the gradient was driven to ~0.
+    """
+    from scipy import linalg as sla
+
+    b = problem.contour(d)
+    upper = b - h_floor
+    w = np.minimum(np.array(w, float), upper)
+    S, areas = problem.S_sym, problem.areas
+    scale_diag = np.diag(S).copy()
+    lam = 1.0
+    e = problem.energy(w, d)
+    g = problem.energy_gradient(w, d)
+    g0 = float(np.max(np.abs(g))) + 1e-300
+    for _ in range(max_iter):
+        at_bound = (w >= upper - 1e-18) & (g < 0)   # pushing further into h < floor
+        free = ~at_bound
+        if float(np.max(np.abs(g[free]), initial=0.0)) <= 1e-10 * g0:
+            return w, True
+        H = S[np.ix_(free, free)].copy()
+        H[np.diag_indices_from(H)] += areas[free] * problem.dpressure(b[free] - w[free])
+        while True:
+            M = H.copy()
+            M[np.diag_indices_from(M)] += lam * scale_diag[free]
+            try:
+                c = sla.cho_factor(M, check_finite=False)
+            except sla.LinAlgError:
+                lam *= 4
+                continue
+            dw = np.zeros_like(w)
+            dw[free] = -sla.cho_solve(c, g[free], check_finite=False)
+            w_new = np.minimum(w + dw, upper)
+            e_new = problem.energy(w_new, d)
+            if np.isfinite(e_new) and e_new <= e:
+                break
+            lam *= 4
+            if lam > 1e12:
+                return w, False
+        w, e = w_new, e_new
+        g = problem.energy_gradient(w, d)
+        lam = max(lam / 3, 1e-8)
+    return w, False
+
+
 def land(problem, d, w_start, *, tol, max_iter):
     """Equilibrium reached by energy descent from w_start at separation d (a jump's landing).
 
-    Minimises elastic + interaction energy with L-BFGS-B under the bound h >= sigma (or
-    h >= z_min for a smooth sphere, where the LJ repulsion keeps the minimiser far from it),
-    then polishes with the Newton corrector of the problem's contact model.
+    Levenberg-Marquardt descent of elastic + interaction energy under the bound h >= sigma (or
+    h >= 0.5 z0 for a smooth sphere, never active at a minimum: the LJ repulsion is far steeper),
+    then the Newton corrector of the problem's contact model polishes the state.
     """
     b = problem.contour(d)
     if problem.sigma is not None:
         h_floor = problem.sigma
     else:
         z0s = [getattr(e, "z0", None) for e in problem.effects.values()]
-        h_floor = 0.3 * min(z for z in z0s if z) if any(z0s) else 1e-12
-    scale = max(float(np.max(np.abs(b))), problem.sigma or 0.0, 1e-10)
-    e_scale = None
-
-    def fun(x):
-        nonlocal e_scale
-        w = x * scale
-        e = problem.energy(w, d)
-        g = problem.energy_gradient(w, d) * scale
-        if e_scale is None:
-            e_scale = max(abs(e), float(np.max(np.abs(g))), 1e-30)
-        return e / e_scale, g / e_scale
-
-    upper = (b - h_floor) / scale
-    x0 = np.minimum(w_start / scale, upper)
-    bounds = list(zip([None] * b.size, upper))
-    opt = optimize.minimize(fun, x0, jac=True, method="L-BFGS-B", bounds=bounds,
-                            options={"maxiter": 20000, "ftol": 1e-15, "gtol": 1e-12})
-    w = opt.x * scale
+        h_floor = 0.5 * min(z for z in z0s if z) if any(z0s) else 1e-12
+    w, _ = _lm_descent(problem, d, w_start, h_floor)
     active = (b - w) <= h_floor * (1 + 1e-9) if problem.sigma is not None else None
-    st = solve_state(problem, d, w, tol=tol, max_iter=max_iter, active0=active,
-                     r_c0=None)
+    st = solve_state(problem, d, w, tol=tol, max_iter=max_iter, active0=active, r_c0=None)
+    if not st.converged:
+        # far from the old branch the polish can start slowly (stiff LJ repulsion, pivoted
+        # factorisations): give it a larger budget from where it got to
+        st2 = solve_state(problem, d, st.w, tol=tol, max_iter=4 * max_iter, active0=st.active,
+                          r_c0=None)
+        st2.n_iter += st.n_iter
+        st = st2
     return st
 
 

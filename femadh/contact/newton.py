@@ -408,8 +408,14 @@ def _solve_hertz_closure(problem, d, w0, *, tol, max_iter, r_c0):
                 if g(lo) < 0:
                     break
                 hi = lo
-        r_c = optimize.brentq(g, lo, hi, xtol=1e-13 * hi, rtol=4 * np.finfo(float).eps,
-                              maxiter=200)
+        try:
+            r_c = optimize.brentq(g, lo, hi, xtol=1e-13 * hi, rtol=4 * np.finfo(float).eps,
+                                  maxiter=200)
+        except ValueError:
+            # g re-evaluated at the bracket ends changed sign: the closure's inner problem has
+            # more than one solution there (the model is ill-posed, see validation/README.md)
+            raise _InnerFailure(hi, math.nan, cache["n_iter"], "the closure condition is not "
+                                "unique near its root") from None
         if cache["last"] is None or cache["last"][0] != r_c:
             g(r_c)
         if cache["last"] is None or abs(g(r_c)) > 1e-6 * sigma:

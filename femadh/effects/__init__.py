@@ -7,5 +7,7 @@ with ``pressure = d energy / dh``). The solver sums only the effects a scene nam
 from .lj import LennardJones
 from .gap import AsperityGap
 from .capillary import CapillaryCondensate
+from .asperity import AsperityAdhesion, GWAdhesion, GWElastic
 
-__all__ = ["LennardJones", "AsperityGap", "CapillaryCondensate"]
+__all__ = ["LennardJones", "AsperityGap", "CapillaryCondensate", "AsperityAdhesion",
+           "GWAdhesion", "GWElastic"]

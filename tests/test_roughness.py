@@ -1,0 +1,84 @@
+"""Greenwood-Williamson statistics and asperity effects (paper 1 sec 5.2-6), regime map."""
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from femadh.effects import AsperityAdhesion, GWAdhesion, GWElastic
+from femadh.reference.gw import (gw_integral, height_density, mean_plane_dominance_bound,
+                                 paper1_table2_roughness)
+
+
+@pytest.mark.parametrize("n", [0.0, 0.5, 1.0, 1.5, 2.5])
+def test_gw_integrals_match_quadrature(n):
+    for t in (-2.5, -0.3, 0.7, 3.0):
+        q = integrate.quad(lambda s: (s - t) ** n * math.exp(-s * s / 2) / math.sqrt(2 * math.pi),
+                           t, np.inf, epsabs=1e-14, epsrel=1e-12)[0]
+        assert gw_integral(n, t) == pytest.approx(q, rel=1e-9)
+
+
+def test_corrected_eq26_is_normalised():
+    r = paper1_table2_roughness(100e12)
+    q = integrate.quad(lambda z: height_density(z, r.z_m, r.sigma_a), r.z_m - 20 * r.sigma_a,
+                       r.z_m + 20 * r.sigma_a)[0]
+    assert q == pytest.approx(1.0, rel=1e-10)
+
+
+def test_paper1_table2_and_fig7_numbers():
+    """Sec 6: composite sigma_a = 0.344 nm, z_m = 1.08 nm, R_a = 0.94 um; at p = 0.5 the real
+    area ratios 0.013/0.04/0.073 and P_LJa 5.56/17.7/31.8 MPa; eq 22 bounds 1.05/0.49 nm."""
+    r = paper1_table2_roughness(1.0)
+    assert (r.sigma_a, r.z_m, r.radius) == pytest.approx((0.344e-9, 1.08e-9, 0.94e-6), rel=2e-3)
+    for rho, ar, plj in ((31.3, 0.013, 5.56), (100, 0.04, 17.7), (179, 0.073, 31.8)):
+        r = paper1_table2_roughness(rho * 1e12)
+        assert r.contact_probability(r.z_m) == pytest.approx(0.5)
+        assert r.real_area_ratio(r.z_m) == pytest.approx(ar, rel=0.05)   # paper's 2 digits
+        assert r.lj_pressure(r.z_m, 0.06) / 1e6 == pytest.approx(plj, rel=5e-3)
+    assert mean_plane_dominance_bound(0.165e-9, 1e-6, 10e12) == pytest.approx(1.05e-9, rel=5e-3)
+    assert mean_plane_dominance_bound(0.165e-9, 1e-6, 100e12) == pytest.approx(0.49e-9, rel=1e-2)
+
+
+def test_asperity_laws_derivatives_by_finite_differences():
+    r = paper1_table2_roughness(100e12)
+    h = np.linspace(0.3e-9, 3e-9, 60)
+    for law in (GWElastic(r, 58.48e9), GWAdhesion(r, 0.06),
+                AsperityAdhesion.from_asperities(0.94e-6, 0.06, 100e12, 0.5, 1.08e-9)):
+        eps = 1e-15
+        fd = (law.pressure(h + eps) - law.pressure(h - eps)) / (2 * eps)
+        assert np.max(np.abs(fd - law.dpressure(h))) <= 1e-7 * np.max(np.abs(fd))
+        fe = (law.energy(h + eps) - law.energy(h - eps)) / (2 * eps)
+        assert np.max(np.abs(fe - law.pressure(h))) <= 1e-7 * np.max(np.abs(law.pressure(h)))
+
+
+def test_paper1_section6_scenes_run_and_report_asperity_forces(tmp_path):
+    import csv
+
+    import femadh
+
+    for name, col in (("paper1_fig8_rho179", "F_LJa_N"), ("paper1_slider_gw", "F_ela_N")):
+        sc = femadh.load_scene(f"validation/scenes/{name}.toml")
+        res = femadh.run(sc, str(tmp_path / name), figures=False, progress=False)
+        assert res.status == "converged"
+        rows = list(csv.DictReader(open(tmp_path / name / "curve.csv")))
+        assert col in rows[0]
+        for r in rows:  # F_ex = F_LJ + F_LJa - F_ela - F_el, row by row
+            f = float(r["F_LJ_N"]) + float(r.get("F_LJa_N") or 0) - float(r.get("F_ela_N") or 0) \
+                - float(r["F_el_N"])
+            assert float(r["F_ex_N"]) == pytest.approx(f, rel=1e-12, abs=1e-18)
+
+
+def test_regime_map_limits_and_hysteresis():
+    """Smooth LJ sphere: small mu approaches the Derjaguin/DMT 2 pi R dg with no hysteresis;
+    at mu = 2 the branch folds (jump-in on approach, jump-out later on retract) and the
+    pull-off falls towards JKR, within a few percent of Maugis-Dugdale at lambda = 1.16 mu."""
+    from femadh.regime import lj_sphere
+
+    lo = lj_sphere(0.1)
+    assert lo.jump_in is None and lo.jump_out is None
+    assert lo.pull_off == pytest.approx(2.0, abs=0.05)       # rigid-LJ limit AR/8z0^2
+    hi = lj_sphere(2.0)
+    assert hi.jump_in is not None and hi.jump_out is not None and hi.jump_out > hi.jump_in
+    assert abs(hi.hysteresis) > 0.1
+    assert 1.5 < hi.pull_off < lo.pull_off
+    assert hi.pull_off == pytest.approx(hi.maugis, rel=0.06)  # LJ vs Dugdale law: measured 3.6 %
