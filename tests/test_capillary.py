@@ -42,7 +42,6 @@ def test_rigid_sphere_limit_is_4_pi_R_gamma():
 
 def test_scene_with_capillary_writes_F_cap_and_includes_it_in_F_ex(tmp_path):
     import femadh
-    from femadh.output import read_curve
 
     sc = femadh.load_scene("validation/scenes/paper1_slider_meniscus.toml")
     res = femadh.run(sc, str(tmp_path), figures=False, progress=False)

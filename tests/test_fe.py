@@ -90,7 +90,7 @@ def test_condensed_solution_satisfies_full_fe_system(fe_fig3):
     s = sw.states[-1]
     assert s.active.any()  # a contact state, with LJ and contact pressure both acting
     u = op.full_field(s.p_total)
-    free, fixed = op.free, op.fixed
+    free = op.free
     f = op.B @ s.p_total
     r = op.K_full[free] @ u - f[free]
     # direct sparse solve: residual at round-off of ||K|| ||u||

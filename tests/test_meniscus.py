@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from femadh.errors import DomainError
-from femadh.meniscus import LIQUIDS, GAB, default_isotherm, kelvin_radius, meniscus, sweep
+from femadh.meniscus import LIQUIDS, default_isotherm, kelvin_radius, meniscus, sweep
 from femadh.meniscus.circular import solve_circular
 from femadh.meniscus.geometry import Geometry, force_over_2pi
 from femadh.meniscus.profile_fe import MeridianFE

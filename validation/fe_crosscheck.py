@@ -14,7 +14,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from femadh.contact import trace  # noqa: E402
-from femadh.elastic import GreenOperator, RadialGrid, disk_displacement  # noqa: E402
+from femadh.elastic import RadialGrid, disk_displacement  # noqa: E402
 from femadh.elastic.fe import FEOperator, FESettings  # noqa: E402
 from femadh.output import state_forces  # noqa: E402
 from femadh.runner import run  # noqa: E402

@@ -16,7 +16,6 @@ try:
 except ModuleNotFoundError:
     import tomli as tomllib
 
-from femadh.reference import surface_energy_from_hamaker
 from femadh.reference.gw import mean_plane_dominance_bound, paper1_table2_roughness
 from femadh.reference.maugis import lj_dugdale_lambda, maugis_pull_off
 from femadh.regime import regime_map

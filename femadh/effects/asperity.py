@@ -14,10 +14,11 @@ import math
 import numpy as np
 
 from ..reference.gw import Roughness, gw_integral
+from .step import SmoothStepLaw
 
 
 @dataclass(frozen=True)
-class AsperityAdhesion:
+class AsperityAdhesion(SmoothStepLaw):
     """Attributes: pressure P_LJa (Pa, eq 20), sigma (m), width w (m)."""
 
     pressure_value: float
@@ -30,18 +31,13 @@ class AsperityAdhesion:
         p = 2 * math.pi * asperity_radius * surface_energy * density * probability
         return cls(p, sigma, smoothing * sigma)
 
-    def _x(self, h):
-        return (self.sigma + 5 * self.width - np.asarray(h, float)) / self.width
+    @property
+    def _amplitude(self):
+        return self.pressure_value
 
-    def pressure(self, h):
-        return self.pressure_value * 0.5 * (1 + np.tanh(0.5 * self._x(h)))
-
-    def dpressure(self, h):
-        s = 0.5 * (1 + np.tanh(0.5 * self._x(h)))
-        return -self.pressure_value / self.width * s * (1 - s)
-
-    def energy(self, h):
-        return -self.pressure_value * self.width * np.logaddexp(0.0, self._x(h))
+    @property
+    def _center(self):
+        return self.sigma + 5 * self.width
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,11 @@ The surface-tension ring force at the meniscus edge (relative size ~ sqrt(|r_K|/
 """
 from dataclasses import dataclass
 
-import numpy as np
+from .step import SmoothStepLaw
 
 
 @dataclass(frozen=True)
-class CapillaryCondensate:
+class CapillaryCondensate(SmoothStepLaw):
     """Attributes: surface_tension gamma (N/m), kelvin_radius r_K (m, < 0), film t (m),
     width w (m) of the smoothed meniscus edge."""
 
@@ -44,15 +44,10 @@ class CapillaryCondensate:
         """Gap (m) below which the condensate fills: 2 |r_K| + 2 t."""
         return 2 * abs(self.kelvin_radius) + 2 * self.film
 
-    def _x(self, h):
-        return (self.fill_gap - np.asarray(h, float)) / self.width
+    @property
+    def _amplitude(self):
+        return self.laplace_pressure
 
-    def pressure(self, h):
-        return self.laplace_pressure * 0.5 * (1 + np.tanh(0.5 * self._x(h)))
-
-    def dpressure(self, h):
-        s = 0.5 * (1 + np.tanh(0.5 * self._x(h)))
-        return -self.laplace_pressure / self.width * s * (1 - s)
-
-    def energy(self, h):
-        return -self.laplace_pressure * self.width * np.logaddexp(0.0, self._x(h))
+    @property
+    def _center(self):
+        return self.fill_gap

@@ -13,10 +13,10 @@ import math
 import time
 
 import numpy as np
-from scipy import linalg
 from scipy.sparse.linalg import splu
 
 from .grid import RadialGrid
+from .operator import SurfaceOperator
 from .mesh import MeshSpec, cached_mesh, read_mesh, surface_points_of
 
 
@@ -93,7 +93,7 @@ class FESettings:
             raise ValueError(f"far_field must be 'boussinesq' or 'fixed', got {self.far_field!r}")
 
 
-class FEOperator:
+class FEOperator(SurfaceOperator):
     """Condensed FE compliance of the axisymmetric half-space on a RadialGrid.
 
     Parameters
@@ -174,7 +174,6 @@ class FEOperator:
         self.compliance = U[self._surface_rows(), :]
         t["condensation"] = time.perf_counter() - t0
         self.timings = t
-        self._stiffness = None
 
     # ------------------------------------------------------------------ set-up helpers
     def _load_matrix(self):
@@ -248,16 +247,6 @@ class FEOperator:
         return where
 
     # ------------------------------------------------------------------ interface
-    @property
-    def stiffness(self):
-        if self._stiffness is None:
-            lu = linalg.lu_factor(self.compliance, check_finite=False)
-            self._stiffness = linalg.lu_solve(lu, np.eye(self.grid.n), check_finite=False)
-        return self._stiffness
-
-    def displacement(self, pressure):
-        return self.compliance @ pressure
-
     def full_field(self, pressure):
         """Displacement DOF vector (m) of the whole mesh under annulus pressures (Pa)."""
         total = float(self.grid.areas @ pressure)

@@ -15,9 +15,10 @@ load Green function (paper 1 eq 1; the paper used 2000 terms of one) is needed.
 import math
 
 import numpy as np
-from scipy import linalg, special
+from scipy import special
 
 from .grid import RadialGrid
+from .operator import SurfaceOperator
 
 
 def disk_displacement(r, a, e_star, p=1.0):
@@ -43,7 +44,7 @@ def disk_displacement(r, a, e_star, p=1.0):
     return p * w / e_star
 
 
-class GreenOperator:
+class GreenOperator(SurfaceOperator):
     """Surface compliance of the half-space on a :class:`RadialGrid` (exact annulus loads).
 
     Parameters
@@ -69,15 +70,3 @@ class GreenOperator:
         r = grid.nodes[:, None]
         w_edges = disk_displacement(r, grid.edges[None, :], self.e_star)
         self.compliance = np.diff(w_edges, axis=1)
-        self._stiffness = None
-
-    @property
-    def stiffness(self):
-        if self._stiffness is None:
-            lu = linalg.lu_factor(self.compliance, check_finite=False)
-            self._stiffness = linalg.lu_solve(lu, np.eye(self.grid.n), check_finite=False)
-        return self._stiffness
-
-    def displacement(self, pressure):
-        """Nodal displacements w (m) of piecewise-constant pressures (Pa) on the annuli."""
-        return self.compliance @ pressure

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
 
 from ..errors import ConvergenceError, DomainError
 from .geometry import Geometry, force_over_2pi

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SceneError
 from .isotherms import BET, GAB, Polynomial, Tabulated, default_isotherm
 from .liquids import LIQUIDS, Liquid
 from .solve import METHODS
