@@ -59,21 +59,25 @@ class ContactProblem:
     def surface_force_stiffness(self):
         """The largest softening stiffness of the effects against the surface's own.
 
-        Returns (ratio, gap, dP/dh, k_node): the largest -dP/dh (Pa/m) over the gaps the
-        surface can reach (h >= sigma with the gap constraint, else h >= z0 where LJ turns
-        repulsive), the gap where it occurs, and k_node = min_k K_kk, the pressure per unit
-        displacement of a single node (Pa/m). With ratio near 1 a single node can snap on its
-        own: the answer then depends on the mesh, not the physics.
+        Returns (ratio, gap, -dP/dh, k_node): the largest -dP/dh (Pa/m) over the gaps the
+        surface can reach, the gap where it occurs, and k_node = min_k K_kk, the pressure per
+        unit displacement of a single node (Pa/m). Reachable gaps: h >= sigma with the gap
+        constraint; otherwise h above the largest gap where the summed law turns repulsive
+        (z0 for LJ alone, ~1 nm with Greenwood-Williamson asperities). With ratio near 1 a
+        single node can snap on its own: the answer then depends on the mesh, not the physics.
         """
-        floors = [self.sigma] if self.sigma is not None else [
-            getattr(e, "z0", None) for e in self.effects.values()]
-        floors = [f for f in floors if f]
-        if not floors or not self.effects:
-            return 0.0, math.nan, 0.0, float(np.min(np.diag(self.K)))
-        h = min(floors) * np.logspace(0, 2, 400)
+        k_node = float(np.min(np.diag(self.K)))
+        if not self.effects:
+            return 0.0, math.nan, 0.0, k_node
+        if self.sigma is not None:
+            floor = self.sigma
+        else:
+            scan = np.logspace(-7, -11, 4000)            # 100 nm down to 0.01 nm
+            repulsive = np.flatnonzero(self.pressure(scan) < 0)
+            floor = float(scan[repulsive[0]]) if repulsive.size else float(scan[-1])
+        h = floor * np.logspace(0, 2, 400)
         soft = -self.dpressure(h)
         k = int(np.argmax(soft))
-        k_node = float(np.min(np.diag(self.K)))
         return float(max(soft[k], 0.0) / k_node), float(h[k]), float(soft[k]), k_node
 
     def contour(self, d):
