@@ -25,6 +25,8 @@ from scipy import linalg, optimize
 from ..reference.hertz import hertz_annulus_force, hertz_annulus_force_drc
 from .problem import State
 
+#: evaluations of the closure condition g(r_c) allowed per solve (bracketing + Brent)
+CLOSURE_MAX_EVALS = 60
 #: a chord step (reused factorisation) must cut the residual at least by this factor
 CHORD_RATE = 0.05
 #: largest fraction of the current gap one Newton step may close (keeps h > 0 for LJ)
@@ -368,6 +370,10 @@ def _solve_hertz_closure(problem, d, w0, *, tol, max_iter, r_c0):
              "n_iter": 0, "last": None}
 
     def g(r_c):
+        cache["evals"] = cache.get("evals", 0) + 1
+        if cache["evals"] > CLOSURE_MAX_EVALS:
+            raise _InnerFailure(r_c, math.nan, cache["n_iter"], "the closure's contact radius "
+                                f"was not found in {CLOSURE_MAX_EVALS} evaluations")
         out = _closure_solve(problem, d, r_c, cache["w"], cache["factor"], tol=tol,
                              max_iter=max_iter)
         w, p, w10, res, it, factor, ok = out
