@@ -127,7 +127,6 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
         for branch, d_vals in plan:
             bar = _progress_bar(len(d_vals) - 1, f"{scene.name} {branch}", progress)
             on_state = (lambda s, b=branch: writer.write_state(b, s)) if writer else None
-            sweep = None
             try:
                 sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
                               max_iter=scene.max_iter, on_state=on_state,

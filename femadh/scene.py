@@ -205,6 +205,16 @@ def _asperity_contact(file, table, e_star):
     return out
 
 
+def scene_name(top, file):
+    """The [scene] table's name, validated (shared by contact and meniscus scenes)."""
+    s = _Reader(file, top.table_at("scene"), "scene")
+    name = s.raw("name")
+    if not isinstance(name, str) or not name:
+        raise s.error("name", name, "a non-empty string")
+    s.done()
+    return name
+
+
 def load_scene(path):
     """Read and validate a scene file.
 
@@ -260,11 +270,7 @@ def scene_from_dict(data, file=None):
     top.used |= _TOP
     top.done(_TOP)
 
-    s = _Reader(file, top.table_at("scene"), "scene")
-    name = s.raw("name")
-    if not isinstance(name, str) or not name:
-        raise s.error("name", name, "a non-empty string")
-    s.done()
+    name = scene_name(top, file)
 
     sp = _Reader(file, top.table_at("sphere"), "sphere")
     sphere = Sphere(sp.quantity("radius", "length"),

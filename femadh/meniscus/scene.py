@@ -51,15 +51,11 @@ class MeniscusScene:
 
 def parse_meniscus(top, file):
     """Build a MeniscusScene from the top-level _Reader of a scene file."""
-    from ..scene import _Reader
+    from ..scene import _Reader, scene_name
 
     top.used |= {"scene", "meniscus", "output"}
     top.done({"scene", "meniscus", "output"})
-    s = _Reader(file, top.table_at("scene"), "scene")
-    name = s.raw("name")
-    if not isinstance(name, str) or not name:
-        raise s.error("name", name, "a non-empty string")
-    s.done()
+    name = scene_name(top, file)
     m = _Reader(file, top.table_at("meniscus"), "meniscus")
     radii_raw = m.raw("tip_radius")
     radii_list = radii_raw if isinstance(radii_raw, list) else [radii_raw]
