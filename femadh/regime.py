@@ -3,126 +3,183 @@
 A smooth elastic sphere against a flat with the LJ law of paper 1 eq (3) and no sigma-gap: the
 repulsive term carries the contact. Swept in the Tabor parameter
 mu = (R dg^2 / (E*^2 z0^3))^(1/3), dg = A / (16 pi z0^2) (eq 19), by choosing E* at fixed R, A,
-z0. Each point is an approach-retract sweep with fold detection; the pull-off is the largest
-tensile force on the retract branch (load-controlled pull-off), normalised by pi R dg and
-compared with Maugis-Dugdale at lambda = 1.157 mu (Johnson & Greenwood 1997) and the JKR (1.5)
-and DMT (2) limits. Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453,
-1277 ("Adhesion of elastic spheres"); Feng 2000, J. Colloid Interface Sci. 238, 318.
+z0. Each point traces the whole equilibrium curve F(d) by pseudo-arclength continuation
+(:mod:`femadh.contact.arclength`), through its folds; the approach and retract paths of a
+displacement-controlled experiment, the jump-in and jump-out separations (the folds) and the
+hysteresis follow from it. The pull-off is the largest tensile force on the retract path
+(load-controlled pull-off), normalised by pi R dg and compared with Maugis-Dugdale at
+lambda = 1.157 mu (Johnson & Greenwood 1997) and the JKR (1.5) and DMT (2) limits.
+
+Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277 ("Adhesion of
+elastic spheres"); Feng 2000, J. Colloid Interface Sci. 238, 318.
+
+Mesh: the contact edge must be resolved by nodes whose own stiffness exceeds the LJ law's
+largest softening stiffness, or single nodes snap on their own (lattice trapping, a mesh
+artefact). That spacing shrinks like mu^-2 in units of the contact radius, so the grid is
+uniform with that spacing only where the contact edge travels and grows geometrically beyond.
 """
 from dataclasses import dataclass
 import math
 import time
+import warnings
 
 import numpy as np
 
-from .contact import ContactProblem, trace
+from .contact import ContactProblem
+from .contact.arclength import trace_curve
 from .effects import LennardJones
 from .elastic import GreenOperator, RadialGrid
 from .indenter import Sphere
-from .output import state_forces
-from .reference.maugis import lj_dugdale_lambda, maugis_pull_off
+from .reference.adhesion import jkr_contact_radius
+from .reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
+
+#: a priori: the fine spacing keeps the LJ softening stiffness below this fraction of a node's
+STIFFNESS_TARGET = 0.4
+#: a posteriori: above this local ratio (on any traced state) a node could snap on its own
+TRAPPING_LIMIT = 1.0
+#: compressive load (units pi R dg) at the deepest point of the sweep: beyond the jump-in
+#: landing (which is tensile), so the whole approach-retract cycle is on the curve
+PRELOAD = 0.5
+#: uniform spacing up to this multiple of the JKR contact radius at PRELOAD (the largest
+#: contact of the sweep; JKR bounds Maugis-Dugdale's radius at a given load from above)
+FINE_MARGIN = 1.15
+#: analysis radius in the same units (the rigid-LJ tail beyond it is added to the force)
+ANALYSIS_RADIUS = 4.32
+
+
+class MeshResolutionWarning(UserWarning):
+    """The traced states reached gaps where a single node is softer than the LJ law."""
 
 
 @dataclass
 class RegimePoint:
+    """One point of the regime map (forces / (pi R dg), separations / z0)."""
+
     mu: float
     e_star: float
-    pull_off: float            # / (pi R dg)
-    maugis: float              # / (pi R dg)
+    pull_off: float            # load-controlled pull-off (largest tension on the curve) / pi R dg
+    pull_off_displacement: float  # largest tension on the displacement-controlled retract path
+    maugis: float              # Maugis-Dugdale pull-off at lambda = 1.157 mu
     jump_in: float | None      # d / z0 of the approach fold
-    jump_out: float | None     # d / z0 of the retract fold
-    hysteresis: float          # energy dissipated per cycle / (pi R dg z0)
-    n_steps: int
+    jump_out: float | None     # d / z0 of the last retract fold
+    hysteresis: float          # energy dissipated per cycle / (pi R dg z0), from energy jumps
+    hysteresis_trapezoid: float  # the same by integrating F dd around the loop (cross-check)
+    n_folds: int               # folds of the traced curve (2 for one S; more: mesh wiggles)
+    trapping_ratio: float      # max over states and nodes of -P'(h_k) / K_kk
+    n_points: int
+    n_solves: int
     nodes: int
     wall_time: float
     curves: dict
 
 
-#: node count is raised until the LJ softening stiffness is below this fraction of one node's
-STIFFNESS_TARGET = 0.4
+def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
+    """The smooth-sphere problem at Tabor mu, on a grid fine where the contact edge travels.
 
-
-def lj_sphere(mu, *, nodes=None, steps=40, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT,
-              tol=1e-19, min_nodes=120):
-    """Approach-retract sweep of a smooth LJ sphere at Tabor parameter mu.
-
-    ``nodes=None`` picks the node count so that the LJ law's largest softening stiffness stays
-    below STIFFNESS_TARGET of a single node's stiffness (K_kk grows like N), which keeps the
-    discrete surface free of node-scale snapping (lattice trapping) at large mu.
+    Returns (problem, lj, e_star, a, d_min): a is the analysis radius (m), d_min the
+    separation (m) of the deepest point, where the JKR load is PRELOAD pi R dg.
     """
-    t0 = time.perf_counter()
     lj = LennardJones(hamaker, z0)
     dg = lj.work_of_adhesion
     e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
     K = 4 * e_star / 3
-    a_unit = (math.pi * dg * radius**2 / K) ** (1 / 3)          # Maugis length units
-    d_unit = (math.pi**2 * dg**2 * radius / K**2) ** (1 / 3)
-    a = max(3.0 * 1.44 * a_unit, math.sqrt(2 * radius * 20 * z0))
-    def build(n):
-        return ContactProblem(GreenOperator(RadialGrid.uniform(a, n), e_star), Sphere(radius),
-                              {"lj": lj})
-
-    if nodes is None:
-        probe = build(min_nodes)
-        ratio = probe.surface_force_stiffness()[0]
-        nodes = max(min_nodes, int(math.ceil(min_nodes * ratio / STIFFNESS_TARGET)))
-        problem = probe if nodes == min_nodes else build(nodes)
+    a_unit = (math.pi * dg * radius**2 / K) ** (1 / 3)
+    a = max(ANALYSIS_RADIUS * a_unit, math.sqrt(2 * radius * 20 * z0))
+    a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, e_star, dg)
+    d_min = z0 - jkr_approach(a_max, radius, e_star, dg)
+    # node self-stiffness scales like 1/spacing: calibrate it on a coarse uniform probe
+    probe = ContactProblem(GreenOperator(RadialGrid.uniform(a, 60), e_star), Sphere(radius),
+                           {"lj": lj})
+    ratio0, _, _, _ = probe.surface_force_stiffness()
+    dr = a / 59.5 * stiffness_target / ratio0
+    if dr >= a / (min_nodes - 0.5):
+        grid = RadialGrid.uniform(a, min_nodes)
     else:
-        problem = build(nodes)
+        grid = RadialGrid.graded(a, dr, FINE_MARGIN * a_max)
+    problem = ContactProblem(GreenOperator(grid, e_star), Sphere(radius), {"lj": lj})
+    return problem, lj, e_star, a, d_min
+
+
+def trapping_ratio(problem, w, d):
+    """max_k -P'(h_k) / K_kk (-): the largest softening stiffness of the law at any node's
+    gap against that node's own stiffness. Above 1 the node can snap alone."""
+    h = problem.contour(d) - w
+    return float(np.max(-problem.dpressure(h) / np.diag(problem.K)))
+
+
+def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-19,
+              stiffness_target=STIFFNESS_TARGET, min_nodes=120, progress=None):
+    """Trace the equilibrium curve of a smooth LJ sphere at Tabor parameter mu (approach from
+    d = 12 z0 to a compressive load of about PRELOAD pi R dg) and read the regime-map numbers
+    off it.
+    """
+    t0 = time.perf_counter()
+    problem, lj, e_star, a, d_min = _lj_problem(mu, radius, hamaker, z0, stiffness_target,
+                                                   min_nodes)
+    dg = lj.work_of_adhesion
     d0 = 12 * z0
-    d_min = z0 - 2.1 * d_unit                                      # compressive ~ +pi R dg
-    d = np.linspace(d0, d_min, steps + 1)
-    ap = trace(problem, d, branch="approach", tol=tol)
-    rt = trace(problem, d[::-1], branch="retract", tol=tol, start=ap.states[-1])
+    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=2.0,
+                        progress=progress)
 
-    def force(states):
-        out = []
-        for s in states:
-            h_a = s.d + a * a / (2 * radius)
-            tail = -2 * math.pi * radius * float(lj.energy(h_a))    # rigid LJ beyond a
-            out.append(state_forces(problem, s)[2] + tail)
-        return np.array(out)
+    def force(d, w):
+        """F on the disk (N, attractive positive): LJ over the grid + rigid LJ beyond a."""
+        h = problem.contour(d) - w
+        tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))
+        return problem.grid.force(problem.pressure(h)) + tail
 
-    fa, fr = force(ap.states), force(rt.states)
-
-    def branch_path(sweep):
-        """(d, F) along a branch in visiting order, folds included (before, then landing)."""
-        pts = []
-        jumps = {id(j.before): j for j in sweep.jumps}
-        states = list(sweep.states)
-        for j in sweep.jumps:  # fold and landing states sit between grid states
-            states += [j.before, j.after]
-        sign = 1 if sweep.branch == "retract" else -1
-        order = sorted(range(len(states)), key=lambda i: (sign * states[i].d,
-                                                          0 if id(states[i]) in jumps else 1))
-        for i in order:
-            pts.append((states[i].d, force([states[i]])[0]))
-        return np.array(pts)
     scale = math.pi * radius * dg
-    # the grid may straddle a sharp force peak (DMT-like, small mu): re-trace the retract
-    # branch finely between the neighbours of its largest tensile force
-    k = int(np.argmax(fr))
-    if 0 < k < len(rt.states) - 1:
-        fine = np.linspace(rt.states[k - 1].d, rt.states[k + 1].d, 41)
-        sub = trace(problem, fine, branch="retract", tol=tol, start=rt.states[k - 1])
-        fr_peak = max(fr.max(), force(sub.states).max())
-    else:
-        fr_peak = fr.max()
-    # hysteresis: work of the closed cycle, approach (d decreasing) then retract, along the
-    # branches including their fold and landing states (the loop can be narrower than a step)
-    fr_on_d = fr[::-1]
+    paths = {k: curve.branch(k) for k in ("approach", "retract")}
+    F = {k: np.array([force(d, w) for _, d, w in v]) for k, v in paths.items()}
+    D = {k: np.array([d for _, d, _ in v]) for k, v in paths.items()}
+
+    # hysteresis: the work of the closed cycle is the energy released at the jumps (the
+    # interaction beyond a is continuous in d and drops out); the loop integral checks it
+    released = 0.0
+    for v in paths.values():
+        for (k1, d1, w1), (k2, _, w2) in zip(v, v[1:]):
+            if k1 == "fold" and k2 == "land":
+                released += problem.energy(w1, d1) - problem.energy(w2, d1)
     trap = getattr(np, "trapezoid", None) or np.trapz
-    pa, pr = branch_path(ap), branch_path(rt)
-    hyst = float(trap(pr[:, 1], pr[:, 0]) + trap(pa[:, 1], pa[:, 0])) / (scale * z0)
+    loop = trap(F["retract"], D["retract"]) + trap(F["approach"], D["approach"])
+
+    # pull-off under load control (as Maugis-Dugdale's): the largest tensile force anywhere on
+    # the equilibrium curve, refined between the neighbours of the best traced point; under
+    # displacement control the retract path may leave the curve (jump-out) before reaching it
+    cf = np.array([force(p.d, p.w) for p in curve.points])
+    i = int(np.argmax(cf))
+    pull = cf[i]
+    if 0 < i < len(curve.points) - 1:
+        pull = max(pull, curve.maximize(i, force)[0])
+    pull_disp = float(np.max(F["retract"]))
+
+    folds_a = [d for kind, d, _ in paths["approach"] if kind == "fold"]
+    folds_r = [d for kind, d, _ in paths["retract"] if kind == "fold"]
+    trapping = max(trapping_ratio(problem, p.w, p.d) for p in curve.points)
+    if trapping > TRAPPING_LIMIT:
+        warnings.warn(f"mu = {mu:g}: a traced state reached -P'(h)/K_kk = {trapping:.2f} > "
+                      f"{TRAPPING_LIMIT} (nodes can snap alone); lower stiffness_target",
+                      MeshResolutionWarning, stacklevel=2)
+    cd = curve.d
     return RegimePoint(
-        mu, e_star, float(fr_peak / scale), maugis_pull_off(lj_dugdale_lambda(mu)),
-        ap.jumps[0].d_fold / z0 if ap.jumps else None,
-        rt.jumps[-1].d_fold / z0 if rt.jumps else None, hyst,
-        ap.n_solves + rt.n_solves, nodes, time.perf_counter() - t0,
-        {"d": d, "approach": fa / scale, "retract": fr_on_d / scale})
+        mu, e_star, float(pull / scale), pull_disp / scale, maugis_pull_off(lj_dugdale_lambda(mu)),
+        folds_a[0] / z0 if folds_a else None, folds_r[-1] / z0 if folds_r else None,
+        float(released / (scale * z0)), float(loop / (scale * z0)), len(curve.folds),
+        trapping, len(curve.points), curve.n_solves, problem.grid.n,
+        time.perf_counter() - t0,
+        {"curve_d": cd / z0, "curve_F": cf / scale,
+         "curve_stable": np.array([p.stable for p in curve.points]),
+         "approach_d": D["approach"] / z0, "approach_F": F["approach"] / scale,
+         "retract_d": D["retract"] / z0, "retract_F": F["retract"] / scale,
+         "n_factor": curve.n_factor, "n_krylov": curve.n_krylov})
 
 
-def regime_map(mus, **kw):
-    return [lj_sphere(mu, **kw) for mu in mus]
+def regime_map(mus, progress=None, **kw):
+    """lj_sphere at each mu; ``progress(i)`` after each point."""
+    out = []
+    for i, mu in enumerate(mus):
+        out.append(lj_sphere(mu, **kw))
+        if progress:
+            progress(i + 1)
+    return out

@@ -49,6 +49,36 @@ class RadialGrid:
         return cls(nodes, edges)
 
     @classmethod
+    def graded(cls, radius, spacing, fine_radius, growth=1.08):
+        """Uniform nodes of the given spacing up to fine_radius, then geometrically coarser.
+
+        Parameters
+        ----------
+        radius : float
+            Analysis radius a (m).
+        spacing : float
+            Node spacing (m) on [0, fine_radius].
+        fine_radius : float
+            Radius (m) up to which the spacing is uniform (where the contact edge can move).
+        growth : float
+            Ratio of successive spacings beyond fine_radius (> 1).
+        """
+        if not (spacing > 0 and growth > 1 and 0 < fine_radius):
+            raise ValueError("need spacing > 0, fine_radius > 0 and growth > 1")
+        m = int(math.floor(min(fine_radius, radius) / spacing))
+        nodes = list(spacing * np.arange(m + 1))
+        step = spacing
+        while True:
+            step *= growth
+            # stop when the last annulus (half-way edge to a) would be narrower than the step
+            if nodes[-1] + step + 0.5 * step * growth > radius:
+                break
+            nodes.append(nodes[-1] + step)
+        if nodes[-1] >= radius:
+            raise ValueError("the fine spacing does not fit inside the analysis radius")
+        return cls.from_nodes(np.array(nodes), radius)
+
+    @classmethod
     def from_nodes(cls, nodes, radius):
         """Annuli with edges half-way between the given nodes (nodes[0] must be 0)."""
         nodes = np.asarray(nodes, float)

@@ -1,0 +1,560 @@
+"""Pseudo-arclength continuation of smooth surface problems: folds are traced, not jumped.
+
+For a problem without the sigma-gap (every effect a smooth law of the gap, e.g. a smooth LJ
+sphere, or Greenwood-Williamson asperity pressures) the equilibria form a curve in (w, d),
+
+    F(w, d) = K w - P(b(d) - w) = 0,        b(d) = d + shape(r)   (paper 1 eqs 5-6),
+
+which turns back in d at every jump-in and jump-out (a fold: dd/ds = 0 and one eigenvalue of
+the Hessian crosses zero). Parametrising by the separation d, as :func:`trace` does, a fold is
+found only as the place where the branch stops; here the curve is followed by its arclength s
+with Keller's bordered system
+
+    [ K + diag(P')   -P' ] [dw]   [ -F ]
+    [ omega t_w^T    t_d ] [dd] = [ -N ],   N = t . (x - x_pred),
+
+which stays regular through simple folds, so the unstable branch between them is traced too and
+each fold is located as the root of t_d (secant iteration on the step length). Lengths are
+scaled by ``scale`` (e.g. z0) and the displacement part of the norm is the nodal mean square
+(omega = 1/N), so one unit of s is one ``scale`` of separation or of typical displacement.
+
+The displacement-controlled approach and retract paths follow from the curve: each path walks
+the stable segments and, at a fold, jumps at fixed d to the next stable segment that exists at
+that d (:meth:`EquilibriumCurve.walk`, :meth:`EquilibriumCurve.branch`).
+
+Linear algebra: the bordered matrix changes little from step to step, so one LU factorisation
+preconditions (right-preconditioned GMRES, dense O(N^2) mat-vecs) the solves of many steps and
+is refreshed only when GMRES slows down; most steps then cost O(N^2), not O(N^3).
+"""
+from dataclasses import dataclass, field
+import math
+import time
+
+import numpy as np
+from scipy import linalg
+from scipy.sparse import linalg as sla
+
+from ..errors import ConvergenceError
+from .newton import _is_positive_definite
+
+#: Newton iterations allowed per corrector
+MAX_ITER = 15
+#: relative accuracy of a Newton step's linear solve (inexact Newton: ample for convergence)
+NEWTON_RTOL = 1e-4
+#: GMRES iterations before the preconditioning factorisation is refreshed
+GMRES_MAX = 8
+#: the step length is tuned so that the corrector moves no gap by more than about this
+#: fraction of itself away from the prediction (the predictor error grows like step^2)
+TARGET_CORRECTION = 0.05
+#: the predictor may change no gap by more than this fraction of itself (resolves the law)
+MAX_GAP_CHANGE = 0.3
+#: the smallest step length, relative to the first one, before the trace gives up
+MIN_STEP_FRACTION = 1e-6
+#: largest fraction of its gap one corrector step may close (LJ repulsion grows like h^-9)
+CORRECTOR_GAP_CLOSURE = 0.3
+#: fold located when |t_d| falls below this (tangents have unit length)
+FOLD_TD_TOL = 1e-7
+
+
+@dataclass
+class CurvePoint:
+    """An equilibrium on the curve: separation d (m), displacements w (m), unit tangent t
+    (scaled units, t[-1] = dd/ds), Hessian positive definite (``stable``), iterations."""
+
+    d: float
+    w: np.ndarray
+    t: np.ndarray
+    stable: bool
+    n_iter: int
+    residual: float
+
+    @property
+    def t_d(self):
+        return float(self.t[-1])
+
+
+@dataclass
+class Fold:
+    """A fold of the curve between points ``index`` and ``index + 1``, at separation d (m)."""
+
+    index: int
+    d: float
+    w: np.ndarray
+    s_offset: float
+
+
+@dataclass
+class EquilibriumCurve:
+    """Points in arclength order from d_start to d_end and the folds between them."""
+
+    points: list = field(default_factory=list)
+    folds: list = field(default_factory=list)
+    n_solves: int = 0
+    n_factor: int = 0
+    n_krylov: int = 0
+    wall_time: float = 0.0
+    _tracer: object = None
+
+    @property
+    def d(self):
+        return np.array([p.d for p in self.points])
+
+    def walk(self, direction):
+        """Segments of the displacement-controlled path in visiting order.
+
+        Returns a list of ``(kind, i, j_or_t)`` items:
+        ``("run", i0, i1)`` - stable points i0..i1 (inclusive, either order) visited in turn;
+        ``("fold", k, None)`` - the k-th fold reached at the end of the previous run;
+        ``("land", i, t)`` - the landing state between points i and i+1 at fraction t in d.
+        Raises ValueError if a fold has no stable landing on the traced curve.
+        """
+        pts, n = self.points, len(self.points)
+        fold_after = {f.index: k for k, f in enumerate(self.folds)}
+        sign = -1.0 if direction == "approach" else 1.0     # d decreases on approach
+        # runs of consecutive stable points (arc order)
+        runs, i = [], 0
+        while i < n:
+            if pts[i].stable:
+                j = i
+                while j + 1 < n and pts[j + 1].stable and j not in fold_after:
+                    j += 1
+                runs.append((i, j))
+                i = j + 1
+            else:
+                i += 1
+        if not runs:
+            raise ValueError("no stable state on the traced curve")
+        out = []
+        start = 0 if direction == "approach" else n - 1
+        run = next(r for r in runs if r[0] <= start <= r[1])
+        lo, hi, i = run[0], run[1], start
+        visited = set()
+        while True:
+            visited.add(run)
+            # direction along the run in which d moves the right way
+            step = 1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1
+            end = hi if step == 1 else lo
+            out.append(("run", i, end))
+            # what lies beyond the run's end: a fold (then jump) or the curve's end
+            k_fold = fold_after.get(end) if step == 1 else fold_after.get(end - 1)
+            if k_fold is None:
+                if end not in (0, n - 1):
+                    raise ValueError(f"stability changes at d = {pts[end].d:.6g} m without a "
+                                     "fold of the curve (a bifurcation): not handled")
+                return out
+            d_f = self.folds[k_fold].d
+            out.append(("fold", k_fold, None))
+            landing = None
+            for r in runs:
+                if r in visited:
+                    continue
+                for a in range(r[0], r[1]):
+                    da, db = pts[a].d - d_f, pts[a + 1].d - d_f
+                    if da * db <= 0 and da != db:
+                        landing = (r, a, da / (da - db))
+                        break
+                if landing:
+                    break
+            if landing is None:
+                raise ValueError(f"the fold at d = {d_f:.6g} m has no stable landing on the "
+                                 "traced curve (trace further, or the curve has an isola)")
+            run, a, t = landing
+            out.append(("land", a, t))
+            # continue from the landing toward the travel direction
+            if sign * (pts[a + 1].d - pts[a].d) > 0:
+                lo, hi, i = a + 1, run[1], a + 1
+            else:
+                lo, hi, i = run[0], a, a
+
+    def _dist(self, p, q):
+        tr = self._tracer
+        dx = (np.r_[q.w, q.d] - np.r_[p.w, p.d]) / tr.scale
+        return float(np.sqrt(tr.omega * (dx[:-1] @ dx[:-1]) + dx[-1] ** 2))
+
+    def _on_curve(self, p, off):
+        """(d, w) of the curve point at arclength offset ``off`` from point p, or None."""
+        tr = self._tracer
+        xc, _, _, ok = tr.correct(np.r_[p.w, p.d] / tr.scale + off * p.t, p.t)
+        return (xc[-1] * tr.scale, xc[:-1] * tr.scale) if ok else None
+
+    def point_at(self, i, d):
+        """The curve's state w (m) at separation d between points i and i+1 (root of
+        d(s) = d by secant iteration on the arclength offset from point i)."""
+        pts = self.points
+        a, b = pts[i], pts[i + 1]
+        s_a, f_a, s_b, f_b = 0.0, a.d - d, self._dist(a, b), b.d - d
+        if f_a == 0:
+            return a.w.copy()
+        w = b.w.copy()
+        for _ in range(60):
+            if f_b == 0 or abs(s_b - s_a) < 1e-12 * self._dist(a, b):
+                break
+            s = s_b - f_b * (s_b - s_a) / (f_b - f_a)
+            if not (min(s_a, s_b) < s < max(s_a, s_b)):
+                s = 0.5 * (s_a + s_b)
+            r = self._on_curve(a, s)
+            if r is None:
+                raise ConvergenceError("a state on the traced curve could not be recomputed",
+                                       d=d, residual=math.nan, n_iter=0)
+            f, w = r[0] - d, r[1]
+            if abs(f) <= 1e-12 * self._tracer.scale:
+                break
+            if f * f_b < 0:
+                s_a, f_a = s_b, f_b
+            else:
+                f_a *= 0.5  # Illinois
+            s_b, f_b = s, f
+        return w
+
+    def maximize(self, i, value):
+        """Largest value(d, w) on the curve between points i-1 and i+1 (bounded search in
+        arclength; each evaluation is a corrected point). Returns (value, d, w)."""
+        from scipy import optimize
+
+        pts = self.points
+        s1, s2 = self._dist(pts[i - 1], pts[i]), self._dist(pts[i], pts[i + 1])
+        best = [value(pts[i].d, pts[i].w), pts[i].d, pts[i].w]
+
+        def neg(s):
+            r = self._on_curve(*((pts[i - 1], s) if s <= s1 else (pts[i], s - s1)))
+            if r is None:
+                return -best[0]
+            v = value(*r)
+            if v > best[0]:
+                best[:] = [v, r[0], r[1]]
+            return -v
+        optimize.minimize_scalar(neg, bounds=(0.0, s1 + s2), method="bounded",
+                                 options={"xatol": 1e-7 * (s1 + s2)})
+        return tuple(best)
+
+    def branch(self, direction):
+        """The states along the displacement-controlled path, folds and landings included.
+
+        Parameters
+        ----------
+        direction : {"approach", "retract"}
+
+        Returns
+        -------
+        list of (kind, d, w)
+            In visiting order; kind is ``"point"`` (a curve point), ``"fold"`` (the last state
+            of a branch) or ``"land"`` (where it jumped to, at the same d, recomputed on the
+            curve between the two points that bracket it).
+        """
+        pts = self.points
+        out = []
+        for kind, i, j in self.walk(direction):
+            if kind == "run":
+                for k in range(i, j + (1 if j >= i else -1), 1 if j >= i else -1):
+                    out.append(("point", pts[k].d, pts[k].w))
+            elif kind == "fold":
+                f = self.folds[i]
+                out.append(("fold", f.d, f.w))
+            else:
+                d_f = out[-1][1]
+                out.append(("land", d_f, self.point_at(i, d_f)))
+        return out
+
+
+class _Bordered:
+    """Linear solves with the bordered Jacobian of one state, cheaply, along the whole curve.
+
+    An LU factorisation of the bordered matrix at some earlier state preconditions GMRES on the
+    exact current matrix (applied as dense mat-vecs, O(N^2)). Along a curve the Jacobian changes
+    slowly, so a factorisation serves many points; it is refreshed (O(N^3)) only when GMRES
+    needs more than GMRES_MAX iterations. ``n_factor`` counts refreshes.
+    """
+
+    def __init__(self, problem, omega):
+        self.problem, self.omega = problem, omega
+        self.n = problem.grid.n
+        # the border row is scaled like a row of K (Pa/m) so the matrix is well balanced
+        self.kappa = float(np.mean(np.diag(problem.K)))
+        self.lu = None
+        self.n_factor = 0
+        self.n_krylov = 0
+
+    def matrix(self, D, t):
+        n, K = self.n, self.problem.K
+        M = np.empty((n + 1, n + 1))
+        M[:n, :n] = K
+        M[np.arange(n), np.arange(n)] += D
+        M[:n, n] = -D
+        M[n, :n] = self.kappa * self.omega * t[:n]
+        M[n, n] = self.kappa * t[n]
+        return M
+
+    def solve(self, D, t, rhs, rtol, atol=0.0):
+        """x with M(D, t) x = rhs, M = [[K + diag D, -D], [kappa omega t_w, kappa t_d]],
+        to rtol * |rhs| or atol (residual units: Pa), whichever is larger."""
+        n, K = self.n, self.problem.K
+        kt = self.kappa * self.omega * t[:n]
+        if self.lu is not None:
+            def mv(x):
+                y = np.empty(n + 1)
+                y[:n] = K @ x[:n] + D * (x[:n] - x[n])
+                y[n] = kt @ x[:n] + self.kappa * t[n] * x[n]
+                return y
+            its = [0]
+
+            def count(_):
+                its[0] += 1
+            def pre(y):
+                return linalg.lu_solve(self.lu, y, check_finite=False)
+            # right preconditioning: GMRES then watches the true residual (Pa), not a
+            # preconditioned one in other units
+            op = sla.LinearOperator((n + 1, n + 1), matvec=lambda y: mv(pre(y)), dtype=float)
+            y, info = sla.gmres(op, rhs, rtol=rtol, atol=atol, restart=GMRES_MAX, maxiter=1,
+                                callback=count, callback_type="pr_norm")
+            x = pre(y)
+            self.n_krylov += its[0]
+            if info == 0 and np.all(np.isfinite(x)):
+                return x
+        self.lu = linalg.lu_factor(self.matrix(D, t), check_finite=False)
+        self.n_factor += 1
+        return linalg.lu_solve(self.lu, rhs, check_finite=False)
+
+
+class _Tracer:
+    """Predictor-corrector machinery shared by the trace and the fold location."""
+
+    def __init__(self, problem, scale, tol, curve):
+        self.problem, self.scale, self.tol, self.curve = problem, scale, tol, curve
+        self.n = problem.grid.n
+        self.omega = 1.0 / self.n
+        self.lin = _Bordered(problem, self.omega)
+
+    def tangent(self, w, d, t_prev):
+        """Unit tangent (scaled: w/scale, d/scale) at an equilibrium, oriented along t_prev."""
+        D = self.problem.dpressure(self.problem.contour(d) - w)
+        rhs = np.zeros(self.n + 1)
+        rhs[-1] = self.lin.kappa
+        t = self.lin.solve(D, t_prev, rhs, 1e-8)
+        return t / math.sqrt(self.omega * (t[:-1] @ t[:-1]) + t[-1] ** 2)
+
+    def correct(self, x_pred, t):
+        """Newton on F = 0 and the hyperplane t.(x - x_pred) = 0. Returns (x, it, res, ok)."""
+        problem, n, scale, omega = self.problem, self.n, self.scale, self.omega
+        self.curve.n_solves += 1
+        x = x_pred.copy()
+        res = res_first = math.inf
+        for it in range(1, MAX_ITER + 1):
+            w, d = x[:n] * scale, x[n] * scale
+            h = problem.contour(d) - w
+            if np.any(h <= 0):
+                return x, it, math.inf, False
+            P = problem.pressure(h)
+            res = float(np.max(np.abs(w - problem.C @ P)))   # residual of eq (6), m
+            if it == 1:
+                res_first = res
+            elif res > 4 * res_first or (it >= 8 and res > 1e-3 * res_first):
+                return x, it, res, False  # diverging or crawling: a shorter step does better
+            plane = omega * (t[:n] @ (x[:n] - x_pred[:n])) + t[n] * (x[n] - x_pred[n])
+            if res <= self.tol and abs(plane) < 1e-10:
+                return x, it, res, True
+            rhs = np.concatenate([P - problem.K @ w, [-self.lin.kappa * plane * scale]])
+            # (dw, dd) in m; the step need not be more accurate than a fraction of tol (the
+            # residual near convergence is rounding noise a relative criterion cannot meet)
+            dx = self.lin.solve(problem.dpressure(h), t, rhs, NEWTON_RTOL,
+                                atol=0.01 * self.tol * self.lin.kappa)
+            closing = dx[:n] - dx[n]
+            alpha = 1.0
+            if np.any(closing > 0):
+                alpha = min(1.0, float(np.min(CORRECTOR_GAP_CLOSURE * h[closing > 0]
+                                              / closing[closing > 0])))
+            x = x + alpha * dx / scale
+        return x, MAX_ITER, res, False
+
+
+def _hessian_stable(problem, w, d):
+    h = problem.contour(d) - w
+    H = problem.S_sym.copy()
+    H[np.diag_indices_from(H)] += problem.areas * problem.dpressure(h)
+    return _is_positive_definite(H)
+
+
+def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
+                max_points=5000, progress=None):
+    """Follow the equilibrium curve from separation d_start until it passes d_end (m).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        A problem without the sigma-gap (``problem.gap is None``).
+    d_start, d_end : float
+        Separations (m) where the curve starts (solved there first) and where it ends.
+    tol : float
+        Residual of eq (6) every point meets (m).
+    scale : float
+        Length (m) of one unit of arclength (e.g. z0).
+    ds : float
+        First step length (units of ``scale``); adapted afterwards.
+    ds_max : float, optional
+        Largest step length (default: 20 * ds).
+    progress : callable(float), optional
+        Called with the fraction of |d_end - d_start| covered so far.
+
+    Notes
+    -----
+    Stability (positive-definite energy Hessian) changes exactly where one eigenvalue crosses
+    zero, i.e. at folds of a gradient system's curve; it is carried from point to point by fold
+    parity and verified by a Cholesky factorisation at the first point and whenever the
+    preconditioner is refreshed away from a fold. A disagreement (a bifurcation, or two
+    folds inside one step) stops the trace with a ConvergenceError.
+
+    Raises
+    ------
+    ConvergenceError
+        If the step length collapses (the corrector fails at every step size), the stability
+        check disagrees with the fold count, or the curve needs more than ``max_points``
+        points; the partial curve is attached as ``.curve``.
+    """
+    from .newton import solve_state
+
+    if problem.gap is not None:
+        raise ValueError("arclength continuation needs a problem without the sigma-gap")
+    t0 = time.perf_counter()
+    n = problem.grid.n
+    ds_max = 20 * ds if ds_max is None else ds_max
+    direction = math.copysign(1.0, d_end - d_start)
+    curve = EquilibriumCurve()
+    tr = _Tracer(problem, scale, tol, curve)
+    curve._tracer = tr
+    w0 = np.zeros(n) if w_start is None else np.asarray(w_start, float)
+    st = solve_state(problem, d_start, w0, tol=tol, max_iter=60)
+    curve.n_solves += 1
+    if not st.converged:
+        raise ConvergenceError("arclength start: Newton did not converge", d=d_start,
+                               residual=st.residual, n_iter=st.n_iter)
+    t_init = np.zeros(n + 1)
+    t_init[n] = direction
+    t = tr.tangent(st.w, d_start, t_init)
+    curve.points.append(CurvePoint(d_start, st.w.copy(), t, _hessian_stable(problem, st.w,
+                                                                             d_start),
+                                   st.n_iter, st.residual))
+    step, ds_min = ds, ds * MIN_STEP_FRACTION
+    weights = np.r_[np.full(n, tr.omega), 1.0]
+
+    def fail(msg, d, res, it):
+        exc = ConvergenceError(msg, d=d, residual=res, n_iter=it)
+        exc.curve = curve
+        curve.wall_time = time.perf_counter() - t0
+        return exc
+
+    check_next = False
+    while True:
+        p = curve.points[-1]
+        x = np.concatenate([p.w, [p.d]]) / scale
+        h = problem.contour(p.d) - p.w
+        dh_ds = (p.t[n] - p.t[:n]) * scale           # gap change per unit s (m)
+        fast = np.abs(dh_ds) > 0
+        if np.any(fast):   # predictor changes no gap by more than MAX_GAP_CHANGE of itself
+            step = min(step, float(np.min(MAX_GAP_CHANGE * h[fast] / np.abs(dh_ds[fast]))))
+        step = max(step, ds_min)
+        x_pred = x + step * p.t
+        factors = tr.lin.n_factor
+        xc, it, res, ok = tr.correct(x_pred, p.t)
+        if not ok:
+            if step <= ds_min * 1.0001:
+                raise fail(f"arclength continuation stalled at d = {p.d * 1e9:.6g} nm: the "
+                           f"corrector failed even at the smallest step", p.d, res, it)
+            step *= 0.5
+            continue
+        w, d = xc[:n] * scale, xc[n] * scale
+        t = tr.tangent(w, d, p.t)
+        if t @ (p.t * weights) < 0.5:
+            # the tangent turned by more than 60 degrees: the step skipped along the curve
+            step *= 0.5
+            continue
+        h_c = problem.contour(d) - w
+        h_p = problem.contour(x_pred[n] * scale) - x_pred[:n] * scale
+        corr = float(np.max(np.abs(h_c - h_p) / h_c))
+        if corr > 4 * TARGET_CORRECTION:
+            step *= 0.5     # the predictor was poor: the point may sit on another branch
+            continue
+        folded = p.t_d * t[n] < 0
+        stable = p.stable != folded
+        # (not next to a fold: there the symmetric energy Hessian and the collocation
+        # Jacobian, whose singularity defines the fold, turn singular at slightly different
+        # points, an O(h) asymmetry of the discretisation)
+        if tr.lin.n_factor != factors and not (folded or check_next):
+            if _hessian_stable(problem, w, d) != stable:
+                if step > ds_min * 1.0001:
+                    step *= 0.5   # likely two folds inside the step: resolve them
+                    continue
+                raise fail(f"stability changed without a fold of the curve between d = "
+                           f"{p.d * 1e9:.6g} and {d * 1e9:.6g} nm (a bifurcation, or two "
+                           "folds in one step: lower ds_max)", d, res, it)
+        check_next = folded
+        q = CurvePoint(d, w, t, stable, it, res)
+        if folded:
+            curve.folds.append(_locate_fold(tr, p, step, len(curve.points) - 1))
+        curve.points.append(q)
+        step = min(ds_max, step * min(2.0, max(0.5, math.sqrt(TARGET_CORRECTION
+                                                             / max(corr, 1e-12)))))
+        if progress:
+            progress(min(1.0, (d - d_start) / (d_end - d_start)))
+        if direction * (d - d_end) >= 0:
+            break
+        if len(curve.points) >= max_points:
+            raise fail(f"arclength continuation needed more than {max_points} points",
+                       d, res, it)
+    # land the last point exactly on d_end (fixed-d Newton from the interpolated state)
+    a, b = curve.points[-2], curve.points[-1]
+    if b.d != d_end:
+        f = (d_end - a.d) / (b.d - a.d)
+        st = solve_state(problem, d_end, a.w + f * (b.w - a.w), tol=tol, max_iter=60)
+        curve.n_solves += 1
+        if not st.converged:
+            raise fail("arclength end point: Newton did not converge", d_end, st.residual,
+                       st.n_iter)
+        t = tr.tangent(st.w, d_end, b.t)
+        curve.points[-1] = CurvePoint(d_end, st.w.copy(), t, st.stable, st.n_iter,
+                                      st.residual)
+    curve.n_factor = tr.lin.n_factor
+    curve.n_krylov = tr.lin.n_krylov
+    curve.wall_time = time.perf_counter() - t0
+    return curve
+
+
+def _locate_fold(tr, p, step, index):
+    """Root of t_d(s) in (0, step) from point p: secant (Illinois) on corrected points."""
+    n, scale = tr.n, tr.scale
+    x = np.concatenate([p.w, [p.d]]) / scale
+
+    def at(s):
+        xc, it, res, ok = tr.correct(x + s * p.t, p.t)
+        if not ok:
+            return None
+        w, d = xc[:n] * scale, xc[n] * scale
+        return tr.tangent(w, d, p.t)[-1], w, d
+
+    a, fa = 0.0, p.t_d
+    b = step
+    rb = at(b)
+    if rb is None:
+        return Fold(index, p.d, p.w.copy(), 0.0)
+    fb, wb, db = rb
+    best = (abs(fb), wb, db, b)
+    side = 0
+    for _ in range(40):
+        s = b - fb * (b - a) / (fb - fa)
+        if not (min(a, b) < s < max(a, b)):
+            s = 0.5 * (a + b)
+        r = at(s)
+        if r is None:
+            break
+        fs, ws, dsp = r
+        if abs(fs) < best[0]:
+            best = (abs(fs), ws, dsp, s)
+        if abs(fs) < FOLD_TD_TOL or abs(b - a) < 1e-12 * step:
+            break
+        if fs * fb < 0:
+            a, fa = b, fb
+            side = 0
+        else:
+            if side == 1:
+                fa *= 0.5   # Illinois: keep the stale end from stalling the secant
+            side = 1
+        b, fb = s, fs
+    return Fold(index, best[2], best[1], best[3])
