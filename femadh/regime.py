@@ -152,7 +152,9 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-
     pull = cf[i]
     if 0 < i < len(curve.points) - 1:
         pull = max(pull, curve.maximize(i, force)[0])
-    pull_disp = float(np.max(F["retract"]))
+    # under displacement control the same maximum is reached if it lies on a stable state;
+    # otherwise the retract path jumps out before it, at its largest tension on the path
+    pull_disp = pull if curve.points[i].stable else float(np.max(F["retract"]))
 
     folds_a = [d for kind, d, _ in paths["approach"] if kind == "fold"]
     folds_r = [d for kind, d, _ in paths["retract"] if kind == "fold"]

@@ -147,40 +147,97 @@ def fig8():
     return "\n".join(rows)
 
 
+def _onset(lo=0.3, hi=1.0, iters=8):
+    """Smallest mu with folds (bistability), by bisection between lo (none) and hi (folds)."""
+    from femadh.regime import lj_sphere
+    for _ in range(iters):
+        mid = math.sqrt(lo * hi)
+        if lj_sphere(mid).n_folds:
+            hi = mid
+        else:
+            lo = mid
+    return lo, hi
+
+
+def _convergence():
+    """Mesh refinement at mu = 1 (uniform grid: N) and mu = 5 (graded: stiffness target)."""
+    from femadh.regime import lj_sphere
+    rows = ["| μ | grid | N | pull-off / πRΔγ | jump-in d/z0 | jump-out d/z0 | "
+            "hysteresis / (πRΔγ z0) | folds | trapping ratio | s |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
+    for mu, kws in ((1.0, [dict(min_nodes=n) for n in (120, 240, 480)]),
+                    (5.0, [dict(stiffness_target=t) for t in (0.4, 0.3, 0.2)])):
+        for kw in kws:
+            p = lj_sphere(mu, **kw)
+            label = ", ".join(f"{k} = {v}" for k, v in kw.items())
+            rows.append(f"| {mu:g} | {label} | {p.nodes} | {p.pull_off:.5f} | "
+                        f"{p.jump_in:.4f} | {p.jump_out:.4f} | {p.hysteresis:.4f} | "
+                        f"{p.n_folds} | {p.trapping_ratio:.2f} | {p.wall_time:.2f} |")
+    return "\n".join(rows)
+
+
 def regime(quick):
-    mus = (0.1, 1.0, 2.0) if quick else (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.3, 1.6, 2.0, 2.5, 3.0)
+    """The 20-point regime map (mu = 0.1-5, log-spaced) with its timing; figures."""
+    mus = (0.1, 1.0, 2.0) if quick else tuple(np.geomspace(0.1, 5.0, 20))
     t0 = time.perf_counter()
     pts = regime_map(mus)
     wall = time.perf_counter() - t0
-    lines = ["| μ | λ = 1.157 μ | N | pull-off / πRΔγ | Maugis-Dugdale | jump-in d/z0 | "
-             "jump-out d/z0 | hysteresis / (πRΔγ z0) | s |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| μ | λ = 1.157 μ | N | pull-off / πRΔγ (load control) | Maugis-Dugdale | "
+             "LJ / MD − 1 | max tension, displacement control | jump-in d/z0 | "
+             "jump-out d/z0 | hysteresis / (πRΔγ z0) | loop integral | folds | points | s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in pts:
         ji = f"{p.jump_in:.3f}" if p.jump_in else "—"
         jo = f"{p.jump_out:.3f}" if p.jump_out else "—"
-        lines.append(f"| {p.mu:g} | {lj_dugdale_lambda(p.mu):.3f} | {p.nodes} | {p.pull_off:.4f} "
-                     f"| {p.maugis:.4f} | {ji} | {jo} | {abs(p.hysteresis):.3f} | "
+        lines.append(f"| {p.mu:.3g} | {lj_dugdale_lambda(p.mu):.3f} | {p.nodes} | "
+                     f"{p.pull_off:.4f} | {p.maugis:.4f} | {p.pull_off / p.maugis - 1:+.1%} | "
+                     f"{p.pull_off_displacement:.4f} | {ji} | {jo} | {p.hysteresis:.4f} | "
+                     f"{p.hysteresis_trapezoid:.4f} | {p.n_folds} | {p.n_points} | "
                      f"{p.wall_time:.2f} |")
     plt = _plt()
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     mu_fine = np.logspace(-1.2, math.log10(6), 60)
     ax[0].semilogx(mu_fine, [maugis_pull_off(lj_dugdale_lambda(m)) for m in mu_fine], "k-",
                    label="Maugis-Dugdale, λ = 1.157 μ")
     ax[0].axhline(2.0, color="grey", ls="--", label="DMT 2πRΔγ")
     ax[0].axhline(1.5, color="grey", ls=":", label="JKR 1.5πRΔγ")
-    ax[0].semilogx([p.mu for p in pts], [p.pull_off for p in pts], "o", label="femadh LJ sphere")
-    ax[0].set(xlabel="Tabor μ", ylabel="pull-off / πRΔγ", title="pull-off force")
+    ax[0].semilogx([p.mu for p in pts], [p.pull_off for p in pts], "o",
+                   label="femadh LJ sphere")
+    ax[0].set(xlabel="Tabor μ", ylabel="pull-off / πRΔγ", title="pull-off force (load control)")
     ax[0].legend(fontsize=8)
     for p in pts:
         if p.jump_in:
-            ax[1].plot(p.mu, p.jump_in, "v", color="C0")
-        if p.jump_out:
-            ax[1].plot(p.mu, p.jump_out, "^", color="C1")
+            ax[1].semilogx(p.mu, p.jump_in, "v", color="C0")
+            ax[1].semilogx(p.mu, p.jump_out, "^", color="C1")
     ax[1].set(xlabel="Tabor μ", ylabel="d / z0 at the fold",
               title="jump-in (▼, approach) and jump-out (▲, retract)")
+    ax[2].loglog([p.mu for p in pts if p.hysteresis > 0],
+                 [p.hysteresis for p in pts if p.hysteresis > 0], "s-")
+    ax[2].set(xlabel="Tabor μ", ylabel="work per cycle / (πRΔγ z0)",
+              title="approach-retract hysteresis")
     for a in ax:
         a.grid(alpha=0.3, which="both")
     fig.tight_layout()
     fig.savefig(RESULTS / "regime_map.png", dpi=110)
+    plt.close(fig)
+    # the traced curves themselves, unstable branches dashed, paths of the experiment
+    show = [p for p in pts if p.mu in (mus[0], mus[len(mus) // 2], mus[-1])] or pts[:3]
+    fig, ax = plt.subplots(1, len(show), figsize=(5 * len(show), 4))
+    for a, p in zip(np.atleast_1d(ax), show):
+        c = p.curves
+        st = c["curve_stable"]
+        F = np.where(st, c["curve_F"], np.nan)
+        Fu = np.where(~st, c["curve_F"], np.nan)
+        a.plot(c["curve_d"], F, "k-", lw=1, label="stable")
+        a.plot(c["curve_d"], Fu, "k--", lw=1, label="unstable (traced)")
+        a.plot(c["approach_d"], c["approach_F"], "C0:", lw=2, label="approach path")
+        a.plot(c["retract_d"], c["retract_F"], "C1:", lw=2, label="retract path")
+        a.set(xlabel="d / z0", ylabel="F / πRΔγ (tension > 0)", title=f"μ = {p.mu:.3g}",
+              xlim=(min(c["curve_d"]), 12))
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(RESULTS / "regime_curves.png", dpi=110)
     plt.close(fig)
     return "\n".join(lines), wall, pts
 
@@ -194,7 +251,9 @@ def main(argv=None):
     A19 = 16 * math.pi * 0.165e-9**2 * DG_ASPERITY
     dg_table1 = 1e-19 / (16 * math.pi * 0.165e-9**2)
     f8 = fig8()
-    rm, wall, _ = regime(args.quick)
+    rm, wall, pts = regime(args.quick)
+    onset = _onset() if not args.quick else (math.nan, math.nan)
+    conv = _convergence() if not args.quick else "(skipped in --quick)"
     text = f"""# Paper 1 sec 5.2-6 and the LJ regime map (validation/roughness.py)
 
 ## Greenwood-Williamson statistics (Fig 7, eqs 20-26)
@@ -222,9 +281,25 @@ Fig 8 below is computed with both Hamaker constants.
 
 ## Smooth-sphere LJ regime map (beyond the paper)
 
+Each point traces the whole equilibrium curve F(d) by pseudo-arclength continuation (through
+its folds, the unstable branch included) from d = 12 z0 to a compressive load of ~0.5 πRΔγ;
+the approach and retract paths, jumps and pull-off are read off the curve. Hysteresis: energy
+released at the jumps (fold state minus landing state at the same d; exact); the loop integral
+of F dd along the paths (trapezoid) is its cross-check.
+
 {rm}
 
-Total {wall:.1f} s on this machine.
+**{len(pts)}-point map: {wall:.1f} s on this machine** (benchmark goal: 20 points, each an
+approach-retract curve, in ≤ 20 s).
+
+Onset of bistability (folds, jumps, hysteresis): between μ = {onset[0]:.3f} and {onset[1]:.3f}
+(bisection on the fold count; the loop closes into a cusp there, so a loop narrower than the
+continuation's resolution could still hide just below: an upper bound).
+
+Mesh convergence (μ = 1: uniform grids; μ = 5: graded grid whose fine spacing keeps the LJ
+softening stiffness below the stiffness target times a node's self-stiffness):
+
+{conv}
 """
     (RESULTS / "roughness.md").write_text(text)
     print(text)

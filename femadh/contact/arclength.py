@@ -52,6 +52,8 @@ MAX_GAP_CHANGE = 0.3
 MIN_STEP_FRACTION = 1e-6
 #: largest fraction of its gap one corrector step may close (LJ repulsion grows like h^-9)
 CORRECTOR_GAP_CLOSURE = 0.3
+#: consecutive unit tangents must be within acos(MIN_TANGENT_COS) = 30 degrees
+MIN_TANGENT_COS = math.cos(math.radians(30.0))
 #: fold located when |t_d| falls below this (tangents have unit length)
 FOLD_TD_TOL = 1e-7
 
@@ -105,7 +107,8 @@ class EquilibriumCurve:
         Returns a list of ``(kind, i, j_or_t)`` items:
         ``("run", i0, i1)`` - stable points i0..i1 (inclusive, either order) visited in turn;
         ``("fold", k, None)`` - the k-th fold reached at the end of the previous run;
-        ``("land", i, t)`` - the landing state between points i and i+1 at fraction t in d.
+        ``("land", a, (s_lo, s_hi))`` - the landing state, on the curve at an arclength offset
+        in [s_lo, s_hi] along point a's tangent (s_hi None: up to point a+1).
         Raises ValueError if a fold has no stable landing on the traced curve.
         """
         pts, n = self.points, len(self.points)
@@ -148,23 +151,36 @@ class EquilibriumCurve:
             for r in runs:
                 if r in visited:
                     continue
+                # a stable branch's pieces: fold -> first point, point -> point, last -> fold
+                # as (from point a, arclength bracket on its tangent, next run point, step)
+                pieces = []
+                k_in, k_out = fold_after.get(r[0] - 1), fold_after.get(r[1])
+                if k_in is not None:
+                    f = self.folds[k_in]
+                    pieces.append((r[0] - 1, f.d, pts[r[0]].d, (f.s_offset, None),
+                                   r[0], r[0]))
                 for a in range(r[0], r[1]):
-                    da, db = pts[a].d - d_f, pts[a + 1].d - d_f
+                    pieces.append((a, pts[a].d, pts[a + 1].d, (0.0, None), a, a + 1))
+                if k_out is not None:
+                    f = self.folds[k_out]
+                    pieces.append((r[1], pts[r[1]].d, f.d, (0.0, f.s_offset), r[1], r[1]))
+                for a, d_lo, d_hi, bracket, first, last in pieces:
+                    da, db = d_lo - d_f, d_hi - d_f
                     if da * db <= 0 and da != db:
-                        landing = (r, a, da / (da - db))
+                        landing = (r, a, bracket, first, last, db - da)
                         break
                 if landing:
                     break
             if landing is None:
                 raise ValueError(f"the fold at d = {d_f:.6g} m has no stable landing on the "
                                  "traced curve (trace further, or the curve has an isola)")
-            run, a, t = landing
-            out.append(("land", a, t))
+            run, a, bracket, first, last, dd = landing
+            out.append(("land", a, bracket))
             # continue from the landing toward the travel direction
-            if sign * (pts[a + 1].d - pts[a].d) > 0:
-                lo, hi, i = a + 1, run[1], a + 1
+            if sign * dd > 0:
+                lo, hi, i = last, run[1], last
             else:
-                lo, hi, i = run[0], a, a
+                lo, hi, i = run[0], first, first
 
     def _dist(self, p, q):
         tr = self._tracer
@@ -177,26 +193,36 @@ class EquilibriumCurve:
         xc, _, _, ok = tr.correct(np.r_[p.w, p.d] / tr.scale + off * p.t, p.t)
         return (xc[-1] * tr.scale, xc[:-1] * tr.scale) if ok else None
 
-    def point_at(self, i, d):
-        """The curve's state w (m) at separation d between points i and i+1 (root of
-        d(s) = d by secant iteration on the arclength offset from point i)."""
+    def point_at(self, i, d, bracket=(0.0, None)):
+        """The curve's state w (m) at separation d beyond point i: root of d(s) = d by secant
+        iteration on the arclength offset s from point i, within ``bracket`` (s_hi None: up
+        to point i+1), on which d(s) must be monotone."""
         pts = self.points
         a, b = pts[i], pts[i + 1]
-        s_a, f_a, s_b, f_b = 0.0, a.d - d, self._dist(a, b), b.d - d
+        s_a, s_b = bracket[0], self._dist(a, b) if bracket[1] is None else bracket[1]
+
+        def at(s):
+            if s == 0.0:
+                return a.d, a.w
+            if bracket[1] is None and s == s_b:
+                return b.d, b.w
+            r = self._on_curve(a, s)
+            if r is None:
+                raise ConvergenceError("a state on the traced curve could not be recomputed",
+                                       d=d, residual=math.nan, n_iter=0)
+            return r
+        (da, wa), (db, w) = at(s_a), at(s_b)
+        f_a, f_b = da - d, db - d
         if f_a == 0:
-            return a.w.copy()
-        w = b.w.copy()
+            return wa
         for _ in range(60):
             if f_b == 0 or abs(s_b - s_a) < 1e-12 * self._dist(a, b):
                 break
             s = s_b - f_b * (s_b - s_a) / (f_b - f_a)
             if not (min(s_a, s_b) < s < max(s_a, s_b)):
                 s = 0.5 * (s_a + s_b)
-            r = self._on_curve(a, s)
-            if r is None:
-                raise ConvergenceError("a state on the traced curve could not be recomputed",
-                                       d=d, residual=math.nan, n_iter=0)
-            f, w = r[0] - d, r[1]
+            dd, w = at(s)
+            f = dd - d
             if abs(f) <= 1e-12 * self._tracer.scale:
                 break
             if f * f_b < 0:
@@ -252,7 +278,7 @@ class EquilibriumCurve:
                 out.append(("fold", f.d, f.w))
             else:
                 d_f = out[-1][1]
-                out.append(("land", d_f, self.point_at(i, d_f)))
+                out.append(("land", d_f, self.point_at(i, d_f, j)))
         return out
 
 
@@ -462,8 +488,14 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             continue
         w, d = xc[:n] * scale, xc[n] * scale
         t = tr.tangent(w, d, p.t)
-        if t @ (p.t * weights) < 0.5:
-            # the tangent turned by more than 60 degrees: the step skipped along the curve
+        if t @ (p.t * weights) < MIN_TANGENT_COS:
+            # the tangent turned too far within one step: the curve bends faster than the
+            # step resolves (near folds and cusps); a shorter step follows it
+            step *= 0.5
+            continue
+        if (d - p.d) * p.t_d < 0 and p.t_d * t[n] > 0:
+            # d moved against both end tangents: two folds inside the step (a narrow loop
+            # near the onset of bistability) - resolve them instead of stepping over
             step *= 0.5
             continue
         h_c = problem.contour(d) - w
