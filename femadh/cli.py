@@ -34,11 +34,61 @@ def _parser():
     s.add_argument("scene", help="scene file (TOML)")
     s.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
     s.add_argument("--out", help="output folder (default: <scene output dir>/study)")
+    g = sub.add_parser(
+        "regime", help="smooth-sphere LJ adhesion map vs the Tabor parameter",
+        description="Trace the force-separation curve of a smooth elastic sphere with LJ "
+                    "surface forces (no sigma-gap) through its folds for a range of Tabor "
+                    "parameters mu = (R dg^2/(E*^2 z0^3))^(1/3); writes regime.csv (pull-off / "
+                    "pi R dg vs Maugis-Dugdale, jump-in/out d / z0, hysteresis), "
+                    "regime_map.png and regime_curves.png.")
+    g.add_argument("--mu", type=float, nargs=2, default=(0.1, 5.0), metavar=("FROM", "TO"),
+                   help="Tabor parameter range (default 0.1 5)")
+    g.add_argument("--points", type=int, default=20, help="log-spaced points (default 20)")
+    g.add_argument("--radius", default="1 um", help="sphere radius (default '1 um')")
+    g.add_argument("--hamaker", default="1e-19 J", help="Hamaker constant (default '1e-19 J')")
+    g.add_argument("--z0", default="0.165 nm", help="LJ equilibrium distance (default "
+                                                    "'0.165 nm')")
+    g.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
     return p
+
+
+def _regime(args):
+    import numpy as np
+
+    from .errors import SceneError
+    from .regime import lj_sphere, write_regime
+    from .studies import default_progress
+    from .units import to_si
+
+    lo, hi = args.mu
+    if not (0 < lo < hi) or args.points < 1:
+        print("femadh: error: --mu needs 0 < FROM < TO and --points >= 1", file=sys.stderr)
+        return 2
+    try:
+        kw = {k: to_si(getattr(args, a), dim, file="command line", key=f"--{a}")
+              for k, a, dim in (("radius", "radius", "length"), ("hamaker", "hamaker", "energy"),
+                                ("z0", "z0", "length"))}
+    except SceneError as exc:
+        print(f"femadh: error: {exc}", file=sys.stderr)
+        return 2
+    mus = np.geomspace(lo, hi, args.points) if args.points > 1 else [lo]
+    bar = default_progress()
+    pts = []
+    for i, mu in enumerate(mus):
+        pts.append(lj_sphere(float(mu), **kw))
+        if bar:
+            bar(f"mu = {mu:.3g}: pull-off {pts[-1].pull_off:.4f} pi R dg "
+                f"({i + 1}/{len(mus)})")
+    path = write_regime(pts, args.out)
+    print(path.read_text(), end="")
+    print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")
+    return 0
 
 
 def main(argv=None):
     args = _parser().parse_args(argv)
+    if args.command == "regime":
+        return _regime(args)
     from .runner import run
     from .scene import load_scene
 

@@ -92,6 +92,17 @@ class RunWriter:
             entries += [(t, vol, 0), (t, surf, 1)]
             write_pvd(self.dir / f"{branch}.pvd", entries)
 
+    def write_equilibrium_curve(self, points, states):
+        """equilibrium_curve.csv: every traced point of an arclength curve in arc order,
+        stable or not, with the tangent's dd/ds (its sign changes at each fold)."""
+        with open(self.dir / "equilibrium_curve.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["arc_index", "d_m", "h0_m", "F_ex_N", "stable", "dd_ds",
+                        "residual_m"])
+            for i, (pt, st) in enumerate(zip(points, states)):
+                w.writerow([i, _g(st.d), _g(st.h0), _g(state_forces(self.problem, st)[2]),
+                            st.stable, _g(pt.t_d), _g(st.residual)])
+
     def close(self):
         for f in self._files.values():
             f.close()

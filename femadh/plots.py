@@ -73,3 +73,62 @@ def paper1_panels(result, path, *, max_profiles=12):
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def regime_figures(pts, out_dir):
+    """regime_map.png (pull-off vs Tabor mu against Maugis-Dugdale, JKR and DMT; fold
+    separations; hysteresis) and regime_curves.png (traced F(d) curves of the smallest, middle
+    and largest mu, unstable branches dashed, with the approach and retract paths)."""
+    import math
+    from pathlib import Path
+
+    import numpy as np
+
+    from .reference.maugis import lj_dugdale_lambda, maugis_pull_off
+
+    plt = _pyplot()
+    out = Path(out_dir)
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    mu_fine = np.logspace(-1.2, math.log10(6), 60)
+    ax[0].semilogx(mu_fine, [maugis_pull_off(lj_dugdale_lambda(m)) for m in mu_fine], "k-",
+                   label="Maugis-Dugdale, λ = 1.157 μ")
+    ax[0].axhline(2.0, color="grey", ls="--", label="DMT 2πRΔγ")
+    ax[0].axhline(1.5, color="grey", ls=":", label="JKR 1.5πRΔγ")
+    ax[0].semilogx([p.mu for p in pts], [p.pull_off for p in pts], "o",
+                   label="femadh LJ sphere")
+    ax[0].set(xlabel="Tabor μ", ylabel="pull-off / πRΔγ", title="pull-off force (load control)")
+    ax[0].legend(fontsize=8)
+    for p in pts:
+        if p.jump_in:
+            ax[1].semilogx(p.mu, p.jump_in, "v", color="C0")
+            ax[1].semilogx(p.mu, p.jump_out, "^", color="C1")
+    ax[1].set(xlabel="Tabor μ", ylabel="d / z0 at the fold",
+              title="jump-in (▼, approach) and jump-out (▲, retract)")
+    ax[2].loglog([p.mu for p in pts if p.hysteresis > 0],
+                 [p.hysteresis for p in pts if p.hysteresis > 0], "s-")
+    ax[2].set(xlabel="Tabor μ", ylabel="work per cycle / (πRΔγ z0)",
+              title="approach-retract hysteresis")
+    for a in ax:
+        a.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    fig.savefig(out / "regime_map.png", dpi=110)
+    plt.close(fig)
+    # the traced curves themselves, unstable branches dashed, paths of the experiment
+    show = [p for p in pts if p.mu in (pts[0].mu, pts[len(pts) // 2].mu, pts[-1].mu)] or pts[:3]
+    fig, ax = plt.subplots(1, len(show), figsize=(5 * len(show), 4))
+    for a, p in zip(np.atleast_1d(ax), show):
+        c = p.curves
+        st = c["curve_stable"]
+        F = np.where(st, c["curve_F"], np.nan)
+        Fu = np.where(~st, c["curve_F"], np.nan)
+        a.plot(c["curve_d"], F, "k-", lw=1, label="stable")
+        a.plot(c["curve_d"], Fu, "k--", lw=1, label="unstable (traced)")
+        a.plot(c["approach_d"], c["approach_F"], "C0:", lw=2, label="approach path")
+        a.plot(c["retract_d"], c["retract_F"], "C1:", lw=2, label="retract path")
+        a.set(xlabel="d / z0", ylabel="F / πRΔγ (tension > 0)", title=f"μ = {p.mu:.3g}",
+              xlim=(min(c["curve_d"]), 12))
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "regime_curves.png", dpi=110)
+    plt.close(fig)

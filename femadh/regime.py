@@ -30,7 +30,7 @@ from .contact.arclength import trace_curve
 from .effects import LennardJones
 from .elastic import GreenOperator, RadialGrid
 from .indenter import Sphere
-from .reference.adhesion import jkr_contact_radius
+from .reference.adhesion import dmt_contact_radius, jkr_contact_radius
 from .reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
@@ -87,8 +87,15 @@ def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
     K = 4 * e_star / 3
     a_unit = (math.pi * dg * radius**2 / K) ** (1 / 3)
     a = max(ANALYSIS_RADIUS * a_unit, math.sqrt(2 * radius * 20 * z0))
-    a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, e_star, dg)
-    d_min = z0 - jkr_approach(a_max, radius, e_star, dg)
+    load = PRELOAD * math.pi * radius * dg
+    a_max = jkr_contact_radius(load, radius, e_star, dg)
+    # the approach for that load in the nearer limit (DMT below mu = 1, JKR above), from
+    # where the rigid sphere's LJ force vanishes, d = z0 / 4^(1/6) (eq 14: U(d) = 0)
+    if mu < 1:
+        delta = dmt_contact_radius(load, radius, e_star, dg) ** 2 / radius
+    else:
+        delta = jkr_approach(a_max, radius, e_star, dg)
+    d_min = z0 / 4 ** (1 / 6) - delta
     # node self-stiffness scales like 1/spacing: calibrate it on a coarse uniform probe
     probe = ContactProblem(GreenOperator(RadialGrid.uniform(a, 60), e_star), Sphere(radius),
                            {"lj": lj})
@@ -120,7 +127,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-
                                                    min_nodes)
     dg = lj.work_of_adhesion
     d0 = 12 * z0
-    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=2.0,
+    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=0.5,
                         progress=progress)
 
     def force(d, w):
@@ -185,3 +192,33 @@ def regime_map(mus, progress=None, **kw):
         if progress:
             progress(i + 1)
     return out
+
+
+REGIME_HEADER = ["mu", "lambda", "e_star_Pa", "nodes", "pull_off", "pull_off_displacement",
+                 "maugis_dugdale", "jump_in_d_over_z0", "jump_out_d_over_z0", "hysteresis",
+                 "hysteresis_loop_integral", "n_folds", "trapping_ratio", "n_points",
+                 "wall_time_s"]
+
+
+def write_regime(pts, out_dir):
+    """regime.csv (forces / (pi R dg), separations / z0, work / (pi R dg z0)) and the figures.
+    Returns the csv path."""
+    import csv
+    from pathlib import Path
+
+    from .plots import regime_figures
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "regime.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(REGIME_HEADER)
+        for p in pts:
+            w.writerow([f"{p.mu:.6g}", f"{lj_dugdale_lambda(p.mu):.6g}", f"{p.e_star:.6g}",
+                        p.nodes, f"{p.pull_off:.6f}", f"{p.pull_off_displacement:.6f}",
+                        f"{p.maugis:.6f}", "" if p.jump_in is None else f"{p.jump_in:.6f}",
+                        "" if p.jump_out is None else f"{p.jump_out:.6f}",
+                        f"{p.hysteresis:.6g}", f"{p.hysteresis_trapezoid:.6g}", p.n_folds,
+                        f"{p.trapping_ratio:.4f}", p.n_points, f"{p.wall_time:.3f}"])
+    regime_figures(pts, out)
+    return out / "regime.csv"

@@ -7,7 +7,8 @@ import warnings
 import numpy as np
 
 from . import __version__
-from .contact import trace
+from .contact import State, trace
+from .contact.continuation import Jump, Sweep
 from .errors import ConvergenceError
 from .output import SIGN_NOTE, RunWriter, state_forces, write_json
 from .scene import Scene, build_problem, load_scene
@@ -122,6 +123,9 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
             plan.append(("retract", d[::-1]))
     else:
         plan.append(("retract", d))
+    if scene.continuation == "arclength":
+        _run_arclength(scene, problem, result, writer, progress)
+        plan = []
     start = None
     try:
         for branch, d_vals in plan:
@@ -149,6 +153,70 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
             from .plots import paper1_panels
             paper1_panels(result, f"{result.out_dir}/fig3_panels.png")
     return result
+
+
+def _curve_state(problem, d, w, stable):
+    """A State for a point of an arclength curve (smooth laws: no contact pressure)."""
+    h = problem.contour(d) - w
+    n = w.size
+    res = float(np.max(np.abs(w - problem.C @ problem.pressure(h))))
+    return State(d, w, h, {k: e.pressure(h) for k, e in problem.effects.items()}, np.zeros(n),
+                 np.zeros(n, bool), 0.0, 0, res, True, stable)
+
+
+def _run_arclength(scene, problem, result, writer, progress):
+    """Trace the scene's equilibrium curve by arclength; write its paths as branches.
+
+    The whole curve (unstable states included) goes to equilibrium_curve.csv; the
+    displacement-controlled approach and retract paths, with their jumps, go to curve.csv as
+    with the stepping solver. On failure the part of the curve traced so far is written.
+    """
+    from .contact.arclength import trace_curve
+
+    d = scene.d_values
+    step = abs(d[1] - d[0])
+    bar = _progress_bar(100, f"{scene.name} arclength", progress)
+    last = [0]
+
+    def tick(frac):
+        k = int(100 * frac)
+        if bar and k > last[0]:
+            bar.update(k - last[0])
+            last[0] = k
+    curve = None
+    try:
+        curve = trace_curve(problem, d[0], d[-1], tol=scene.tolerance, scale=step, ds=1.0,
+                            ds_max=1.0, progress=tick)
+    except ConvergenceError as exc:
+        result.status, result.error = "failed", str(exc)
+        curve = getattr(exc, "curve", None)
+    finally:
+        if bar:
+            bar.close()
+    if curve is None:
+        return
+    result.curve_points = curve.points
+    if writer:
+        writer.write_equilibrium_curve(curve.points,
+                                       [_curve_state(problem, p.d, p.w, p.stable)
+                                        for p in curve.points])
+    if result.status != "converged":
+        return
+    for branch in scene.directions:
+        sweep = Sweep(branch, n_solves=curve.n_solves)
+        before = None
+        for kind, dk, wk in curve.branch(branch):
+            st = _curve_state(problem, dk, wk, True)
+            if kind == "fold":
+                before = st
+                continue        # the fold state is the jump's 'before', not a grid state
+            if kind == "land":
+                sweep.jumps.append(Jump(branch, dk, dk, 0.0, before, st))
+            sweep.states.append(st)
+            if writer:
+                writer.write_state(branch, st)
+        sweep.wall_time = curve.wall_time
+        result.sweeps[branch] = sweep
 
 
 def _summary(result):

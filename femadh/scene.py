@@ -54,6 +54,7 @@ class Scene:
     output_dir: str
     fe_poisson_ratio: float = 0.3
     vtk: bool = False
+    continuation: str = "steps"
     raw: dict = field(repr=False, default_factory=dict)
 
     @property
@@ -69,6 +70,7 @@ class Scene:
             "solver": {"method": self.method, "nodes": self.nodes,
                        "analysis_radius_m": self.analysis_radius,
                        "tolerance_m": self.tolerance, "max_iter": self.max_iter,
+                       "continuation": self.continuation,
                        "mesh": None if self.fe_settings is None else {
                            "outer_factor": self.fe_settings.outer_factor,
                            "growth": self.fe_settings.growth,
@@ -342,6 +344,11 @@ def scene_from_dict(data, file=None):
         raise so.error("analysis_radius", ar, f"less than the sphere radius {sphere.radius} m")
     tol = so.quantity("tolerance", "length", default="1e-10 nm")
     max_iter = so.integer("max_iter", 1, 40)
+    continuation = so.choice("continuation", ("steps", "arclength"), "steps")
+    if continuation == "arclength" and gap is not None:
+        raise so.error("continuation", continuation, "'steps' with [effects.asperity_gap]: "
+                       "arclength continuation traces smooth laws only (the hard sigma-gap "
+                       "is not smooth)")
     fe_settings, fe_nu = None, (disk.poisson_ratio if disk is not None else 0.3)
     mesh_t = so.table_at("mesh", None)
     if method == "fe":
@@ -395,6 +402,9 @@ def scene_from_dict(data, file=None):
     if abs(n_steps - k) > 1e-6:
         raise sw.error("step", sw.table["step"], f"a step that divides |stop - start| = "
                        f"{abs(stop - start):.6g} m into whole steps")
+    if continuation == "arclength" and "approach" not in dirs:
+        raise sw.error("directions", dirs, "a list with 'approach' for [solver] continuation "
+                       "= 'arclength' (the curve is traced from start to stop)")
     sign = -1.0 if stop < start else 1.0
     d_values = [start + sign * i * step for i in range(k + 1)]
     sw.done()
@@ -419,7 +429,7 @@ def scene_from_dict(data, file=None):
                  method=method, nodes=nodes, analysis_radius=a, tolerance=tol,
                  max_iter=max_iter, fe_settings=fe_settings, d_values=d_values,
                  directions=tuple(dirs), output_dir=out_dir, fe_poisson_ratio=fe_nu, vtk=vtk,
-                 raw=data)
+                 continuation=continuation, raw=data)
 
 
 def build_operator(scene, progress=None):

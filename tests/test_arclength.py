@@ -105,3 +105,52 @@ def test_gap_constrained_problem_is_refused():
                         {"lj": LennardJones(A, Z0)}, AsperityGap(1e-9))
     with pytest.raises(ValueError, match="sigma-gap"):
         trace_curve(pb, 5e-9, 0.0, tol=TOL, scale=Z0, ds=0.2)
+
+
+def test_scene_with_arclength_continuation_matches_stepping(tmp_path):
+    """`[solver] continuation = "arclength"` in a scene: the folds of the traced curve are the
+    jumps the stepping solver finds (to its 2^-10-step resolution); equilibrium_curve.csv holds
+    the unstable branch too; curve.csv keeps its contract (F_ex = F_LJ - F_el row by row)."""
+    import copy
+    import csv
+    from pathlib import Path
+
+    import femadh
+    from femadh.scene import scene_from_dict
+
+    path = Path(__file__).resolve().parents[1] / "validation/scenes/lj_sphere_mu2_arclength.toml"
+    arc = femadh.load_scene(path)
+    raw = copy.deepcopy(arc.raw)
+    raw["solver"]["continuation"] = "steps"
+    steps = scene_from_dict(raw, str(path))
+    ra = femadh.run(arc, str(tmp_path / "arc"), figures=False, progress=False)
+    rs = femadh.run(steps, str(tmp_path / "steps"), figures=False, progress=False)
+    assert ra.status == rs.status == "converged"
+    res = 0.1e-9 * 2.0**-10 * 1.01
+    for b in ("approach", "retract"):
+        ja, js = ra.sweeps[b].jumps, rs.sweeps[b].jumps
+        assert len(ja) == len(js) == 1
+        assert ja[0].d_fold == pytest.approx(js[0].d_fold, abs=res)
+    rows = list(csv.DictReader(open(tmp_path / "arc" / "equilibrium_curve.csv")))
+    assert any(r["stable"] == "False" for r in rows)
+    signs = np.sign([float(r["dd_ds"]) for r in rows])
+    assert np.count_nonzero(np.diff(signs)) == 2           # two folds: one S
+    for r in csv.DictReader(open(tmp_path / "arc" / "curve.csv")):
+        assert float(r["F_ex_N"]) == pytest.approx(float(r["F_LJ_N"]) - float(r["F_el_N"]),
+                                                   rel=1e-12, abs=1e-20)
+
+
+def test_arclength_with_sigma_gap_is_a_scene_error(tmp_path):
+    from pathlib import Path
+
+    import femadh
+    from femadh.errors import SceneError
+
+    fig3 = (Path(__file__).resolve().parents[1] / "validation/scenes/paper1_fig3.toml")
+    text = fig3.read_text().replace('[solver]\n', '[solver]\ncontinuation = "arclength"\n', 1)
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    with pytest.raises(SceneError) as e:
+        femadh.load_scene(p)
+    msg = str(e.value)
+    assert "solver.continuation" in msg and "arclength" in msg and "sigma-gap" in msg

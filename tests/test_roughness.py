@@ -88,3 +88,21 @@ def test_regime_map_limits_and_hysteresis():
     assert mid.pull_off == pytest.approx(mid.maugis, rel=0.05)
     assert hi.pull_off == pytest.approx(hi.maugis, rel=0.025)
     assert abs(hi.pull_off / hi.maugis - 1) < abs(mid.pull_off / mid.maugis - 1)
+
+
+def test_regime_cli_writes_table_and_figures(tmp_path, capsys):
+    """`femadh regime`: csv with one row per mu, the two figures; units are checked."""
+    import csv
+
+    from femadh.cli import main
+
+    out = tmp_path / "reg"
+    assert main(["regime", "--mu", "0.5", "1.0", "--points", "2", "--out", str(out)]) == 0
+    rows = list(csv.DictReader(open(out / "regime.csv")))
+    assert [float(r["mu"]) for r in rows] == [0.5, 1.0]
+    assert rows[0]["jump_in_d_over_z0"] == "" and float(rows[1]["jump_in_d_over_z0"]) > 2
+    assert (out / "regime_map.png").stat().st_size > 0
+    assert (out / "regime_curves.png").stat().st_size > 0
+    assert main(["regime", "--radius", "1 kg", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--radius" in err and "1 kg" in err and "length" in err

@@ -8,6 +8,7 @@ import copy
 import math
 from pathlib import Path
 import time
+import warnings
 
 import numpy as np
 
@@ -18,6 +19,7 @@ except ModuleNotFoundError:
 
 from femadh.reference.gw import mean_plane_dominance_bound, paper1_table2_roughness
 from femadh.reference.maugis import lj_dugdale_lambda, maugis_pull_off
+from femadh.plots import regime_figures
 from femadh.regime import regime_map
 from femadh.runner import run
 from femadh.scene import scene_from_dict
@@ -81,7 +83,7 @@ def fig7():
 
 
 def _slider(A="1e-19 J", sigma="1.08 nm", rho=0, smoothing=None, model="complementarity",
-            gw=None):
+            gw=None, arclength=False, stop="0 nm"):
     base = tomllib.loads((HERE / "scenes" / "paper1_fig3.toml").read_text())
     d = copy.deepcopy(base)
     d["effects"]["lennard_jones"]["hamaker"] = A
@@ -98,8 +100,10 @@ def _slider(A="1e-19 J", sigma="1.08 nm", rho=0, smoothing=None, model="compleme
             "model": "greenwood-williamson", "rms_height": "0.344 nm", "mean_height": "1.08 nm",
             "asperity_radius": "0.94 um", "density": f"{gw} um^-2",
             "surface_energy": f"{DG_ASPERITY} J/m^2"}
-        d["sweep"] = {"start": "3 nm", "stop": "0 nm", "step": "0.1 nm"}
-    return scene_from_dict(d, f"slider rho={rho}")
+        d["sweep"] = {"start": "3 nm", "stop": stop, "step": "0.1 nm"}
+        if arclength:
+            d["solver"]["continuation"] = "arclength"
+    return scene_from_dict(d, f"slider rho={rho}" if gw is None else f"slider GW rho={gw}")
 
 
 def _max_fex(res):
@@ -136,6 +140,19 @@ def fig8():
         res = run(_slider(gw=rho), write=False, figures=False, progress=False)
         rows.append(f"| Greenwood-Williamson (continuous), dg_a = 0.06 | 1e-19 | {rho} | "
                     f"{res.status} | {_max_fex(res):.4f} | — |")
+    for rho, stop in ((31.3, "0.6 nm"), (100, "0 nm")):
+        t0 = time.perf_counter()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = run(_slider(gw=rho, arclength=True, stop=stop), write=False, figures=False,
+                      progress=False)
+        trap = [w for w in caught if "snap" in str(w.message)]
+        folds = sum(len(sw.jumps) for sw in res.sweeps.values())
+        note = (f"; {folds} jumps, node stiffness {res.stiffness_ratio:.1f}x too soft: "
+                "mesh-dependent" if trap else f"; {folds} jumps")
+        rows.append(f"| Greenwood-Williamson, arclength to {stop} | 1e-19 | {rho} | "
+                    f"{res.status}{note} ({time.perf_counter() - t0:.0f} s) | "
+                    f"{_max_fex(res):.4f} | — |")
     ax[0].set(xlabel="d (nm)", ylabel="-F_ex (mN)", title="Fig 8(a): force on slider")
     ax[1].set(xlabel="-F_ex (mN)", ylabel="r_c (µm)", title="Fig 8(b): contact radius")
     for a in ax:
@@ -194,51 +211,7 @@ def regime(quick):
                      f"{p.pull_off_displacement:.4f} | {ji} | {jo} | {p.hysteresis:.4f} | "
                      f"{p.hysteresis_trapezoid:.4f} | {p.n_folds} | {p.n_points} | "
                      f"{p.wall_time:.2f} |")
-    plt = _plt()
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
-    mu_fine = np.logspace(-1.2, math.log10(6), 60)
-    ax[0].semilogx(mu_fine, [maugis_pull_off(lj_dugdale_lambda(m)) for m in mu_fine], "k-",
-                   label="Maugis-Dugdale, λ = 1.157 μ")
-    ax[0].axhline(2.0, color="grey", ls="--", label="DMT 2πRΔγ")
-    ax[0].axhline(1.5, color="grey", ls=":", label="JKR 1.5πRΔγ")
-    ax[0].semilogx([p.mu for p in pts], [p.pull_off for p in pts], "o",
-                   label="femadh LJ sphere")
-    ax[0].set(xlabel="Tabor μ", ylabel="pull-off / πRΔγ", title="pull-off force (load control)")
-    ax[0].legend(fontsize=8)
-    for p in pts:
-        if p.jump_in:
-            ax[1].semilogx(p.mu, p.jump_in, "v", color="C0")
-            ax[1].semilogx(p.mu, p.jump_out, "^", color="C1")
-    ax[1].set(xlabel="Tabor μ", ylabel="d / z0 at the fold",
-              title="jump-in (▼, approach) and jump-out (▲, retract)")
-    ax[2].loglog([p.mu for p in pts if p.hysteresis > 0],
-                 [p.hysteresis for p in pts if p.hysteresis > 0], "s-")
-    ax[2].set(xlabel="Tabor μ", ylabel="work per cycle / (πRΔγ z0)",
-              title="approach-retract hysteresis")
-    for a in ax:
-        a.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    fig.savefig(RESULTS / "regime_map.png", dpi=110)
-    plt.close(fig)
-    # the traced curves themselves, unstable branches dashed, paths of the experiment
-    show = [p for p in pts if p.mu in (mus[0], mus[len(mus) // 2], mus[-1])] or pts[:3]
-    fig, ax = plt.subplots(1, len(show), figsize=(5 * len(show), 4))
-    for a, p in zip(np.atleast_1d(ax), show):
-        c = p.curves
-        st = c["curve_stable"]
-        F = np.where(st, c["curve_F"], np.nan)
-        Fu = np.where(~st, c["curve_F"], np.nan)
-        a.plot(c["curve_d"], F, "k-", lw=1, label="stable")
-        a.plot(c["curve_d"], Fu, "k--", lw=1, label="unstable (traced)")
-        a.plot(c["approach_d"], c["approach_F"], "C0:", lw=2, label="approach path")
-        a.plot(c["retract_d"], c["retract_F"], "C1:", lw=2, label="retract path")
-        a.set(xlabel="d / z0", ylabel="F / πRΔγ (tension > 0)", title=f"μ = {p.mu:.3g}",
-              xlim=(min(c["curve_d"]), 12))
-        a.grid(alpha=0.3)
-        a.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(RESULTS / "regime_curves.png", dpi=110)
-    plt.close(fig)
+    regime_figures(pts, RESULTS)
     return "\n".join(lines), wall, pts
 
 
