@@ -117,17 +117,17 @@ def trapping_ratio(problem, w, d):
 
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-19,
-              stiffness_target=STIFFNESS_TARGET, min_nodes=120, progress=None):
+              stiffness_target=STIFFNESS_TARGET, min_nodes=120, ds_max=0.5, progress=None):
     """Trace the equilibrium curve of a smooth LJ sphere at Tabor parameter mu (approach from
     d = 12 z0 to a compressive load of about PRELOAD pi R dg) and read the regime-map numbers
-    off it.
+    off it. ``ds_max`` is the largest continuation step (units of z0).
     """
     t0 = time.perf_counter()
     problem, lj, e_star, a, d_min = _lj_problem(mu, radius, hamaker, z0, stiffness_target,
                                                    min_nodes)
     dg = lj.work_of_adhesion
     d0 = 12 * z0
-    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=0.5,
+    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=ds_max,
                         progress=progress)
 
     def force(d, w):
