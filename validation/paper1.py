@@ -98,10 +98,7 @@ def cases(quick):
     out = []
     for fig, sig in (("fig3", "1.0 nm"), ("fig4", "0.5 nm")):
         for model in ("complementarity", "hertz-closure"):
-            # the paper's closure runs at N = 100: at N = 200 its failing sweeps (ill-posed
-            # closure, see validation/README.md) spend minutes in step halving
-            nm = n if model == "complementarity" else 100
-            out.append((fig, model, scene("paper1_fig3", nm, sigma=sig, contact_model=model,
+            out.append((fig, model, scene("paper1_fig3", n, sigma=sig, contact_model=model,
                                           name=f"paper1-{fig}-{model}")))
     for sig in ("0.25 nm", "0.20 nm", "0.18 nm", "0.165 nm", "0.16 nm", "0.15 nm"):
         out.append((f"fig6 σ={sig}", "complementarity",

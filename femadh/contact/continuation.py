@@ -20,6 +20,14 @@ from .newton import solve_state, tangent
 
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
+#: solves allowed between two requested separations before the branch counts as stalled
+#: (a fold needs ~log2(1/MIN_STEP_FRACTION) = 10 halvings; healthy steps need a handful)
+MAX_SOLVES_PER_STEP = 200
+#: consecutive accepted steps within 4x the smallest step that count as a stall (a fold would
+#: have ended the branch instead; a healthy branch doubles its step back up)
+MAX_TINY_STEPS = 8
+#: folds within one requested step beyond which the branch counts as stalled
+MAX_JUMPS_PER_STEP = 3
 #: a corrector that moves any gap by more than this fraction away from the prediction has
 #: left the branch (jumped) even if it converged
 MAX_CORRECTION_FRACTION = 0.25
@@ -212,7 +220,24 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
         grid_step = d_next - state.d
         step = grid_step
         min_step = abs(grid_step) * MIN_STEP_FRACTION
+        solves_here, tiny, jumps_here = 0, 0, 0
         while state.d != d_next:
+            if solves_here >= MAX_SOLVES_PER_STEP:
+                # the folds of the crawl are not physical snaps: keep them out of the result
+                crawl = sweep.jumps[len(sweep.jumps) - jumps_here:] if jumps_here else []
+                del sweep.jumps[len(sweep.jumps) - jumps_here:]
+                # accepted steps keep collapsing to the smallest size without a fold: the
+                # branch crawls (e.g. the Hertz closure's inner problem turning non-unique)
+                why = (f"{len(crawl)} folds in a row at the smallest step, none of them a "
+                       "branch the model continues" if crawl else
+                       f"{solves_here} solves, converged states only at the smallest steps")
+                exc = ConvergenceError(
+                    f"continuation stalled between d = {state.d * 1e9:.6g} and "
+                    f"{d_next * 1e9:.6g} nm: {why} ({abs(step) * 1e9:.3g} nm)",
+                    d=state.d, residual=state.residual, n_iter=state.n_iter)
+                exc.sweep = sweep
+                raise exc
+            solves_here += 1
             d_try = state.d + step
             if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
                     abs(d_next - d_try) < 0.5 * min_step:
@@ -222,6 +247,9 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
                               active0=act, r_c0=state.r_c, factor=state.lu)
             sweep.n_solves += 1
             if _accept(new, w_pred, d_try):
+                tiny = tiny + 1 if abs(d_try - state.d) <= 4 * min_step else 0
+                if tiny > MAX_TINY_STEPS:
+                    solves_here = MAX_SOLVES_PER_STEP   # crawling: report as stalled
                 prev, state = state, new
                 step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
                 continue
@@ -233,6 +261,11 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
             sweep.n_solves += 1
             _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol, sweep)
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
+            jumps_here += 1
+            if jumps_here > MAX_JUMPS_PER_STEP:
+                # fold after fold at the smallest step: not a physical snap but a branch the
+                # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
+                solves_here = MAX_SOLVES_PER_STEP
             prev, state = None, landed
         sweep.states.append(state)
         if on_state:
