@@ -130,9 +130,10 @@ def main(argv=None):
                   f" at d = {c['d'][k] * 1e9:.3g} nm, F_LJ(d = {c['d'][-1] * 1e9:.3g} nm) = "
                   f"{c['F_LJ'][-1] * 1e3:.4g} mN")
         for j in res.jumps:
+            where = (f"±{j.resolution * 1e9:.1e} nm" if j.resolution > 0 else
+                     "traced fold, dd/ds = 0")
             print(f"jump ({j.branch}): branch folds at d = {j.d_fold * 1e9:.4f} nm "
-                  f"(±{j.resolution * 1e9:.1e} nm), h0 {j.before.h0 * 1e9:.3f} -> "
-                  f"{j.after.h0 * 1e9:.3f} nm")
+                  f"({where}), h0 {j.before.h0 * 1e9:.3f} -> {j.after.h0 * 1e9:.3f} nm")
         print(f"results in {res.out_dir} ({res.wall_time:.2f} s)")
     if res.status != "converged":
         print(f"femadh: error: {res.error}; states computed before it are kept in "
