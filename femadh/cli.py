@@ -56,7 +56,7 @@ def _regime(args):
     import numpy as np
 
     from .errors import SceneError
-    from .regime import lj_sphere, write_regime
+    from .regime import regime_map, write_regime
     from .studies import default_progress
     from .units import to_si
 
@@ -72,13 +72,10 @@ def _regime(args):
         print(f"femadh: error: {exc}", file=sys.stderr)
         return 2
     mus = np.geomspace(lo, hi, args.points) if args.points > 1 else [lo]
-    bar = default_progress()
-    pts = []
-    for i, mu in enumerate(mus):
-        pts.append(lj_sphere(float(mu), **kw))
-        if bar:
-            bar(f"mu = {mu:.3g}: pull-off {pts[-1].pull_off:.4f} pi R dg "
-                f"({i + 1}/{len(mus)})")
+    say = default_progress()
+    pts = regime_map(mus, progress=(lambda i, p: say(
+        f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
+        if say else None, **kw)
     path = write_regime(pts, args.out)
     print(path.read_text(), end="")
     print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")

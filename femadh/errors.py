@@ -44,3 +44,8 @@ class ConvergenceError(FemadhError, RuntimeError):
 
 class DomainError(FemadhError, ValueError):
     """A physical model is asked for a state outside its domain of validity."""
+
+
+class MeshResolutionWarning(UserWarning):
+    """The discretisation is too coarse for the surface forces' stiffness: single nodes can
+    snap on their own (lattice trapping) and results depend on the mesh."""

@@ -29,6 +29,7 @@ from .contact import ContactProblem
 from .contact.arclength import trace_curve
 from .effects import LennardJones
 from .elastic import GreenOperator, RadialGrid
+from .errors import MeshResolutionWarning
 from .indenter import Sphere
 from .reference.adhesion import dmt_contact_radius, jkr_contact_radius
 from .reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
@@ -47,10 +48,6 @@ PRELOAD = 0.5
 FINE_MARGIN = 1.15
 #: analysis radius in the same units (the rigid-LJ tail beyond it is added to the force)
 ANALYSIS_RADIUS = 4.32
-
-
-class MeshResolutionWarning(UserWarning):
-    """The traced states reached gaps where a single node is softer than the LJ law."""
 
 
 @dataclass
@@ -109,13 +106,6 @@ def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
     return problem, lj, e_star, a, d_min
 
 
-def trapping_ratio(problem, w, d):
-    """max_k -P'(h_k) / K_kk (-): the largest softening stiffness of the law at any node's
-    gap against that node's own stiffness. Above 1 the node can snap alone."""
-    h = problem.contour(d) - w
-    return float(np.max(-problem.dpressure(h) / np.diag(problem.K)))
-
-
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-19,
               stiffness_target=STIFFNESS_TARGET, min_nodes=120, ds_max=0.5, progress=None):
     """Trace the equilibrium curve of a smooth LJ sphere at Tabor parameter mu (approach from
@@ -165,7 +155,8 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-
 
     folds_a = [d for kind, d, _ in paths["approach"] if kind == "fold"]
     folds_r = [d for kind, d, _ in paths["retract"] if kind == "fold"]
-    trapping = max(trapping_ratio(problem, p.w, p.d) for p in curve.points)
+    trapping = max(problem.node_softening_ratio(problem.contour(p.d) - p.w)
+                   for p in curve.points)
     if trapping > TRAPPING_LIMIT:
         warnings.warn(f"mu = {mu:g}: a traced state reached -P'(h)/K_kk = {trapping:.2f} > "
                       f"{TRAPPING_LIMIT} (nodes can snap alone); lower stiffness_target",
@@ -185,12 +176,12 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-
 
 
 def regime_map(mus, progress=None, **kw):
-    """lj_sphere at each mu; ``progress(i)`` after each point."""
+    """lj_sphere at each mu (keywords passed on); ``progress(i, point)`` after each."""
     out = []
     for i, mu in enumerate(mus):
-        out.append(lj_sphere(mu, **kw))
+        out.append(lj_sphere(float(mu), **kw))
         if progress:
-            progress(i + 1)
+            progress(i, out[-1])
     return out
 
 

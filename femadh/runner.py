@@ -9,17 +9,13 @@ import numpy as np
 from . import __version__
 from .contact import State, trace
 from .contact.continuation import Jump, Sweep
-from .errors import ConvergenceError
+from .errors import ConvergenceError, MeshResolutionWarning
 from .output import SIGN_NOTE, RunWriter, state_forces, write_json
 from .scene import Scene, build_problem, load_scene
 
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
-
-
-class MeshResolutionWarning(UserWarning):
-    """The discretisation is too coarse for the surface forces' stiffness."""
 
 
 @dataclass
@@ -195,7 +191,6 @@ def _run_arclength(scene, problem, result, writer, progress):
             bar.close()
     if curve is None:
         return
-    result.curve_points = curve.points
     if writer:
         writer.write_equilibrium_curve(curve.points,
                                        [_curve_state(problem, p.d, p.w, p.stable)

@@ -42,7 +42,7 @@ def test_folds_are_turning_points_with_a_zero_eigenvalue(mu2):
         p = curve.points[f.index]
         hp = problem.contour(p.d) - p.w
         svp = np.linalg.svd(problem.K + np.diag(problem.dpressure(hp)), compute_uv=False)
-        # fold located to |t_d| < 1e-7: the smallest singular value is that small relative
+        # fold located to 1e-12 of the step: the smallest singular value is tiny relative
         assert sv[-1] / sv[0] < 1e-6
         assert svp[-1] / svp[0] > 10 * sv[-1] / sv[0]
 
@@ -88,7 +88,7 @@ def test_hysteresis_energy_identity(monkeypatch):
     coarse, fine = runs
     assert fine.n_points > 1.5 * coarse.n_points
     assert coarse.hysteresis > 0.5
-    # folds located to |t_d| < 1e-7 and landings solved to tol: step-independent to ~1e-8
+    # folds located to 1e-12 of a step, landings solved to tol: step-independent to ~1e-9
     assert fine.hysteresis == pytest.approx(coarse.hysteresis, rel=1e-7)
     err = [abs(r.hysteresis_trapezoid - r.hysteresis) for r in runs]
     assert err[1] < err[0] / 3   # 2.4x more points: error falls faster than 1/points (5.7x)

@@ -14,7 +14,7 @@ with Keller's bordered system
     [ omega t_w^T    t_d ] [dd] = [ -N ],   N = t . (x - x_pred),
 
 which stays regular through simple folds, so the unstable branch between them is traced too and
-each fold is located as the root of t_d (secant iteration on the step length). Lengths are
+each fold is located as the root of t_d (Brent's method on the step length). Lengths are
 scaled by ``scale`` (e.g. z0) and the displacement part of the norm is the nodal mean square
 (omega = 1/N), so one unit of s is one ``scale`` of separation or of typical displacement.
 
@@ -31,7 +31,7 @@ import math
 import time
 
 import numpy as np
-from scipy import linalg
+from scipy import linalg, optimize
 from scipy.sparse import linalg as sla
 
 from ..errors import ConvergenceError
@@ -54,8 +54,6 @@ MIN_STEP_FRACTION = 1e-6
 CORRECTOR_GAP_CLOSURE = 0.3
 #: consecutive unit tangents must be within acos(MIN_TANGENT_COS) = 30 degrees
 MIN_TANGENT_COS = math.cos(math.radians(30.0))
-#: fold located when |t_d| falls below this (tangents have unit length)
-FOLD_TD_TOL = 1e-7
 
 
 @dataclass
@@ -194,49 +192,29 @@ class EquilibriumCurve:
         return (xc[-1] * tr.scale, xc[:-1] * tr.scale) if ok else None
 
     def point_at(self, i, d, bracket=(0.0, None)):
-        """The curve's state w (m) at separation d beyond point i: root of d(s) = d by secant
-        iteration on the arclength offset s from point i, within ``bracket`` (s_hi None: up
-        to point i+1), on which d(s) must be monotone."""
+        """The curve's state w (m) at separation d beyond point i: root of d(s) = d in the
+        arclength offset s from point i, within ``bracket`` (s_hi None: up to point i+1), on
+        which d(s) must be monotone."""
         pts = self.points
         a, b = pts[i], pts[i + 1]
-        s_a, s_b = bracket[0], self._dist(a, b) if bracket[1] is None else bracket[1]
+        s_lo, s_hi = bracket[0], self._dist(a, b) if bracket[1] is None else bracket[1]
+        known = {0.0: (a.d, a.w)}
+        if bracket[1] is None:
+            known[s_hi] = (b.d, b.w)
 
         def at(s):
-            if s == 0.0:
-                return a.d, a.w
-            if bracket[1] is None and s == s_b:
-                return b.d, b.w
-            r = self._on_curve(a, s)
+            r = known.get(s) or self._on_curve(a, s)
             if r is None:
                 raise ConvergenceError("a state on the traced curve could not be recomputed",
                                        d=d, residual=math.nan, n_iter=0)
-            return r
-        (da, wa), (db, w) = at(s_a), at(s_b)
-        f_a, f_b = da - d, db - d
-        if f_a == 0:
-            return wa
-        for _ in range(60):
-            if f_b == 0 or abs(s_b - s_a) < 1e-12 * self._dist(a, b):
-                break
-            s = s_b - f_b * (s_b - s_a) / (f_b - f_a)
-            if not (min(s_a, s_b) < s < max(s_a, s_b)):
-                s = 0.5 * (s_a + s_b)
-            dd, w = at(s)
-            f = dd - d
-            if abs(f) <= 1e-12 * self._tracer.scale:
-                break
-            if f * f_b < 0:
-                s_a, f_a = s_b, f_b
-            else:
-                f_a *= 0.5  # Illinois
-            s_b, f_b = s, f
-        return w
+            known[s] = r
+            return r[0] - d
+        s = _bracketed_root(at, s_lo, s_hi, xtol=1e-12 * self._dist(a, b))
+        return known[s][1] if s in known else self._on_curve(a, s)[1]
 
     def maximize(self, i, value):
         """Largest value(d, w) on the curve between points i-1 and i+1 (bounded search in
         arclength; each evaluation is a corrected point). Returns (value, d, w)."""
-        from scipy import optimize
-
         pts = self.points
         s1, s2 = self._dist(pts[i - 1], pts[i]), self._dist(pts[i], pts[i + 1])
         best = [value(pts[i].d, pts[i].w), pts[i].d, pts[i].w]
@@ -325,6 +303,7 @@ class _Bordered:
 
             def count(_):
                 its[0] += 1
+
             def pre(y):
                 return linalg.lu_solve(self.lu, y, check_finite=False)
             # right preconditioning: GMRES then watches the true residual (Pa), not a
@@ -392,11 +371,13 @@ class _Tracer:
         return x, MAX_ITER, res, False
 
 
+def _residual(problem, w, d):
+    """max |w - C P(h)| (m): the residual of eq (6)."""
+    return float(np.max(np.abs(w - problem.C @ problem.pressure(problem.contour(d) - w))))
+
+
 def _hessian_stable(problem, w, d):
-    h = problem.contour(d) - w
-    H = problem.S_sym.copy()
-    H[np.diag_indices_from(H)] += problem.areas * problem.dpressure(h)
-    return _is_positive_definite(H)
+    return _is_positive_definite(problem.energy_hessian(problem.contour(d) - w))
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
@@ -531,18 +512,15 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         if len(curve.points) >= max_points:
             raise fail(f"arclength continuation needed more than {max_points} points",
                        d, res, it)
-    # land the last point exactly on d_end (fixed-d Newton from the interpolated state)
-    a, b = curve.points[-2], curve.points[-1]
+    # the last point exactly on d_end, recomputed on the curve inside the last step
+    b = curve.points[-1]
     if b.d != d_end:
-        f = (d_end - a.d) / (b.d - a.d)
-        st = solve_state(problem, d_end, a.w + f * (b.w - a.w), tol=tol, max_iter=60)
-        curve.n_solves += 1
-        if not st.converged:
-            raise fail("arclength end point: Newton did not converge", d_end, st.residual,
-                       st.n_iter)
-        t = tr.tangent(st.w, d_end, b.t)
-        curve.points[-1] = CurvePoint(d_end, st.w.copy(), t, st.stable, st.n_iter,
-                                      st.residual)
+        try:
+            w = curve.point_at(len(curve.points) - 2, d_end)
+        except ConvergenceError as exc:
+            raise fail(f"arclength end point: {exc}", d_end, math.nan, 0) from None
+        curve.points[-1] = CurvePoint(d_end, w, tr.tangent(w, d_end, b.t), b.stable, b.n_iter,
+                                      _residual(problem, w, d_end))
     curve.n_factor = tr.lin.n_factor
     curve.n_krylov = tr.lin.n_krylov
     curve.wall_time = time.perf_counter() - t0
@@ -550,43 +528,32 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
 
 
 def _locate_fold(tr, p, step, index):
-    """Root of t_d(s) in (0, step) from point p: secant (Illinois) on corrected points."""
+    """The fold between point p and the point one ``step`` further: root of t_d(s) on
+    corrected points (t_d changes sign across it), located to 1e-12 of the step."""
     n, scale = tr.n, tr.scale
     x = np.concatenate([p.w, [p.d]]) / scale
+    known = {0.0: (p.t_d, p.w, p.d)}
 
-    def at(s):
-        xc, it, res, ok = tr.correct(x + s * p.t, p.t)
-        if not ok:
-            return None
-        w, d = xc[:n] * scale, xc[n] * scale
-        return tr.tangent(w, d, p.t)[-1], w, d
+    def t_d(s):
+        if s not in known:
+            xc, _, _, ok = tr.correct(x + s * p.t, p.t)
+            if not ok:
+                raise _OffCurve
+            w, d = xc[:n] * scale, xc[n] * scale
+            known[s] = (tr.tangent(w, d, p.t)[-1], w, d)
+        return known[s][0]
+    try:
+        s = _bracketed_root(t_d, 0.0, step, xtol=1e-12 * step)
+    except _OffCurve:   # the corrector failed inside the step: the best point found so far
+        s = min(known, key=lambda k: abs(known[k][0]))
+    _, w, d = known[s]
+    return Fold(index, d, w, s)
 
-    a, fa = 0.0, p.t_d
-    b = step
-    rb = at(b)
-    if rb is None:
-        return Fold(index, p.d, p.w.copy(), 0.0)
-    fb, wb, db = rb
-    best = (abs(fb), wb, db, b)
-    side = 0
-    for _ in range(40):
-        s = b - fb * (b - a) / (fb - fa)
-        if not (min(a, b) < s < max(a, b)):
-            s = 0.5 * (a + b)
-        r = at(s)
-        if r is None:
-            break
-        fs, ws, dsp = r
-        if abs(fs) < best[0]:
-            best = (abs(fs), ws, dsp, s)
-        if abs(fs) < FOLD_TD_TOL or abs(b - a) < 1e-12 * step:
-            break
-        if fs * fb < 0:
-            a, fa = b, fb
-            side = 0
-        else:
-            if side == 1:
-                fa *= 0.5   # Illinois: keep the stale end from stalling the secant
-            side = 1
-        b, fb = s, fs
-    return Fold(index, best[2], best[1], best[3])
+
+class _OffCurve(Exception):
+    """The corrector did not converge at a requested arclength offset."""
+
+
+def _bracketed_root(f, lo, hi, *, xtol):
+    """Root of f in [lo, hi] with f(lo) f(hi) <= 0 (scipy's Brent method)."""
+    return optimize.brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=100)

@@ -23,9 +23,6 @@ MIN_STEP_FRACTION = 2.0**-10
 #: solves allowed between two requested separations before the branch counts as stalled
 #: (a fold needs ~log2(1/MIN_STEP_FRACTION) = 10 halvings; healthy steps need a handful)
 MAX_SOLVES_PER_STEP = 200
-#: consecutive accepted steps within 4x the smallest step that count as a stall (a fold would
-#: have ended the branch instead; a healthy branch doubles its step back up)
-MAX_TINY_STEPS = 8
 #: folds within one requested step beyond which the branch counts as stalled
 MAX_JUMPS_PER_STEP = 3
 #: a corrector that moves any gap by more than this fraction away from the prediction has
@@ -109,8 +106,7 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
     b = problem.contour(d)
     upper = b - h_floor
     w = np.minimum(np.array(w, float), upper)
-    S, areas = problem.S_sym, problem.areas
-    scale_diag = np.diag(S).copy()
+    scale_diag = np.diag(problem.S_sym).copy()
     lam = 1.0
     e = problem.energy(w, d)
     g = problem.energy_gradient(w, d)
@@ -120,8 +116,7 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
         free = ~at_bound
         if float(np.max(np.abs(g[free]), initial=0.0)) <= 1e-10 * g0:
             return w, True
-        H = S[np.ix_(free, free)].copy()
-        H[np.diag_indices_from(H)] += areas[free] * problem.dpressure(b[free] - w[free])
+        H = problem.energy_hessian(b - w, free)
         while True:
             M = H.copy()
             M[np.diag_indices_from(M)] += lam * scale_diag[free]
@@ -220,7 +215,7 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
         grid_step = d_next - state.d
         step = grid_step
         min_step = abs(grid_step) * MIN_STEP_FRACTION
-        solves_here, tiny, jumps_here = 0, 0, 0
+        solves_here, jumps_here = 0, 0
         while state.d != d_next:
             if solves_here >= MAX_SOLVES_PER_STEP:
                 # the folds of the crawl are not physical snaps: keep them out of the result
@@ -247,9 +242,6 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
                               active0=act, r_c0=state.r_c, factor=state.lu)
             sweep.n_solves += 1
             if _accept(new, w_pred, d_try):
-                tiny = tiny + 1 if abs(d_try - state.d) <= 4 * min_step else 0
-                if tiny > MAX_TINY_STEPS:
-                    solves_here = MAX_SOLVES_PER_STEP   # crawling: report as stalled
                 prev, state = state, new
                 step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
                 continue

@@ -273,9 +273,7 @@ def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
                                 else m, problem.areas)
         stable = factor.min_rel_pivot(m) > 0 if m < h.size else True
     else:
-        D = problem.dpressure(h)
-        H = problem.S_sym[np.ix_(I, I)]
-        H[np.diag_indices_from(H)] += problem.areas[I] * D[I]
+        H = problem.energy_hessian(h, I)
         stable = _is_positive_definite(H) if H.size else True
     return State(d, w, h, _effect_pressures(problem, h), pc, A.copy(),
                  _area_radius(problem, A), it, res, True, stable, factor)
@@ -283,9 +281,7 @@ def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
 
 def hessian_is_positive_definite(problem, state):
     """The reference stability test (Cholesky of the free-node energy Hessian)."""
-    I = ~state.active
-    H = problem.S_sym[np.ix_(I, I)]
-    H[np.diag_indices_from(H)] += problem.areas[I] * problem.dpressure(state.h[I])
+    H = problem.energy_hessian(state.h, ~state.active)
     return _is_positive_definite(H) if H.size else True
 
 

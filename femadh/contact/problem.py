@@ -112,6 +112,23 @@ class ContactProblem:
         h = self.contour(d) - w
         return self.S_sym @ w - self.areas * self.pressure(h)
 
+    def energy_hessian(self, h, free=None):
+        """Symmetric Hessian (N/m) of :meth:`energy` at gaps h, on the nodes ``free`` (mask;
+        all by default): sym(S) + diag(area P'(h)). Positive definite = a stable state."""
+        if free is None:
+            H = self.S_sym.copy()
+            H[np.diag_indices_from(H)] += self.areas * self.dpressure(h)
+        else:
+            H = self.S_sym[np.ix_(free, free)]
+            H[np.diag_indices_from(H)] += self.areas[free] * self.dpressure(h[free])
+        return H
+
+    def node_softening_ratio(self, h):
+        """max_k -P'(h_k) / K_kk at the gaps h of a state: the a-posteriori twin of
+        :meth:`surface_force_stiffness` (each node against its own stiffness, at the gap it
+        actually reached). Near 1 a node can snap on its own (lattice trapping)."""
+        return float(np.max(-self.dpressure(h) / np.diag(self.K)))
+
 
 @dataclass(eq=False)
 class State:
