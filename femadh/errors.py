@@ -36,10 +36,18 @@ class ConvergenceError(FemadhError, RuntimeError):
         if d is not None:
             parts.append(f"d = {d * 1e9:.6g} nm")
         if residual is not None:
-            parts.append(f"residual = {residual:.3e} m")
+            # a non-finite residual is a bug's symptom, not a number to report: the place
+            # where the non-finite value arose raises its own error first
+            parts.append(f"residual = {residual:.3e} m" if residual == residual
+                         and abs(residual) != float("inf") else "no finite residual")
         if n_iter is not None:
             parts.append(f"after {n_iter} iterations")
         super().__init__("; ".join(parts))
+
+
+class LawError(FemadhError, ValueError):
+    """A pressure law is inconsistent (its derivative or energy does not match its value) or
+    returned a non-finite value."""
 
 
 class DomainError(FemadhError, ValueError):

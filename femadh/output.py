@@ -37,9 +37,12 @@ def state_forces(problem, state):
 
 
 #: extra curve.csv columns, by effect name (only for the effects a scene names), with the sign
-#: that makes them positive in their own sense (attractive, or repulsive for asperity_elastic)
+#: that makes them positive in their own sense (attractive, or repulsive for asperity_elastic);
+#: fields.csv gets the matching pressure column (attractive positive, as the law returns it)
 EFFECT_COLUMNS = {"capillary": ("F_cap_N", 1.0), "asperity_adhesion": ("F_LJa_N", 1.0),
                   "asperity_elastic": ("F_ela_N", -1.0)}
+EFFECT_FIELDS = {"capillary": "P_cap_Pa", "asperity_adhesion": "P_LJa_Pa",
+                 "asperity_elastic": "P_ela_Pa"}
 
 
 class RunWriter:
@@ -55,8 +58,9 @@ class RunWriter:
         self._writers = {}
         self.extra = [k for k in EFFECT_COLUMNS if k in problem.effects]
         curve_header = CURVE_HEADER + [EFFECT_COLUMNS[k][0] for k in self.extra]
+        field_header = FIELD_HEADER + [EFFECT_FIELDS[k] for k in self.extra]
         for name, header in (("curve", curve_header), ("diagnostics", DIAG_HEADER),
-                             ("fields", FIELD_HEADER)):
+                             ("fields", field_header)):
             f = open(self.dir / f"{name}.csv", "w", newline="")
             w = csv.writer(f)
             w.writerow(header)
@@ -77,7 +81,8 @@ class RunWriter:
             _g(state.diagnostics.get("eq10_violation_inside_m", 0.0))])
         p_lj = state.p_effects.get("lj", np.zeros_like(state.w))
         rows = np.column_stack([np.full(state.w.size, state.d), p.grid.nodes, state.w, state.h,
-                                p_lj, state.p_contact])
+                                p_lj, state.p_contact]
+                               + [state.p_effects[k] for k in self.extra])
         fw = self._writers["fields"]
         for row in rows:
             fw.writerow([branch] + [_g(x) for x in row])

@@ -20,3 +20,47 @@ def observed_order(h, err):
 @pytest.fixture
 def e_star():
     return E_STAR
+
+
+def check_curve_against_fields(out_dir, rel=1e-12):
+    """curve.csv's forces equal the pressures of fields.csv integrated over the annuli (edges
+    half-way between the nodes, the last at the analysis radius of summary.json), state by
+    state; and F_ex is their signed sum (paper 1 eqs 11-13 with area weights). The csv holds
+    repr() floats, so only the summation order separates them: measured <= 3e-16 relative.
+    Returns the number of states checked."""
+    import csv
+    import json
+    from pathlib import Path
+
+    out = Path(out_dir)
+    a = json.loads((out / "summary.json").read_text())["scene"]["solver"]["analysis_radius_m"]
+    curve = list(csv.DictReader(open(out / "curve.csv")))
+    fields = list(csv.DictReader(open(out / "fields.csv")))
+    groups, order = {}, []
+    for r in fields:
+        key = (r["branch"], r["d_m"])
+        if key not in groups:
+            groups[key] = []
+            order.append(key)
+        groups[key].append(r)
+    assert len(order) == len(curve)       # a state is in both files or in neither
+    signs = {"F_LJ_N": ("P_LJ_Pa", 1.0), "F_el_N": ("P_el_Pa", 1.0),
+             "F_cap_N": ("P_cap_Pa", 1.0), "F_LJa_N": ("P_LJa_Pa", 1.0),
+             "F_ela_N": ("P_ela_Pa", -1.0)}
+    for row, key in zip(curve, order):
+        assert (row["branch"], row["d_m"]) == key
+        rows = groups[key]
+        r = np.array([float(x["r_m"]) for x in rows])
+        edges = np.concatenate([[0.0], 0.5 * (r[1:] + r[:-1]), [a]])
+        areas = np.pi * np.diff(edges**2)
+        total = 0.0
+        scale = 0.0
+        for col, (fcol, sign) in signs.items():
+            if col not in row:
+                continue
+            f = sign * float(areas @ np.array([float(x[fcol]) for x in rows]))
+            scale = max(scale, abs(f))
+            assert float(row[col]) == pytest.approx(f, rel=rel, abs=rel * scale)
+            total += -f if col in ("F_el_N", "F_ela_N") else f
+        assert float(row["F_ex_N"]) == pytest.approx(total, rel=rel, abs=rel * scale)
+    return len(curve)

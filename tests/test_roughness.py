@@ -6,6 +6,7 @@ import pytest
 from scipy import integrate
 
 from femadh.effects import AsperityAdhesion, GWAdhesion, GWElastic
+from conftest import check_curve_against_fields
 from femadh.reference.gw import (gw_integral, height_density, mean_plane_dominance_bound,
                                  paper1_table2_roughness)
 
@@ -32,7 +33,7 @@ def test_paper1_table2_and_fig7_numbers():
     assert (r.sigma_a, r.z_m, r.radius) == pytest.approx((0.344e-9, 1.08e-9, 0.94e-6), rel=2e-3)
     for rho, ar, plj in ((31.3, 0.013, 5.56), (100, 0.04, 17.7), (179, 0.073, 31.8)):
         r = paper1_table2_roughness(rho * 1e12)
-        assert r.contact_probability(r.z_m) == pytest.approx(0.5)
+        assert r.contact_probability(r.z_m) == pytest.approx(0.5, rel=1e-14)
         assert r.real_area_ratio(r.z_m) == pytest.approx(ar, rel=0.05)   # paper's 2 digits
         assert r.lj_pressure(r.z_m, 0.06) / 1e6 == pytest.approx(plj, rel=5e-3)
     assert mean_plane_dominance_bound(0.165e-9, 1e-6, 10e12) == pytest.approx(1.05e-9, rel=5e-3)
@@ -62,10 +63,8 @@ def test_paper1_section6_scenes_run_and_report_asperity_forces(tmp_path):
         assert res.status == "converged"
         rows = list(csv.DictReader(open(tmp_path / name / "curve.csv")))
         assert col in rows[0]
-        for r in rows:  # F_ex = F_LJ + F_LJa - F_ela - F_el, row by row
-            f = float(r["F_LJ_N"]) + float(r.get("F_LJa_N") or 0) - float(r.get("F_ela_N") or 0) \
-                - float(r["F_el_N"])
-            assert float(r["F_ex_N"]) == pytest.approx(f, rel=1e-12, abs=1e-18)
+        # F_ex = F_LJ + F_LJa - F_ela - F_el, each integrated from fields.csv
+        assert check_curve_against_fields(tmp_path / name) == len(rows)
 
 
 def test_regime_map_limits_and_hysteresis():
@@ -77,16 +76,18 @@ def test_regime_map_limits_and_hysteresis():
 
     lo = lj_sphere(0.1)
     assert lo.jump_in is None and lo.jump_out is None and lo.n_folds == 0
-    assert lo.pull_off == pytest.approx(2.0, abs=0.05)       # rigid-LJ limit AR/8z0^2
+    # rigid-LJ limit AR/8z0^2 = 2 pi R dg; at mu = 0.1 measured 1.969 (Maugis-Dugdale: 1.940)
+    assert lo.pull_off == pytest.approx(2.0, abs=0.05)
     mid, hi = lj_sphere(2.0), lj_sphere(4.0)
     for p in (mid, hi):
         assert p.jump_in is not None and p.jump_out > p.jump_in
         assert p.trapping_ratio < 0.45   # mesh-wiggle onset measured at ~0.4-0.6 (mu = 3)
     assert 1.5 < hi.pull_off < mid.pull_off < lo.pull_off
     assert hi.hysteresis > mid.hysteresis > 0.5
-    # LJ vs Dugdale law differ in shape: measured 3.7 % at mu = 2, 1.9 % at mu = 4
-    assert mid.pull_off == pytest.approx(mid.maugis, rel=0.05)
-    assert hi.pull_off == pytest.approx(hi.maugis, rel=0.025)
+    # LJ vs Dugdale law differ in shape (not a numerical error): measured 3.7 % at mu = 2,
+    # 1.85 % at mu = 4
+    assert mid.pull_off == pytest.approx(mid.maugis, rel=0.042)
+    assert hi.pull_off == pytest.approx(hi.maugis, rel=0.021)
     assert abs(hi.pull_off / hi.maugis - 1) < abs(mid.pull_off / mid.maugis - 1)
 
 

@@ -33,7 +33,7 @@ def test_fig6_external_force_hardly_depends_on_sigma_below_z0(tmp_path):
     """Paper Fig 6(c): -F_ex vs d is almost identical for sigma <= z0."""
     peaks = [fig6(s, tmp_path).curve("approach")["F_ex"].max() for s in
              ("0.165 nm", "0.16 nm", "0.15 nm")]
-    assert np.ptp(peaks) / np.mean(peaks) < 0.01  # femadh: 0.05 % spread
+    assert np.ptp(peaks) / np.mean(peaks) < 5e-3  # femadh: 0.05 % spread
 
 
 def test_closure_breaks_eq10_inside_while_complementarity_keeps_both(tmp_path):
@@ -45,14 +45,19 @@ def test_closure_breaks_eq10_inside_while_complementarity_keeps_both(tmp_path):
              figures=False, progress=False)
     comp, clos = measure(rc), measure(rh)
     assert comp["status"] == "converged"
-    assert comp["eq10_residual_nm"] <= 1e-10 and comp["eq10_inside_nm"] == 0
-    assert comp["eq8_min_h_minus_sigma_nm"] > -1e-8   # round-off of b - w only
-    assert clos["eq8_min_h_minus_sigma_nm"] > -1e-8
-    assert clos["eq10_inside_nm"] > 0.05              # > 5 % of sigma: not a round-off effect
+    tol_nm = rc.scene.tolerance * 1e9                 # 1e-10 nm
+    # eq 10 recomputed from each state's pressures: the complementarity model meets it to
+    # the Newton tolerance inside and outside the contact
+    assert comp["eq10_residual_nm"] <= tol_nm and comp["eq10_inside_nm"] <= tol_nm
+    assert clos["eq10_residual_nm"] <= tol_nm         # the closure: outside only ...
+    assert clos["eq10_inside_nm"] > 0.05              # ... > 5 % of sigma inside (0.168 nm)
+    # eq 8: h >= sigma up to the round-off of b - w (eps * 1 nm = 2e-16 nm, measured -2.1e-16)
+    assert comp["eq8_min_h_minus_sigma_nm"] > -2e-15
+    assert clos["eq8_min_h_minus_sigma_nm"] > -2e-15
     # where both have states, F_LJ agrees to a few percent: inside the contact both carry
     # P_LJ(sigma); they differ in the contact pressure's shape and hence in r_c
     fc, fh = rc.curve("approach"), rh.curve("approach")
     k = len(fh["d"])
     assert k >= 20                                    # the closure gets well into contact
-    assert np.allclose(fh["d"], fc["d"][:k])
-    assert np.allclose(fh["F_LJ"], fc["F_LJ"][:k], rtol=0.05)
+    assert np.array_equal(fh["d"], fc["d"][:k])
+    assert np.max(np.abs(fh["F_LJ"] / fc["F_LJ"][:k] - 1)) < 0.035   # measured 1.8 %

@@ -35,7 +35,7 @@ from scipy import linalg, optimize
 from scipy.sparse import linalg as sla
 
 from ..errors import ConvergenceError
-from .newton import _is_positive_definite
+from .stability import is_positive_definite
 
 #: Newton iterations allowed per corrector
 MAX_ITER = 15
@@ -54,6 +54,10 @@ MIN_STEP_FRACTION = 1e-6
 CORRECTOR_GAP_CLOSURE = 0.3
 #: consecutive unit tangents must be within acos(MIN_TANGENT_COS) = 30 degrees
 MIN_TANGENT_COS = math.cos(math.radians(30.0))
+#: corrector attempts (each after halving the step) allowed for one new point; a healthy
+#: trace needs a few, a fold a dozen (halving 1 -> 1e-3); more means the corrector and the
+#: tangent disagree (e.g. a law whose derivative is inconsistent with its value)
+MAX_ATTEMPTS_PER_POINT = 40
 
 
 @dataclass
@@ -377,7 +381,7 @@ def _residual(problem, w, d):
 
 
 def _hessian_stable(problem, w, d):
-    return _is_positive_definite(problem.energy_hessian(problem.contour(d) - w))
+    return is_positive_definite(problem.energy_hessian(problem.contour(d) - w))
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
@@ -449,6 +453,19 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         return exc
 
     check_next = False
+    attempts = 0
+
+    def shorten(reason, d, res, it):
+        """Halve the step after a rejected attempt; give up at the smallest step or after
+        MAX_ATTEMPTS_PER_POINT attempts for one point (each is a corrector solve)."""
+        nonlocal step
+        if step <= ds_min * 1.0001 or attempts >= MAX_ATTEMPTS_PER_POINT:
+            why = ("at the smallest step" if step <= ds_min * 1.0001 else
+                   f"after {attempts} attempts at shorter steps")
+            raise fail(f"arclength continuation stalled after d = {p.d * 1e9:.6g} nm "
+                       f"({len(curve.points)} points): {reason} {why}", d, res, it)
+        step *= 0.5
+
     while True:
         p = curve.points[-1]
         x = np.concatenate([p.w, [p.d]]) / scale
@@ -460,30 +477,29 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         step = max(step, ds_min)
         x_pred = x + step * p.t
         factors = tr.lin.n_factor
+        attempts += 1
         xc, it, res, ok = tr.correct(x_pred, p.t)
         if not ok:
-            if step <= ds_min * 1.0001:
-                raise fail(f"arclength continuation stalled at d = {p.d * 1e9:.6g} nm: the "
-                           f"corrector failed even at the smallest step", p.d, res, it)
-            step *= 0.5
+            shorten("the corrector did not converge", x_pred[n] * scale, res, it)
             continue
         w, d = xc[:n] * scale, xc[n] * scale
         t = tr.tangent(w, d, p.t)
         if t @ (p.t * weights) < MIN_TANGENT_COS:
             # the tangent turned too far within one step: the curve bends faster than the
             # step resolves (near folds and cusps); a shorter step follows it
-            step *= 0.5
+            shorten("the tangent turned by more than 30 degrees", d, res, it)
             continue
         if (d - p.d) * p.t_d < 0 and p.t_d * t[n] > 0:
             # d moved against both end tangents: two folds inside the step (a narrow loop
             # near the onset of bistability) - resolve them instead of stepping over
-            step *= 0.5
+            shorten("two folds inside one step", d, res, it)
             continue
         h_c = problem.contour(d) - w
         h_p = problem.contour(x_pred[n] * scale) - x_pred[:n] * scale
         corr = float(np.max(np.abs(h_c - h_p) / h_c))
         if corr > 4 * TARGET_CORRECTION:
-            step *= 0.5     # the predictor was poor: the point may sit on another branch
+            # the predictor was poor: the point may sit on another branch
+            shorten(f"the corrector moved a gap by {corr:.2g} of itself", d, res, it)
             continue
         folded = p.t_d * t[n] < 0
         stable = p.stable != folded
@@ -492,13 +508,13 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         # points, an O(h) asymmetry of the discretisation)
         if tr.lin.n_factor != factors and not (folded or check_next):
             if _hessian_stable(problem, w, d) != stable:
-                if step > ds_min * 1.0001:
-                    step *= 0.5   # likely two folds inside the step: resolve them
-                    continue
-                raise fail(f"stability changed without a fold of the curve between d = "
-                           f"{p.d * 1e9:.6g} and {d * 1e9:.6g} nm (a bifurcation, or two "
-                           "folds in one step: lower ds_max)", d, res, it)
+                # likely two folds inside the step (resolve them); at the smallest step a
+                # bifurcation, which this continuation does not follow
+                shorten(f"stability changed without a fold of the curve between d = "
+                        f"{p.d * 1e9:.6g} and {d * 1e9:.6g} nm (a bifurcation?)", d, res, it)
+                continue
         check_next = folded
+        attempts = 0
         q = CurvePoint(d, w, t, stable, it, res)
         if folded:
             curve.folds.append(_locate_fold(tr, p, step, len(curve.points) - 1))

@@ -65,6 +65,7 @@ class Sweep:
     jumps: list = field(default_factory=list)
     n_solves: int = 0
     wall_time: float = 0.0
+    d_current: float = math.nan     # separation of the solve under way (for error messages)
 
 
 def _accept(new, pred_w, d):
@@ -124,6 +125,8 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
                 c = sla.cho_factor(M, check_finite=False)
             except sla.LinAlgError:
                 lam *= 4
+                if lam > 1e12:
+                    return w, False
                 continue
             dw = np.zeros_like(w)
             dw[free] = -sla.cho_solve(c, g[free], check_finite=False)
@@ -193,9 +196,26 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
         step halving and an energy-descent landing. States already passed to ``on_state``
         are kept by the caller.
     """
-    t0 = time.perf_counter()
     sweep = Sweep(branch)
+    try:
+        return _trace(sweep, problem, d_values, branch=branch, tol=tol, start=start,
+                      max_iter=max_iter, on_state=on_state, progress=progress)
+    except ConvergenceError as exc:
+        # every failure carries the states computed so far and the separation it happened at
+        if exc.d is None and math.isfinite(sweep.d_current):
+            new = ConvergenceError(exc.args[0], d=sweep.d_current)
+            new.sweep = sweep
+            raise new from None
+        if getattr(exc, "sweep", None) is None:
+            exc.sweep = sweep
+        raise
+
+
+def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, progress):
+    """The body of :func:`trace`, filling ``sweep`` as it goes."""
+    t0 = time.perf_counter()
     d_values = [float(x) for x in d_values]
+    sweep.d_current = d_values[0]
     if start is None:
         state = solve_state(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
                             max_iter=max_iter)
@@ -237,6 +257,7 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
             if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
                     abs(d_next - d_try) < 0.5 * min_step:
                 d_try = d_next
+            sweep.d_current = d_try
             w_pred, act = _predict(problem, state, prev, d_try)
             new = solve_state(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
                               active0=act, r_c0=state.r_c, factor=state.lu)

@@ -24,6 +24,7 @@ from scipy import linalg, optimize
 
 from ..reference.hertz import hertz_annulus_force, hertz_annulus_force_drc
 from .problem import State
+from .stability import is_stable
 
 #: evaluations of the closure condition g(r_c) allowed per solve (bracketing + Brent)
 CLOSURE_MAX_EVALS = 60
@@ -43,14 +44,6 @@ def _damping(h, dh_closing):
     if not np.any(closing):
         return 1.0
     return float(min(1.0, np.min(MAX_GAP_CLOSURE * h[closing] / dh_closing[closing])))
-
-
-def _is_positive_definite(M):
-    try:
-        linalg.cho_factor(M, check_finite=False)
-        return True
-    except linalg.LinAlgError:
-        return False
 
 
 def _effect_pressures(problem, h):
@@ -82,8 +75,7 @@ class TrailingLU:
     from m. Factorised in reversed node order, every trailing block is a *leading* block, and
     the LU of a leading block is the leading part of the full LU as long as partial pivoting
     made no row swap before it (checked: ``k_valid``). So moving the contact edge costs a
-    triangular solve, not a new factorisation, and the pivots' signs give the block's inertia
-    (the stability test) for free.
+    triangular solve, not a new factorisation.
     """
 
     def __init__(self, K, D, m0, scale=None):
@@ -101,7 +93,6 @@ class TrailingLU:
         self.lu, self.piv = linalg.lu_factor(M, check_finite=False)
         swaps = np.flatnonzero(self.piv != np.arange(n - m0))
         self.k_valid = int(swaps[0]) if swaps.size else n - m0
-        self.rel_pivots = np.diag(self.lu) / np.diag(M)
         self._block = (None, None)
 
     def covers(self, m):
@@ -125,9 +116,6 @@ class TrailingLU:
             rhs = rhs * self.scale[m:]
         return linalg.lu_solve(self._lu_block(m), rhs[::-1], check_finite=False)[::-1]
 
-    def min_rel_pivot(self, m):
-        return float(np.min(self.rel_pivots[: self.n - m])) if m < self.n else math.inf
-
 
 def _disk_size(A):
     """m if the active set is exactly the nodes 0..m-1, else None."""
@@ -137,9 +125,6 @@ def _disk_size(A):
 
 #: extra nodes factorised inside the contact edge so a shrinking contact stays covered
 DISK_MARGIN_FRACTION = 0.05
-#: a stale factorisation's pivots are trusted for the stability test only above this
-#: (relative) size; closer to a fold the converged state is refactorised
-STALE_PIVOT_MARGIN = 0.05
 
 
 def _solve_complementarity(problem, d, w0, *, tol, max_iter, active0, constrained=True,
@@ -256,33 +241,17 @@ def _area_radius(problem, A):
 
 
 def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
-    """Package a converged state and test its stability.
-
-    Stable means: the energy Hessian on the free nodes, sym(S)_II + diag(area_I P'(h_I)), is
-    positive definite. With a disk-shaped contact the test reads the signs of the trailing-block
-    pivots (the inertia of the area-scaled Jacobian, equal to the Hessian's up to the O(h)
-    asymmetry of collocation); a factorisation from an earlier iterate is trusted only while its
-    smallest relative pivot is above STALE_PIVOT_MARGIN, else the state is refactorised.
-    Otherwise a Cholesky factorisation of the Hessian decides.
-    """
-    I = ~A
-    m = _disk_size(A)
-    if isinstance(factor, TrailingLU) and m is not None and factor.covers(m):
-        if not fresh and factor.min_rel_pivot(m) < STALE_PIVOT_MARGIN:
-            factor = TrailingLU(problem.K, problem.dpressure(h), factor.m0 if factor.m0 <= m
-                                else m, problem.areas)
-        stable = factor.min_rel_pivot(m) > 0 if m < h.size else True
-    else:
-        H = problem.energy_hessian(h, I)
-        stable = _is_positive_definite(H) if H.size else True
+    """Package a converged state; its stability is the inertia of the energy Hessian on the
+    free nodes (:func:`femadh.contact.stability.is_stable`), never read off the Newton
+    factorisation (that one is of the collocation Jacobian, whose pivot signs do not give
+    the Hessian's inertia)."""
     return State(d, w, h, _effect_pressures(problem, h), pc, A.copy(),
-                 _area_radius(problem, A), it, res, True, stable, factor)
+                 _area_radius(problem, A), it, res, True, is_stable(problem, h, ~A), factor)
 
 
 def hessian_is_positive_definite(problem, state):
-    """The reference stability test (Cholesky of the free-node energy Hessian)."""
-    H = problem.energy_hessian(state.h, ~state.active)
-    return _is_positive_definite(H) if H.size else True
+    """Stability of a state: Cholesky of the free-node energy Hessian (see stability.py)."""
+    return is_stable(problem, state.h, ~state.active)
 
 
 def tangent(problem, state):

@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from ..effects import AsperityGap
+from ..errors import ConvergenceError
 from ..indenter import Sphere
 
 
@@ -29,15 +30,25 @@ class ContactProblem:
         evaluated.
     gap : AsperityGap or None
         The sigma-gap constraint (eq 8) and its contact model; None for a smooth sphere.
+    check_laws : bool
+        Verify each law's derivative and energy against finite differences of its value
+        (:func:`femadh.effects.check.check_law`) before solving; a LawError names the first
+        inconsistency. Off only for deliberately partial laws (tests).
     """
 
     operator: object
     sphere: Sphere
     effects: dict
     gap: AsperityGap | None = None
+    check_laws: bool = True
     shape: np.ndarray = field(init=False)
 
     def __post_init__(self):
+        if self.check_laws:
+            from ..effects.check import check_law
+
+            for name, law in self.effects.items():
+                check_law(name, law)
         g = self.operator.grid
         self.grid = g
         self.shape = self.sphere.shape(g.nodes)
@@ -86,16 +97,22 @@ class ContactProblem:
 
     def pressure(self, h):
         """Sum of the effect pressures (Pa, attractive positive) at gaps h."""
-        out = np.zeros_like(h)
-        for eff in self.effects.values():
-            out += eff.pressure(h)
-        return out
+        return self._sum("pressure", h)
 
     def dpressure(self, h):
         """d/dh of :meth:`pressure` (Pa/m)."""
+        return self._sum("dpressure", h)
+
+    def _sum(self, part, h):
+        """Sum of one part of every law; a non-finite value stops the solve where it arose."""
         out = np.zeros_like(h)
-        for eff in self.effects.values():
-            out += eff.dpressure(h)
+        for name, eff in self.effects.items():
+            v = getattr(eff, part)(h)
+            if not np.all(np.isfinite(v)):
+                k = int(np.flatnonzero(~np.isfinite(v))[0])
+                raise ConvergenceError(f"law {name!r}: {part} is not finite at node {k} "
+                                       f"(gap h = {np.ravel(h)[k]:.6g} m)")
+            out += v
         return out
 
     def energy(self, w, d):

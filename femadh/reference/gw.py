@@ -15,11 +15,32 @@ import numpy as np
 from scipy import special
 
 
+#: |t| beyond which scipy's pbdv overflows (t < 0) or returns nan (t > ~2071); there
+#: I_n is 0 in double precision (t > 0: below 1e-300) or its Gaussian-moment series (t < 0)
+_T_SAFE = 37.0
+
+
 def gw_integral(n, t):
-    """I_n(t) = int_t^inf (s - t)^n phi*(s) ds for n > -1, vectorised in t."""
+    """I_n(t) = int_t^inf (s - t)^n phi*(s) ds for n > -1, vectorised in t (finite for all t)."""
     t = np.asarray(t, float)
-    d, _ = special.pbdv(-n - 1.0, t)
-    return special.gamma(n + 1.0) * np.exp(-t * t / 4.0) * d / math.sqrt(2 * math.pi)
+    tc = np.clip(t, -_T_SAFE, _T_SAFE)
+    d, _ = special.pbdv(-n - 1.0, tc)
+    out = special.gamma(n + 1.0) * np.exp(-tc * tc / 4.0) * d / math.sqrt(2 * math.pi)
+    out = np.where(t > _T_SAFE, 0.0, out)
+    low = t < -_T_SAFE
+    if np.any(low):
+        # E[(X + c)^n], c = -t > 37: the mass below -c is < 1e-300; binomial series in 1/c^2
+        # with the Gaussian moments E[X^2k] = (2k-1)!!, 4 terms: relative error < 1e-12
+        c = -t[low]
+        series = np.ones_like(c)
+        coef, moment = 1.0, 1.0
+        for k in range(1, 4):
+            coef *= (n - 2 * k + 2) * (n - 2 * k + 1) / ((2 * k - 1) * (2 * k))
+            moment *= 2 * k - 1
+            series = series + coef * moment * c ** (-2.0 * k)
+        out = np.array(out, float)
+        out[low] = c**n * series
+    return out
 
 
 def height_density(z, z_m, sigma_a):
