@@ -184,3 +184,22 @@ def test_closure_crawl_stops_with_a_clear_error():
     sweep = e.value.sweep
     assert sweep.states and all(s.converged for s in sweep.states)
     assert not sweep.jumps
+
+
+def test_exact_sphere_profile_and_its_paraboloid_limit():
+    """profile = "sphere": b(r) - d = R - sqrt(R^2 - r^2), i.e. R(1 - cos theta) at
+    r = R sin theta (round-off only); near the axis the paraboloid of eq 4 is its leading
+    term of the series r^2/2R + r^4/8R^3 + r^6/16R^5 + ..."""
+    R = 1e-6
+    sp, pa = Sphere(R, "sphere"), Sphere(R)
+    th = np.array([1e-3, 0.1, 0.7, 1.3, math.pi / 2])
+    # R (1 - cos theta) = 2 R sin^2(theta/2), without the cancellation at small theta
+    exact = 2 * R * np.sin(th / 2) ** 2
+    assert np.max(np.abs(sp.shape(R * np.sin(th)) / exact - 1)) < 1e-14
+    for r in (1e-9, 1e-8, 1e-7):
+        series = pa.shape(r) + r**4 / (8 * R**3) + r**6 / (16 * R**5)
+        # the next term is 5/64 (r/R)^6 of the leading one
+        assert sp.shape(r) == pytest.approx(series, rel=0.1 * (r / R) ** 6 + 1e-15)
+    # the problem uses the profile it is given
+    p = ContactProblem(GreenOperator(RadialGrid.uniform(0.5 * R, 50), E_STAR), sp, {})
+    assert np.array_equal(p.shape, sp.shape(p.grid.nodes))

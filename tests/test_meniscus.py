@@ -163,3 +163,29 @@ def test_bad_meniscus_scene(tmp_path):
     p.write_text(text.replace("0.95]", "1.0]"))
     with pytest.raises(SceneError, match="relative_pressure"):
         femadh.load_scene(p)
+
+
+def test_force_is_normalised_by_the_solid_radius():
+    """Paper 2 normalises the capillary force by 4 pi R gamma with R the solid sphere's
+    radius, not that of the film-covered sphere R + h (a 1-nm film on a 10-nm tip: 10 %)."""
+    rk = kelvin_radius(ETOH, 0.5, T)
+    r = meniscus("fe", 10e-9, ETOH.surface_tension, rk, 1e-9)
+    assert r.force_over_4piRgamma == pytest.approx(
+        r.force / (4 * math.pi * 10e-9 * ETOH.surface_tension), rel=1e-14)
+
+
+def test_isotherms_limits_and_identities():
+    """GAB: Henry's law h ~ t_m c k x as x -> 0 (error O(x)), BET at k = 1, and the film stays
+    finite at saturation for k < 1; tabulated: exact at its points, linear between."""
+    from femadh.meniscus import BET, GAB, Tabulated
+
+    gab = GAB(0.3e-9, 15.0, 0.7)
+    for x in (1e-4, 1e-6):
+        assert gab(x) / (0.3e-9 * 15.0 * 0.7 * x) == pytest.approx(1.0, rel=20 * x)
+    xs = np.array([0.1, 0.5, 0.9])
+    assert np.max(np.abs(GAB(0.3e-9, 15.0, 1.0)(xs) / BET(0.3e-9, 15.0)(xs) - 1)) < 1e-14
+    # k < 1: finite at x -> 1, t_m c k / ((1 - k)(1 - k + c k))
+    assert gab(1 - 1e-12) == pytest.approx(0.3e-9 * 15 * 0.7 / (0.3 * (0.3 + 15 * 0.7)),
+                                           rel=1e-9)
+    tab = Tabulated((0.1, 0.5, 0.9), (0.2e-9, 0.6e-9, 1.6e-9))
+    assert tab(0.5) == 0.6e-9 and tab(0.3) == pytest.approx(0.4e-9, rel=1e-14)

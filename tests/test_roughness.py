@@ -107,3 +107,60 @@ def test_regime_cli_writes_table_and_figures(tmp_path, capsys):
     assert main(["regime", "--radius", "1 kg", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "--radius" in err and "1 kg" in err and "length" in err
+
+
+def test_regime_force_of_the_undeformed_surface_is_eq14_untruncated():
+    """w = 0: the map's force (grid + tail beyond the analysis radius) is the rigid sphere's
+    eq 14 on the whole plane; the grid's midpoint rule costs at most 1.5e-4 here (measured),
+    while the tail alone is 0.3-11 % of it at d = z0 ... 10 z0."""
+    from femadh.reference.rigid_lj import rigid_sphere_lj_force
+    from femadh.regime import _lj_problem, lj_force
+
+    R, A, z0 = 1e-6, 1e-19, 0.165e-9
+    problem, lj, *_ = _lj_problem(1.0, R, A, z0, 0.4, 120)
+    for d in np.array([1.0, 1.5, 3.0, 10.0]) * z0:
+        F = lj_force(problem, lj, d, np.zeros(problem.grid.n))
+        assert F == pytest.approx(rigid_sphere_lj_force(d, A, z0, R), rel=5e-4)
+
+
+def test_a_narrow_loop_near_the_cusp_is_not_stepped_over():
+    """Just above the onset of bistability (mu ~ 0.70) the S-loop is narrower than the
+    continuation's steps (jump-in/out 2.2657/2.2684 z0 at mu = 0.72): the trace must resolve
+    its two folds (it halves a step whose tangent turns by more than 30 degrees), as finer
+    steps do."""
+    from femadh.regime import lj_sphere
+
+    p = lj_sphere(0.72, ds_max=0.5)
+    fine = lj_sphere(0.72, ds_max=0.1)
+    assert p.n_folds == fine.n_folds == 2
+    assert p.jump_in == pytest.approx(fine.jump_in, rel=1e-9)
+    assert p.jump_out > p.jump_in
+
+
+def test_eq20_law_amplitude_is_the_papers_P_LJa():
+    """The [effects.asperity_adhesion] law carries eq 20's P_LJa = 2 pi R_a dg rho p: at
+    p = 0.5 the paper's 5.56 / 17.7 / 31.8 MPa for rho = 31.3 / 100 / 179 um^-2 (3 digits)."""
+    for rho, plj in ((31.3, 5.56), (100, 17.7), (179, 31.8)):
+        law = AsperityAdhesion.from_asperities(0.94e-6, 0.06, rho * 1e12, 0.5, 1.08e-9)
+        assert law.pressure_value / 1e6 == pytest.approx(plj, rel=5e-3)
+        # deep in contact (h = sigma) the smoothed step has fully switched on: 1 - S(5)
+        assert law.pressure(1.08e-9) / law.pressure_value == pytest.approx(
+            1 / (1 + math.exp(-5)), rel=1e-12)
+
+
+@pytest.mark.parametrize("rho", [31.3, 100.0, 179.0])
+def test_gw_laws_equal_eqs_23_24_by_quadrature(rho):
+    """The laws the solver uses (closed-form parabolic-cylinder integrals) against eqs 23-24
+    integrated over the corrected eq 26 density by adaptive quadrature (measured <= 2e-12)."""
+    r = paper1_table2_roughness(rho * 1e12)
+    E = 58.48e9
+    el, ad = GWElastic(r, E), GWAdhesion(r, 0.06)
+    for h in (0.4e-9, 0.9e-9, 1.08e-9, 1.6e-9, 2.5e-9):
+        phi = lambda z: height_density(z, r.z_m, r.sigma_a)  # noqa: E731
+        top = r.z_m + 12 * r.sigma_a
+        p_el = 4 / 3 * E * r.density * math.sqrt(r.radius) * integrate.quad(
+            lambda z: (z - h) ** 1.5 * phi(z), h, top, epsabs=0, epsrel=1e-13, limit=200)[0]
+        prob = integrate.quad(phi, h, top, epsabs=0, epsrel=1e-13, limit=200)[0]
+        p_ad = 2 * math.pi * r.radius * 0.06 * r.density * prob
+        assert -el.pressure(h) == pytest.approx(p_el, rel=1e-10)
+        assert ad.pressure(h) == pytest.approx(p_ad, rel=1e-10)

@@ -1,0 +1,294 @@
+"""Seeded-defect check: does the test suite catch small physics defects?
+
+Each defect is a small edit of the package (a factor, a sign, a term, a safeguard removed),
+applied one at a time to a scratch copy of the repository; the default test suite then runs
+on that copy (stopping at the first failure). A defect is *caught* if some test fails. The
+report names, per defect, the first test that failed and the seconds it took.
+
+    python -m tests.seeded_defects              # all defects, 2 in parallel
+    python -m tests.seeded_defects --only lj    # defects whose name contains 'lj'
+    python -m tests.seeded_defects --list
+
+Writes validation/results/seeded_defects.md. Run it before calling any change to physics
+code done: a defect that survives means a physics claim no test asserts. When code moves,
+update the file paths and snippets below (an edit that no longer applies is reported as
+"not applied", never silently skipped).
+"""
+import argparse
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+import os
+from pathlib import Path
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = Path(__file__).resolve().parents[1]
+REPORT = ROOT / "validation" / "results" / "seeded_defects.md"
+#: a whole suite run takes ~25 s here; a defect that makes a solver crawl must not hang us
+TIMEOUT_S = 600
+
+
+@dataclass(frozen=True)
+class Defect:
+    name: str
+    what: str
+    path: str
+    edits: tuple          # ((old, new), ...): each old must occur exactly once in the file
+
+
+D = Defect
+DEFECTS = [
+    # -- elastic operators
+    D("green_inside", "disk displacement inside the load +2 %", "femadh/elastic/green.py",
+      (("w[inside] = 4.0 * a[inside] / math.pi", "w[inside] = 4.08 * a[inside] / math.pi"),)),
+    D("green_outside", "disk displacement outside the load: wrong hypergeometric parameter",
+      "femadh/elastic/green.py",
+      (("special.hyp2f1(0.5, 0.5, 2.0, m_out)", "special.hyp2f1(0.5, 0.5, 2.5, m_out)"),)),
+    D("fe_hoop_strain", "FE weak form: hoop strain u_r/(2r)", "femadh/elastic/fe.py",
+      (("return g[0, 0], g[1, 1], u[0] / r,", "return g[0, 0], g[1, 1], u[0] / (2 * r),"),)),
+    D("fe_shear_term", "FE weak form: shear term counted once", "femadh/elastic/fe.py",
+      (("+ 2 * s[3] * ev[3])", "+ s[3] * ev[3])"),)),
+    D("fe_far_field", "Boussinesq far field: (1 - nu) instead of 2 (1 - nu)",
+      "femadh/elastic/fe.py",
+      (("u_z = c * (zeta**2 / rho**3 + 2 * (1 - nu) / rho)",
+        "u_z = c * (zeta**2 / rho**3 + (1 - nu) / rho)"),)),
+    D("fe_lame", "Lame lambda with (1 - nu) for (1 + nu)", "femadh/elastic/fe.py",
+      (("lam = self.youngs * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))",
+        "lam = self.youngs * self.nu / ((1 - self.nu) * (1 - 2 * self.nu))"),)),
+    D("fe_load_shape", "FE load vector: mid-side shape function 10 % heavy",
+      "femadh/elastic/fe.py",
+      (("s * (2 * s - 1), 4 * s * (1 - s)])", "s * (2 * s - 1), 4.4 * s * (1 - s)])"),)),
+    D("grid_areas", "annulus areas without pi", "femadh/elastic/grid.py",
+      (("return math.pi * (e[1:] ** 2 - e[:-1] ** 2)", "return 3.0 * (e[1:] ** 2 - e[:-1] ** 2)"),)),
+    D("composite_modulus", "eq 2: second body counted half", "femadh/materials.py",
+      (("inv += 1.0 / m2.plane_strain_modulus", "inv += 0.5 / m2.plane_strain_modulus"),)),
+    D("plane_strain_modulus", "E/(1 - nu) instead of E/(1 - nu^2)", "femadh/materials.py",
+      (("return self.youngs_modulus / (1.0 - self.poisson_ratio**2)",
+        "return self.youngs_modulus / (1.0 - self.poisson_ratio)"),)),
+    D("sphere_profile", "exact sphere profile replaced by R - sqrt(R^2 - r^2/2)",
+      "femadh/indenter.py",
+      (("return r * r / (R + np.sqrt(R * R - r * r))",
+        "return 0.5 * r * r / (R + np.sqrt(R * R - 0.5 * r * r))"),)),
+    # -- pressure laws
+    D("lj_pressure", "eq 3: repulsive term 10 % weak", "femadh/effects/lj.py",
+      (("return self.hamaker / (6.0 * math.pi * h**3) * (1.0 - s)",
+        "return self.hamaker / (6.0 * math.pi * h**3) * (1.0 - 0.9 * s)"),)),
+    D("lj_dpressure", "eq 3 derivative: 2.5 for 3 in the repulsive term", "femadh/effects/lj.py",
+      (("(1.0 - 3.0 * s)", "(1.0 - 2.5 * s)"),)),
+    D("lj_energy", "LJ energy: 0.3 for 1/4 in the repulsive term", "femadh/effects/lj.py",
+      (("(1.0 - 0.25 * s)", "(1.0 - 0.3 * s)"),)),
+    D("lj_consistent_scale", "whole LJ law (value, derivative, energy) 10 % weak",
+      "femadh/effects/lj.py",
+      (("self.hamaker / (6.0 * math.pi * h**3)", "self.hamaker / (6.6 * math.pi * h**3)"),
+       ("-self.hamaker / (2.0 * math.pi * h**4)", "-self.hamaker / (2.2 * math.pi * h**4)"),
+       ("-self.hamaker / (12.0 * math.pi * h**2)", "-self.hamaker / (13.2 * math.pi * h**2)"))),
+    D("step_derivative", "smoothed step law: derivative 10 % steep", "femadh/effects/step.py",
+      (("return -self._amplitude / self.width * s * (1 - s)",
+        "return -1.1 * self._amplitude / self.width * s * (1 - s)"),)),
+    D("capillary_one_film", "capillary filled gap counts one adsorbed film, not two",
+      "femadh/effects/capillary.py",
+      (("return 2 * abs(self.kelvin_radius) + 2 * self.film",
+        "return 2 * abs(self.kelvin_radius) + self.film"),)),
+    D("capillary_laplace", "Laplace pressure 2 gamma / |r_K|", "femadh/effects/capillary.py",
+      (("return self.surface_tension / abs(self.kelvin_radius)",
+        "return 2 * self.surface_tension / abs(self.kelvin_radius)"),)),
+    D("eq20_asperity_adhesion", "eq 20: pi R_a instead of 2 pi R_a",
+      "femadh/effects/asperity.py",
+      (("p = 2 * math.pi * asperity_radius * surface_energy * density * probability",
+        "p = math.pi * asperity_radius * surface_energy * density * probability"),)),
+    D("gw_elastic", "GW elastic asperity law (eq 23) 10 % strong", "femadh/effects/asperity.py",
+      (("return 4.0 / 3.0 * self.e_star * r.density * math.sqrt(r.radius)",
+        "return 4.4 / 3.0 * self.e_star * r.density * math.sqrt(r.radius)"),)),
+    D("gw_adhesion_derivative", "GW adhesion derivative: 2 pi for sqrt(2 pi)",
+      "femadh/effects/asperity.py",
+      (("/ (math.sqrt(2 * math.pi) * r.sigma_a)", "/ (2 * math.pi * r.sigma_a)"),)),
+    D("gw_integral", "GW integrals: Gamma(n + 1.1)", "femadh/reference/gw.py",
+      (("out = special.gamma(n + 1.0) *", "out = special.gamma(n + 1.1) *"),)),
+    # -- contact
+    D("active_set_never_releases", "active-set rule never releases a contact node",
+      "femadh/contact/newton.py",
+      (("new_A = (A & (pc > 0)) | (I & (h < sigma))", "new_A = A | (I & (h < sigma))"),)),
+    D("stability_constant", "stability decision replaced by True", "femadh/contact/stability.py",
+      (("    return is_positive_definite(H)\n", "    return True\n"),)),
+    D("closure_hertz", "the paper's closure: Hertz pressure 10 % high",
+      "femadh/reference/hertz.py",
+      (("return 4.0 * e_star / (3.0 * radius) * (g[:-1] - g[1:])",
+        "return 4.4 * e_star / (3.0 * radius) * (g[:-1] - g[1:])"),)),
+    D("fold_resolution", "continuation: folds located to 1/8 of a step, not 1/1024",
+      "femadh/contact/continuation.py",
+      (("MIN_STEP_FRACTION = 2.0**-10", "MIN_STEP_FRACTION = 2.0**-3"),)),
+    D("correction_guard", "continuation: a converged jump accepted as a step",
+      "femadh/contact/continuation.py",
+      (("MAX_CORRECTION_FRACTION = 0.25", "MAX_CORRECTION_FRACTION = 1e6"),)),
+    D("arclength_fold_parity", "arclength: stability not flipped at a fold",
+      "femadh/contact/arclength.py",
+      (("stable = p.stable != folded", "stable = p.stable"),)),
+    D("arclength_tangent_turn", "arclength: no limit on the tangent's turn per step",
+      "femadh/contact/arclength.py",
+      (("MIN_TANGENT_COS = math.cos(math.radians(30.0))",
+        "MIN_TANGENT_COS = math.cos(math.radians(89.0))"),)),
+    D("force_contact", "contact force integrated 10 % low", "femadh/output.py",
+      (("f_el = g.force(state.p_contact)", "f_el = 0.9 * g.force(state.p_contact)"),)),
+    D("regime_tail", "regime map: LJ tail beyond the analysis radius dropped",
+      "femadh/regime.py",
+      (("tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))",
+        "tail = 0.0"),)),
+    D("hysteresis_energy", "hysteresis: half the energy released at a jump", "femadh/regime.py",
+      (("released += problem.energy(w1, d1) - problem.energy(w2, d1)",
+        "released += 0.5 * (problem.energy(w1, d1) - problem.energy(w2, d1))"),)),
+    # -- references (the judges)
+    D("maugis_load", "Maugis-Dugdale load: m atan s for m^2 atan s",
+      "femadh/reference/maugis.py",
+      (("P = A**3 - lam * A * A * (s + m * m * at)", "P = A**3 - lam * A * A * (s + m * at)"),)),
+    D("maugis_lambda", "LJ -> Dugdale lambda with sqrt 2 for sqrt 3",
+      "femadh/reference/maugis.py",
+      (("sigma0_factor = 16.0 / (9.0 * math.sqrt(3.0))",
+        "sigma0_factor = 16.0 / (9.0 * math.sqrt(2.0))"),)),
+    D("eq17_surface_energy", "eq 17: z0^6 / (3 s^6) for z0^6 / (4 s^6)",
+      "femadh/reference/adhesion.py",
+      (("(1.0 - z0**6 / (4.0 * spacing**6))", "(1.0 - z0**6 / (3.0 * spacing**6))"),)),
+    D("jkr_radius", "JKR contact radius: 3R/(2E*) for 3R/(4E*)",
+      "femadh/reference/adhesion.py",
+      (("return (3.0 * radius / (4.0 * e_star) * (load + q + math.sqrt(disc)))",
+        "return (3.0 * radius / (2.0 * e_star) * (load + q + math.sqrt(disc)))"),)),
+    # -- meniscus (paper 2)
+    D("kelvin_log10", "Kelvin radius with log10 for ln", "femadh/meniscus/kelvin.py",
+      (("(R_GAS * temperature * math.log(p_ratio))", "(R_GAS * temperature * math.log10(p_ratio))"),)),
+    D("meniscus_normalisation", "meniscus force normalised by R + h instead of R",
+      "femadh/meniscus/solve.py",
+      (("F0 = 4 * math.pi * radius * gamma", "F0 = 4 * math.pi * (radius + h) * gamma"),)),
+    D("meniscus_contact_geometry", "meniscus in contact at D = -h instead of -2h",
+      "femadh/meniscus/solve.py",
+      (("geo = Geometry(Re / r_k, (s - 2 * h) / Re)", "geo = Geometry(Re / r_k, (s - h) / Re)"),)),
+    D("meniscus_first_integral", "first integral without the 1/2", "femadh/meniscus/geometry.py",
+      (("return r * math.sin(psi) - 0.5 * kappa * r * r", "return r * math.sin(psi) - kappa * r * r"),)),
+    D("meniscus_fe_curvature", "FE meridian: azimuthal curvature 10 % weak",
+      "femadh/meniscus/profile_fe.py",
+      (("f_psi = geo.kappa - sp / rq", "f_psi = geo.kappa - 0.9 * sp / rq"),)),
+    D("circular_force", "circular approximation: kappa sin^2 instead of kappa sin^2 / 2",
+      "femadh/meniscus/circular.py",
+      (("return s2 - 0.5 * geo.kappa * s2", "return s2 - geo.kappa * s2"),)),
+    D("gab_isotherm", "GAB isotherm: (1 + c k x) for (1 - k x + c k x)",
+      "femadh/meniscus/isotherms.py",
+      (("return self.monolayer * self.c * kx / ((1 - kx) * (1 - kx + self.c * kx))",
+        "return self.monolayer * self.c * kx / ((1 - kx) * (1 + self.c * kx))"),)),
+]
+
+
+def _copy_repo(dst):
+    for name in ("femadh", "tests", "validation", "meshes"):
+        shutil.copytree(ROOT / name, dst / name,
+                        ignore=shutil.ignore_patterns("__pycache__", "results", "*.png"))
+    (dst / "validation" / "results").mkdir(exist_ok=True)
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, dst / name)
+
+
+def _apply(root, defect):
+    path = root / defect.path
+    text = path.read_text()
+    for old, new in defect.edits:
+        if text.count(old) != 1:
+            return None, f"not applied: {old[:50]!r} occurs {text.count(old)} times"
+        text = text.replace(old, new)
+    original = path.read_text()
+    path.write_text(text)
+    return original, None
+
+
+def _first_failure(output):
+    m = re.search(r"^(?:FAILED|ERROR) (\S+)", output, re.M)
+    if m:
+        return m.group(1)
+    m = re.search(r"^_+ (?:ERROR collecting )?(\S+) _+$", output, re.M)
+    return m.group(1) if m else None
+
+
+def run_one(defect, root):
+    original, problem = _apply(root, defect)
+    if problem:
+        return {"defect": defect, "caught": None, "test": problem, "seconds": 0.0}
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+                              "-W", "ignore"], cwd=root, env=env, capture_output=True,
+                             text=True, timeout=TIMEOUT_S)
+        text, code = out.stdout + out.stderr, out.returncode
+    except subprocess.TimeoutExpired:
+        text, code = "", "timeout"
+    dt = time.perf_counter() - t0
+    (root / defect.path).write_text(original)
+    if code == "timeout":
+        return {"defect": defect, "caught": False, "test": f"suite hung > {TIMEOUT_S} s",
+                "seconds": dt}
+    caught = code != 0
+    return {"defect": defect, "caught": caught,
+            "test": (_first_failure(text) or f"exit {code}") if caught else "(suite passed)",
+            "seconds": dt}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", help="run the defects whose name contains this")
+    ap.add_argument("--jobs", type=int, default=2, help="suites in parallel (default 2)")
+    ap.add_argument("--list", action="store_true", help="list the defects and exit")
+    ap.add_argument("--no-report", action="store_true", help="do not write the report")
+    args = ap.parse_args(argv)
+    todo = [d for d in DEFECTS if not args.only or args.only in d.name]
+    if args.list:
+        for d in todo:
+            print(f"{d.name:28s} {d.path:34s} {d.what}")
+        return 0
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        roots = []
+        for k in range(max(1, args.jobs)):
+            r = Path(tmp) / f"copy{k}"
+            r.mkdir()
+            _copy_repo(r)
+            roots.append(r)
+        # one scratch copy per worker; each defect is applied and reverted on its worker's copy
+        free = list(roots)
+        import threading
+        lock = threading.Lock()
+
+        def job(defect):
+            with lock:
+                root = free.pop()
+            try:
+                res = run_one(defect, root)
+            finally:
+                with lock:
+                    free.append(root)
+            mark = {True: "caught", False: "MISSED", None: "NOT APPLIED"}[res["caught"]]
+            print(f"{mark:11s} {defect.name:28s} {res['seconds']:6.1f} s  {res['test']}",
+                  flush=True)
+            return res
+
+        with ThreadPoolExecutor(max_workers=len(roots)) as ex:
+            results = list(ex.map(job, todo))
+    wall = time.perf_counter() - t0
+    caught = sum(r["caught"] is True for r in results)
+    print(f"{caught}/{len(results)} defects caught in {wall:.0f} s")
+    if not args.no_report and not args.only:
+        lines = ["# Seeded defects (tests/seeded_defects.py)", "",
+                 f"{caught} of {len(results)} defects caught; {wall:.0f} s with {args.jobs} "
+                 "suites in parallel. Each row: one small edit of the package, the first "
+                 "test that failed on it (pytest -x), and the seconds until then.", "",
+                 "| defect | what | file | first failing test | s |", "|---|---|---|---|---|"]
+        for r in results:
+            d = r["defect"]
+            test = r["test"] if r["caught"] else f"**{r['test']}**"
+            lines.append(f"| {d.name} | {d.what} | `{d.path}` | {test} | {r['seconds']:.1f} |")
+        REPORT.write_text("\n".join(lines) + "\n")
+        print(f"report: {REPORT}")
+    return 0 if caught == len(results) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
