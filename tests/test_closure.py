@@ -264,8 +264,8 @@ def test_no_stable_state_error_shows_the_scan():
 # --------------------------------------------------------------------------- eq 20
 
 def test_asperity_adhesion_acts_over_the_contact_only():
-    """Eq 20 in the closure: the constant P_LJa on r < r_c (force P_LJa pi r_c^2 exactly), and
-    it raises the adhesion (sec 6, rho = 179 um^-2, sigma = 1.08 nm)."""
+    """Eq 20 in the closure: the constant P_LJa on r < r_c (force P_LJa pi r_c^2 exactly); it
+    makes touch-down a snap and raises the adhesion (sec 6, rho = 179 um^-2, sigma = 1.08 nm)."""
     sigma = 1.08e-9
     ad = AsperityAdhesion.from_asperities(0.94e-6, 0.06, 179e12, 0.5, sigma)
     p0 = problem(100, sigma)
@@ -279,6 +279,11 @@ def test_asperity_adhesion_acts_over_the_contact_only():
         assert F_a == pytest.approx(ad.pressure_value * math.pi * s.r_c**2, rel=2e-15, abs=0)
     f0 = max(state_forces(p0, s)[2] for s in s0.states)
     f1 = max(state_forces(p1, s)[2] for s in s1.states)
+    # eq 20's pull grows with the contact (P_LJa D(r_c, r_c) ~ r_c): touch-down is a fold and
+    # the surface snaps into a finite contact there (N = 200: at 1.2465 nm, to 1.437 um)
+    (jump,) = s1.jumps
+    assert jump.before.r_c == 0 and jump.after.r_c > 1e-6
+    assert not s0.jumps
     # measured on this 0.2-nm grid: 0.02682 (no eq 20) and 0.16121 mN (N = 200: 0.16124)
     assert f0 == pytest.approx(0.02682e-3, rel=2e-3)
     assert f1 == pytest.approx(0.16121e-3, rel=2e-3)

@@ -1045,6 +1045,30 @@ def trace_closure(problem, d_values, *, branch, tol, start=None, max_iter=40, on
     return sweep
 
 
+def _onset_is_stable(cs, free, tol, max_iter):
+    """Is the contact branch stable where it leaves the free surface ``free``?
+
+    Solves the closure at the smallest contact (half a node spacing) for (w, d) from the free
+    state and tests the stability rule there. Stable: the contact grows continuously from
+    touch-down (sigma = 1 nm). Unstable: d*(r_c) first rises with r_c (e.g. eq 20's pull over
+    the contact), so touch-down is a fold and entering or leaving contact is a snap.
+    """
+    res = _newton_contact(cs, free.d, free.w, 0.5 * cs.nodes[1], border="d", tol=tol,
+                          max_iter=max_iter * ENTRY_BUDGET)
+    if not res.ok:
+        return False
+    lu = linalg.lu_factor(cs.add_jacobian(res.ev).jacobian("r_c"), check_finite=False)
+    return _lu_sign(lu) < 0
+
+
+def _continuous_transition(cs, old, new, tol, max_iter):
+    """A step between the free surface and contact is continuous only if the contact branch
+    is stable at its onset (checked on the free state of the two); other steps pass."""
+    if (old.r_c > 0) == (new.r_c > 0):
+        return True
+    return _onset_is_stable(cs, old if old.r_c == 0 else new, tol, max_iter)
+
+
 def _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter):
     """Step from state to d_next with halving; folds -> land_closure."""
     grid_step = d_next - state.d
@@ -1066,7 +1090,8 @@ def _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter):
         new = solve_closure_state(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
                                   r_c0=r_pred, system=cs)
         sweep.n_solves += 1
-        if new.converged and new.stable and _close_to_prediction(cs, new, w_pred, r_pred):
+        if (new.converged and new.stable and _close_to_prediction(cs, new, w_pred, r_pred)
+                and _continuous_transition(cs, state, new, tol, max_iter)):
             state = new
             step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
             continue
