@@ -57,7 +57,9 @@ moves on the snap (growing on approach, shrinking on retract). The surface lands
 *stable* state at that d met by the scan: on approach the stable state with the smallest r_c
 above the departing one, on retract the one with the largest r_c below it, or the free
 (r_c = 0) state when the scan reaches r_c -> 0 first. With no such state a ConvergenceError
-gives the scanned range of d(r_c).
+gives the scanned range of d(r_c). A step between the free surface and contact is accepted as
+continuous only if the contact branch is stable at its onset (half a node spacing); otherwise
+touch-down is itself a fold (eq 20's pull grows with r_c) and the same landing applies.
 
 For an operator with no influence function at arbitrary radii (FE), :class:`InterpolatedInfluence`
 interpolates the disk influences between the node/edge radii (first order in the edge position);
