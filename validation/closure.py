@@ -8,7 +8,6 @@ complementarity model runs through :func:`femadh.runner.run` on the bundled scen
 the statements of its text (sec 4-6); its figures are not in the text we have.
 """
 import argparse
-import copy
 import math
 from pathlib import Path
 import time

@@ -73,7 +73,7 @@ import numpy as np
 from scipy import linalg, special
 
 from ..effects.asperity import AsperityAdhesion
-from ..elastic.green import GreenOperator, disk_displacement
+from ..elastic.green import GreenOperator
 from ..errors import ConvergenceError
 from ..reference.hertz import (hertz_annulus_force, hertz_annulus_force_drc,
                                hertz_displacement)
