@@ -6,7 +6,7 @@ Python API::
     scene = femadh.load_scene("validation/scenes/paper1_fig3.toml")
     result = femadh.run(scene)          # RunResult: sweeps, jumps, curves, status
 """
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: F401  (the package version, femadh.__version__)
 
 
 def load_scene(path):
@@ -17,5 +17,5 @@ def load_scene(path):
 
 def run(scene, out_dir=None, **kwargs):
     """Solve a scene; see :func:`femadh.runner.run`."""
-    from .runner import run as _run
+    from .runner.contact import run as _run
     return _run(scene, out_dir, **kwargs)

@@ -56,8 +56,8 @@ def _regime(args):
     import numpy as np
 
     from .errors import SceneError
-    from .regime import regime_map, write_regime
-    from .studies import default_progress
+    from .studies.convergence import default_progress
+    from .studies.regime import regime_map, write_regime
     from .units import to_si
 
     lo, hi = args.mu
@@ -86,7 +86,7 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     if args.command == "regime":
         return _regime(args)
-    from .runner import run
+    from .runner.contact import run
     from .scene import load_scene
 
     try:
@@ -103,7 +103,7 @@ def main(argv=None):
         if args.command == "mesh":
             return _mesh(scene, args.out)
         if args.command == "study":
-            from .studies import convergence, default_progress, write_convergence
+            from .studies.convergence import convergence, default_progress, write_convergence
 
             if not 1 <= args.levels <= 4:
                 print("femadh: error: --levels must be 1 to 4", file=sys.stderr)
@@ -140,7 +140,7 @@ def main(argv=None):
 
 
 def _run_meniscus(scene, args):
-    from .meniscus.run import run_meniscus
+    from .runner.meniscus import run_meniscus
 
     results, errors, wall = run_meniscus(scene, args.out, figures=not args.no_figures)
     if not args.quiet:
@@ -167,13 +167,12 @@ def _mesh(scene, out):
     import meshio
 
     from .elastic import RadialGrid
-    from .elastic.fe import FESettings
-    from .elastic.mesh import MeshSpec, cached_mesh, read_mesh, surface_points_of
+    from .elastic.fe import FESettings, mesh_spec
+    from .elastic.fe.mesh import cached_mesh, read_mesh
 
     st = scene.fe_settings or FESettings()
     grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
-    spec = MeshSpec(surface_points_of(grid), st.outer_factor * grid.radius, st.growth,
-                    st.surface_fraction * float(grid.nodes[1]))
+    spec = mesh_spec(grid, st)
     src = cached_mesh(spec, progress=lambda m: print(m, file=sys.stderr))
     out = Path(out or scene.output_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -11,8 +11,8 @@ from pathlib import Path
 import meshio
 
 from femadh.elastic import RadialGrid
-from femadh.elastic.mesh import MeshSpec, build_mesh, surface_points_of
-from femadh.studies import FE_LEVELS
+from femadh.elastic.fe.mesh import MeshSpec, build_mesh, surface_points_of
+from femadh.studies.convergence import FE_LEVELS
 
 HERE = Path(__file__).resolve().parent
 

@@ -1,13 +1,12 @@
 """Pseudo-arclength continuation through folds (femadh.contact.arclength) on a smooth LJ sphere."""
-import math
 
 import numpy as np
 import pytest
 
 from femadh.contact import trace
 from femadh.contact.arclength import trace_curve
-from femadh.contact.continuation import land
-from femadh.regime import _lj_problem
+from femadh.contact.landing import land
+from femadh.studies.regime import _lj_problem
 
 from conftest import check_curve_against_fields
 
@@ -83,7 +82,7 @@ def test_hysteresis_energy_identity(monkeypatch):
     and landing states, which do not depend on the continuation's steps) = loop integral of
     F dd (trapezoid along the paths), which converges to it as the steps shrink."""
     import femadh.contact.arclength as al
-    from femadh.regime import lj_sphere
+    from femadh.studies.regime import lj_sphere
 
     runs = []
     for target, ds_max in ((0.05, 0.5), (0.0125, 0.125)):   # steps ~4x shorter everywhere
@@ -101,7 +100,8 @@ def test_hysteresis_energy_identity(monkeypatch):
 
 def test_gap_constrained_problem_is_refused():
     from femadh.contact import ContactProblem
-    from femadh.effects import AsperityGap, LennardJones
+    from femadh.contact import AsperityGap
+    from femadh.laws import LennardJones
     from femadh.elastic import GreenOperator, RadialGrid
     from femadh.indenter import Sphere
 

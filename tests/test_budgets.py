@@ -8,11 +8,12 @@ import pytest
 
 from femadh.contact import ContactProblem, trace
 from femadh.contact.arclength import trace_curve
-from femadh.effects import AsperityGap, LennardJones
+from femadh.contact import AsperityGap
+from femadh.laws import LennardJones
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.errors import ConvergenceError, LawError
 from femadh.indenter import Sphere
-from femadh.regime import _lj_problem
+from femadh.studies.regime import _lj_problem
 
 from conftest import E_STAR, HAMAKER, Z0
 

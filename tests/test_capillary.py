@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from femadh.contact import ContactProblem, trace
-from femadh.effects import AsperityGap, CapillaryCondensate
+from femadh.contact import AsperityGap
+from femadh.laws import CapillaryCondensate
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.indenter import Sphere
 

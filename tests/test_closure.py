@@ -10,13 +10,14 @@ import math
 import numpy as np
 import pytest
 
-from femadh.contact import ContactProblem
+from femadh.contact import AsperityGap, ContactProblem
 from femadh.contact import closure as cl
-from femadh.effects import AsperityAdhesion, AsperityGap, LennardJones
+from femadh.contact.closure import trace as cl_trace
+from femadh.laws import AsperityAdhesion, LennardJones
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.errors import ConvergenceError
 from femadh.indenter import Sphere
-from femadh.output import state_forces
+from femadh.contact.forces import state_forces
 from femadh.reference import hertz_load
 
 from conftest import E_STAR, HAMAKER, Z0
@@ -162,7 +163,7 @@ def test_sigma_half_nm_snap_in_snap_out_and_hysteresis(fig4_closure):
     assert all(s.converged and s.stable for s in a.states + r.states)
     assert all(s.residual <= TOL for s in a.states + r.states)
     (jin,), (jout,) = a.jumps, r.jumps
-    res = 0.2e-9 * cl.MIN_STEP_FRACTION                 # folds located to 1.95e-4 nm
+    res = 0.2e-9 * cl_trace.MIN_STEP_FRACTION                 # folds located to 1.95e-4 nm
     assert jin.resolution == pytest.approx(res) and jout.resolution == pytest.approx(res)
     # snap-in: the free surface's fold (the same as the complementarity model's, 1.1098 nm)
     assert jin.before.r_c == 0 and jin.after.r_c > 0
@@ -204,7 +205,7 @@ def test_stability_rule_flips_at_the_fold():
     cs = cl.ClosureSystem(p)
     free = cl.solve_closure_state(p, 1.2e-9, np.zeros(100), tol=TOL, system=cs)
     assert free.r_c == 0 and free.stable
-    pts, _, crossings = cl._scan_branch(cs, free.w, free.d, 0.5 * cs.nodes[1], +1, 1.2e-9,
+    pts, _, crossings = cl_trace._scan_branch(cs, free.w, free.d, 0.5 * cs.nodes[1], +1, 1.2e-9,
                                         tol=TOL, max_iter=40, stop_at_first=False,
                                         r_to=3e-6)
     assert [s for _, s in crossings] == [False, True]

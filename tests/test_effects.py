@@ -4,7 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from femadh.effects import AsperityGap, LennardJones
+from femadh.contact import AsperityGap
+from femadh.laws import LennardJones
 
 from conftest import HAMAKER, Z0
 

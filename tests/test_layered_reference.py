@@ -84,11 +84,13 @@ def test_stack_of_the_substrate_material_is_the_half_space(layers):
     # in k: measured <= 1.3e-15 relative for k t = 1e-8 ... 1e4
     assert np.max(np.abs(s.compliance_k(k) * k * e_star / 2 - 1)) < 1e-14
     r = np.array([0.0, 0.3, 0.999, 1.0, 1.001, 2.0, 50.0]) * A
-    # measured 0 (the remainder is below cutoff_tol everywhere); the brief asks 1e-10
-    assert rel_max(s.disk_displacement(r, A, P), disk_displacement(r, A, e_star, P)) < 1e-14
+    # the remainder is below cutoff_tol everywhere; what is left is the judge's E, K form
+    # (which cancels outside: 1.6e-13 at r = 50 a) against the Green operator's 2F1 form:
+    # measured 1.1e-14 on the 40-node grid
+    assert rel_max(s.disk_displacement(r, A, P), disk_displacement(r, A, e_star, P)) < 1e-12
     g = RadialGrid.uniform(2 * A, 40)
     assert rel_max(s.annulus_compliance(g.nodes, g.edges),
-                   GreenOperator(g, e_star).compliance) < 1e-14
+                   GreenOperator(g, e_star).compliance) < 1e-13
 
 
 def test_two_equal_layers_equal_one_layer_of_summed_thickness():

@@ -137,7 +137,7 @@ def test_meniscus_scene_runs_and_writes(tmp_path):
     import pyvista as pv
 
     import femadh
-    from femadh.meniscus.run import HEADER
+    from femadh.runner.meniscus import HEADER
 
     sc = femadh.load_scene("validation/scenes/paper2_ethanol_100nm.toml")
     results, errors, _ = femadh.run(sc, str(tmp_path))

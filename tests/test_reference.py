@@ -71,7 +71,7 @@ def test_jkr_identities():
 def test_surface_energy_relations_eqs_17_19():
     """Eq 17 is the LJ energy per area (eq 3 integrated from s to infinity): it equals the
     law's own energy -U(s) at any spacing; eq 19 is its value at s = z0."""
-    from femadh.effects import LennardJones
+    from femadh.laws import LennardJones
 
     A, z0 = 1e-19, 0.165e-9
     lj = LennardJones(A, z0)

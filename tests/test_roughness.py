@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from femadh.effects import AsperityAdhesion, GWAdhesion, GWElastic
+from femadh.laws import AsperityAdhesion, GWAdhesion, GWElastic
 from conftest import check_curve_against_fields
-from femadh.reference.gw import (gw_integral, height_density, mean_plane_dominance_bound,
+from femadh.laws import gw_integral
+from femadh.reference.gw import (height_density, mean_plane_dominance_bound,
                                  paper1_table2_roughness)
 
 
@@ -72,7 +73,7 @@ def test_regime_map_limits_and_hysteresis():
     at larger mu the curve folds (jump-in on approach, jump-out later on retract), the loop
     widens and the pull-off falls towards JKR's 1.5, ever closer to Maugis-Dugdale at
     lambda = 1.16 mu; no traced state lets a node snap on its own."""
-    from femadh.regime import lj_sphere
+    from femadh.studies.regime import lj_sphere
 
     lo = lj_sphere(0.1)
     assert lo.jump_in is None and lo.jump_out is None and lo.n_folds == 0
@@ -114,7 +115,7 @@ def test_regime_force_of_the_undeformed_surface_is_eq14_untruncated():
     eq 14 on the whole plane; the grid's midpoint rule costs at most 1.5e-4 here (measured),
     while the tail alone is 0.3-11 % of it at d = z0 ... 10 z0."""
     from femadh.reference.rigid_lj import rigid_sphere_lj_force
-    from femadh.regime import _lj_problem, lj_force
+    from femadh.studies.regime import _lj_problem, lj_force
 
     R, A, z0 = 1e-6, 1e-19, 0.165e-9
     problem, lj, *_ = _lj_problem(1.0, R, A, z0, 0.4, 120)
@@ -128,7 +129,7 @@ def test_a_narrow_loop_near_the_cusp_is_not_stepped_over():
     continuation's steps (jump-in/out 2.2657/2.2684 z0 at mu = 0.72): the trace must resolve
     its two folds (it halves a step whose tangent turns by more than 30 degrees), as finer
     steps do."""
-    from femadh.regime import lj_sphere
+    from femadh.studies.regime import lj_sphere
 
     p = lj_sphere(0.72, ds_max=0.5)
     fine = lj_sphere(0.72, ds_max=0.1)

@@ -7,7 +7,7 @@ import pytest
 import femadh
 from femadh.cli import main
 from femadh.errors import SceneError
-from femadh.output import CURVE_HEADER, read_curve
+from femadh.io.writers import CURVE_HEADER, read_curve
 
 from conftest import check_curve_against_fields
 

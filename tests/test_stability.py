@@ -4,19 +4,17 @@ The regression case of the old decision (signs of LU pivots over the matrix diag
 node whose own diagonal turns negative (LJ softening above the node's stiffness, the lattice-
 trapping regime) makes pivot and diagonal both negative, so a saddle read as stable.
 """
-import math
 
 import numpy as np
 import pytest
 
 from femadh.contact import ContactProblem
 from femadh.contact.arclength import trace_curve
-from femadh.contact.newton import solve_state
+from femadh.contact import solve_state
 from femadh.contact.stability import is_stable
-from femadh.effects import LennardJones
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.indenter import Sphere
-from femadh.regime import _lj_problem
+from femadh.studies.regime import _lj_problem
 
 from conftest import HAMAKER, Z0
 

@@ -2,7 +2,7 @@
 import numpy as np
 
 from femadh.reference import max_rigid_lj_force
-from femadh.runner import run
+from femadh.runner.contact import run
 from validation.paper1 import measure, scene
 
 from conftest import HAMAKER, Z0
@@ -37,9 +37,9 @@ def test_fig6_external_force_hardly_depends_on_sigma_below_z0(tmp_path):
 
 
 def test_closure_breaks_eq10_inside_while_complementarity_keeps_both(tmp_path):
-    """The two contact models at sigma = 1 nm: complementarity satisfies eq 8 and eq 10
-    everywhere; the paper's Hertz closure satisfies eq 8 (clamped) but violates eq 10 inside the
-    contact by a sizeable fraction of sigma."""
+    """The two contact models at sigma = 1 nm, down to d = -5 nm: complementarity satisfies
+    eq 8 and eq 10 everywhere; the paper's Hertz closure satisfies eq 8 (clamped) and eq 10
+    outside, but violates eq 10 inside the contact by a sizeable fraction of sigma."""
     rc = run(scene("paper1_fig3", 100), str(tmp_path / "c"), figures=False, progress=False)
     rh = run(scene("paper1_fig3", 100, contact_model="hertz-closure"), str(tmp_path / "h"),
              figures=False, progress=False)
@@ -49,15 +49,21 @@ def test_closure_breaks_eq10_inside_while_complementarity_keeps_both(tmp_path):
     # eq 10 recomputed from each state's pressures: the complementarity model meets it to
     # the Newton tolerance inside and outside the contact
     assert comp["eq10_residual_nm"] <= tol_nm and comp["eq10_inside_nm"] <= tol_nm
-    assert clos["eq10_residual_nm"] <= tol_nm         # the closure: outside only ...
-    assert clos["eq10_inside_nm"] > 0.05              # ... > 5 % of sigma inside (0.168 nm)
+    # the closure meets its own eq 10 outside and its edge condition to the tolerance ...
+    for s in rh.sweeps["approach"].states:
+        assert s.diagnostics.get("eq10_residual_free_m", s.residual) <= rh.scene.tolerance
+        assert s.diagnostics["edge_residual_m"] <= rh.scene.tolerance
+    # ... with the Hertz displacement in closed form: recomputed from the annulus-averaged
+    # Hertz pressure, eq 10 outside differs by that sqrt edge's discretisation (measured
+    # 1.5e-3 nm at N = 100), while inside it is violated by 19 % of sigma (measured 0.190 nm)
+    assert clos["eq10_residual_nm"] < 3e-3
+    assert clos["eq10_inside_nm"] > 0.05
     # eq 8: h >= sigma up to the round-off of b - w (eps * 1 nm = 2e-16 nm, measured -2.1e-16)
     assert comp["eq8_min_h_minus_sigma_nm"] > -2e-15
     assert clos["eq8_min_h_minus_sigma_nm"] > -2e-15
     # where both have states, F_LJ agrees to a few percent: inside the contact both carry
     # P_LJ(sigma); they differ in the contact pressure's shape and hence in r_c
     fc, fh = rc.curve("approach"), rh.curve("approach")
-    k = len(fh["d"])
-    assert k >= 20                                    # the closure gets well into contact
-    assert np.array_equal(fh["d"], fc["d"][:k])
-    assert np.max(np.abs(fh["F_LJ"] / fc["F_LJ"][:k] - 1)) < 0.035   # measured 1.8 %
+    assert rh.status == "converged"                   # the closure reaches -5 nm
+    assert np.array_equal(fh["d"], fc["d"])
+    assert np.max(np.abs(fh["F_LJ"] / fc["F_LJ"] - 1)) < 0.035   # measured 1.7 %

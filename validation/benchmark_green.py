@@ -17,7 +17,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from femadh.contact import trace  # noqa: E402
-from femadh.output import state_forces  # noqa: E402
+from femadh.contact.forces import state_forces  # noqa: E402
 from femadh.scene import build_problem  # noqa: E402
 from validation.paper1 import scene  # noqa: E402
 

@@ -16,10 +16,10 @@ import numpy as np
 
 from femadh.contact.closure import trace_closure
 from femadh.errors import ConvergenceError
-from femadh.output import state_forces
+from femadh.contact.forces import state_forces
 from femadh.reference import (max_rigid_lj_force, surface_energy_from_hamaker,
                               tabor_parameter)
-from femadh.runner import run
+from femadh.runner.contact import run
 from femadh.scene import build_problem
 
 from .paper1 import scene

@@ -16,10 +16,10 @@ import numpy as np  # noqa: E402
 from femadh.contact import trace  # noqa: E402
 from femadh.elastic import RadialGrid, disk_displacement  # noqa: E402
 from femadh.elastic.fe import FEOperator, FESettings  # noqa: E402
-from femadh.output import state_forces  # noqa: E402
-from femadh.runner import run  # noqa: E402
+from femadh.contact.forces import state_forces  # noqa: E402
+from femadh.runner.contact import run  # noqa: E402
 from femadh.scene import build_problem  # noqa: E402
-from femadh.studies import convergence, write_convergence  # noqa: E402
+from femadh.studies.convergence import convergence, write_convergence  # noqa: E402
 from validation.paper1 import scene  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"

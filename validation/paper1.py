@@ -18,7 +18,7 @@ except ModuleNotFoundError:
 
 from femadh.reference import (contact_lj_force_estimate, max_rigid_lj_force,
                               surface_energy_from_hamaker, tabor_parameter, dmt_pull_off)
-from femadh.runner import run
+from femadh.runner.contact import run
 from femadh.scene import scene_from_dict
 
 HERE = Path(__file__).resolve().parent

@@ -18,10 +18,10 @@ except ModuleNotFoundError:
     import tomli as tomllib
 
 from femadh.reference.gw import mean_plane_dominance_bound, paper1_table2_roughness
-from femadh.reference.maugis import lj_dugdale_lambda, maugis_pull_off
-from femadh.plots import regime_figures
-from femadh.regime import regime_map
-from femadh.runner import run
+from femadh.reference.maugis import lj_dugdale_lambda
+from femadh.io.plots import regime_figures
+from femadh.studies.regime import regime_map
+from femadh.runner.contact import run
 from femadh.scene import scene_from_dict
 
 HERE = Path(__file__).resolve().parent
@@ -166,7 +166,7 @@ def fig8():
 
 def _onset(lo=0.3, hi=1.0, iters=8):
     """Smallest mu with folds (bistability), by bisection between lo (none) and hi (folds)."""
-    from femadh.regime import lj_sphere
+    from femadh.studies.regime import lj_sphere
     for _ in range(iters):
         mid = math.sqrt(lo * hi)
         if lj_sphere(mid).n_folds:
@@ -178,7 +178,7 @@ def _onset(lo=0.3, hi=1.0, iters=8):
 
 def _convergence():
     """Mesh refinement at mu = 1 (uniform grid: N) and mu = 5 (graded: stiffness target)."""
-    from femadh.regime import lj_sphere
+    from femadh.studies.regime import lj_sphere
     rows = ["| μ | grid | N | pull-off / πRΔγ | jump-in d/z0 | jump-out d/z0 | "
             "hysteresis / (πRΔγ z0) | folds | trapping ratio | s |",
             "|---|---|---|---|---|---|---|---|---|---|"]

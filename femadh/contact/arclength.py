@@ -26,15 +26,15 @@ Linear algebra: the bordered matrix changes little from step to step, so one LU 
 preconditions (right-preconditioned GMRES, dense O(N^2) mat-vecs) the solves of many steps and
 is refreshed only when GMRES slows down; most steps then cost O(N^2), not O(N^3).
 """
-from dataclasses import dataclass, field
 import math
 import time
 
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
 from scipy.sparse import linalg as sla
 
 from ..errors import ConvergenceError
+from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
 from .stability import is_positive_definite
 
 #: Newton iterations allowed per corrector
@@ -58,210 +58,6 @@ MIN_TANGENT_COS = math.cos(math.radians(30.0))
 #: trace needs a few, a fold a dozen (halving 1 -> 1e-3); more means the corrector and the
 #: tangent disagree (e.g. a law whose derivative is inconsistent with its value)
 MAX_ATTEMPTS_PER_POINT = 40
-
-
-@dataclass
-class CurvePoint:
-    """An equilibrium on the curve: separation d (m), displacements w (m), unit tangent t
-    (scaled units, t[-1] = dd/ds), Hessian positive definite (``stable``), iterations."""
-
-    d: float
-    w: np.ndarray
-    t: np.ndarray
-    stable: bool
-    n_iter: int
-    residual: float
-
-    @property
-    def t_d(self):
-        return float(self.t[-1])
-
-
-@dataclass
-class Fold:
-    """A fold of the curve between points ``index`` and ``index + 1``, at separation d (m)."""
-
-    index: int
-    d: float
-    w: np.ndarray
-    s_offset: float
-
-
-@dataclass
-class EquilibriumCurve:
-    """Points in arclength order from d_start to d_end and the folds between them."""
-
-    points: list = field(default_factory=list)
-    folds: list = field(default_factory=list)
-    n_solves: int = 0
-    n_factor: int = 0
-    n_krylov: int = 0
-    wall_time: float = 0.0
-    _tracer: object = None
-
-    @property
-    def d(self):
-        return np.array([p.d for p in self.points])
-
-    def walk(self, direction):
-        """Segments of the displacement-controlled path in visiting order.
-
-        Returns a list of ``(kind, i, j_or_t)`` items:
-        ``("run", i0, i1)`` - stable points i0..i1 (inclusive, either order) visited in turn;
-        ``("fold", k, None)`` - the k-th fold reached at the end of the previous run;
-        ``("land", a, (s_lo, s_hi))`` - the landing state, on the curve at an arclength offset
-        in [s_lo, s_hi] along point a's tangent (s_hi None: up to point a+1).
-        Raises ValueError if a fold has no stable landing on the traced curve.
-        """
-        pts, n = self.points, len(self.points)
-        fold_after = {f.index: k for k, f in enumerate(self.folds)}
-        sign = -1.0 if direction == "approach" else 1.0     # d decreases on approach
-        # runs of consecutive stable points (arc order)
-        runs, i = [], 0
-        while i < n:
-            if pts[i].stable:
-                j = i
-                while j + 1 < n and pts[j + 1].stable and j not in fold_after:
-                    j += 1
-                runs.append((i, j))
-                i = j + 1
-            else:
-                i += 1
-        if not runs:
-            raise ValueError("no stable state on the traced curve")
-        out = []
-        start = 0 if direction == "approach" else n - 1
-        run = next(r for r in runs if r[0] <= start <= r[1])
-        lo, hi, i = run[0], run[1], start
-        visited = set()
-        while True:
-            visited.add(run)
-            # direction along the run in which d moves the right way
-            step = 1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1
-            end = hi if step == 1 else lo
-            out.append(("run", i, end))
-            # what lies beyond the run's end: a fold (then jump) or the curve's end
-            k_fold = fold_after.get(end) if step == 1 else fold_after.get(end - 1)
-            if k_fold is None:
-                if end not in (0, n - 1):
-                    raise ValueError(f"stability changes at d = {pts[end].d:.6g} m without a "
-                                     "fold of the curve (a bifurcation): not handled")
-                return out
-            d_f = self.folds[k_fold].d
-            out.append(("fold", k_fold, None))
-            landing = None
-            for r in runs:
-                if r in visited:
-                    continue
-                # a stable branch's pieces: fold -> first point, point -> point, last -> fold
-                # as (from point a, arclength bracket on its tangent, next run point, step)
-                pieces = []
-                k_in, k_out = fold_after.get(r[0] - 1), fold_after.get(r[1])
-                if k_in is not None:
-                    f = self.folds[k_in]
-                    pieces.append((r[0] - 1, f.d, pts[r[0]].d, (f.s_offset, None),
-                                   r[0], r[0]))
-                for a in range(r[0], r[1]):
-                    pieces.append((a, pts[a].d, pts[a + 1].d, (0.0, None), a, a + 1))
-                if k_out is not None:
-                    f = self.folds[k_out]
-                    pieces.append((r[1], pts[r[1]].d, f.d, (0.0, f.s_offset), r[1], r[1]))
-                for a, d_lo, d_hi, bracket, first, last in pieces:
-                    da, db = d_lo - d_f, d_hi - d_f
-                    if da * db <= 0 and da != db:
-                        landing = (r, a, bracket, first, last, db - da)
-                        break
-                if landing:
-                    break
-            if landing is None:
-                raise ValueError(f"the fold at d = {d_f:.6g} m has no stable landing on the "
-                                 "traced curve (trace further, or the curve has an isola)")
-            run, a, bracket, first, last, dd = landing
-            out.append(("land", a, bracket))
-            # continue from the landing toward the travel direction
-            if sign * dd > 0:
-                lo, hi, i = last, run[1], last
-            else:
-                lo, hi, i = run[0], first, first
-
-    def _dist(self, p, q):
-        tr = self._tracer
-        dx = (np.r_[q.w, q.d] - np.r_[p.w, p.d]) / tr.scale
-        return float(np.sqrt(tr.omega * (dx[:-1] @ dx[:-1]) + dx[-1] ** 2))
-
-    def _on_curve(self, p, off):
-        """(d, w) of the curve point at arclength offset ``off`` from point p, or None."""
-        tr = self._tracer
-        xc, _, _, ok = tr.correct(np.r_[p.w, p.d] / tr.scale + off * p.t, p.t)
-        return (xc[-1] * tr.scale, xc[:-1] * tr.scale) if ok else None
-
-    def point_at(self, i, d, bracket=(0.0, None)):
-        """The curve's state w (m) at separation d beyond point i: root of d(s) = d in the
-        arclength offset s from point i, within ``bracket`` (s_hi None: up to point i+1), on
-        which d(s) must be monotone."""
-        pts = self.points
-        a, b = pts[i], pts[i + 1]
-        s_lo, s_hi = bracket[0], self._dist(a, b) if bracket[1] is None else bracket[1]
-        known = {0.0: (a.d, a.w)}
-        if bracket[1] is None:
-            known[s_hi] = (b.d, b.w)
-
-        def at(s):
-            r = known.get(s) or self._on_curve(a, s)
-            if r is None:
-                raise ConvergenceError("a state on the traced curve could not be recomputed",
-                                       d=d, residual=math.nan, n_iter=0)
-            known[s] = r
-            return r[0] - d
-        s = _bracketed_root(at, s_lo, s_hi, xtol=1e-12 * self._dist(a, b))
-        return known[s][1] if s in known else self._on_curve(a, s)[1]
-
-    def maximize(self, i, value):
-        """Largest value(d, w) on the curve between points i-1 and i+1 (bounded search in
-        arclength; each evaluation is a corrected point). Returns (value, d, w)."""
-        pts = self.points
-        s1, s2 = self._dist(pts[i - 1], pts[i]), self._dist(pts[i], pts[i + 1])
-        best = [value(pts[i].d, pts[i].w), pts[i].d, pts[i].w]
-
-        def neg(s):
-            r = self._on_curve(*((pts[i - 1], s) if s <= s1 else (pts[i], s - s1)))
-            if r is None:
-                return -best[0]
-            v = value(*r)
-            if v > best[0]:
-                best[:] = [v, r[0], r[1]]
-            return -v
-        optimize.minimize_scalar(neg, bounds=(0.0, s1 + s2), method="bounded",
-                                 options={"xatol": 1e-7 * (s1 + s2)})
-        return tuple(best)
-
-    def branch(self, direction):
-        """The states along the displacement-controlled path, folds and landings included.
-
-        Parameters
-        ----------
-        direction : {"approach", "retract"}
-
-        Returns
-        -------
-        list of (kind, d, w)
-            In visiting order; kind is ``"point"`` (a curve point), ``"fold"`` (the last state
-            of a branch) or ``"land"`` (where it jumped to, at the same d, recomputed on the
-            curve between the two points that bracket it).
-        """
-        pts = self.points
-        out = []
-        for kind, i, j in self.walk(direction):
-            if kind == "run":
-                for k in range(i, j + (1 if j >= i else -1), 1 if j >= i else -1):
-                    out.append(("point", pts[k].d, pts[k].w))
-            elif kind == "fold":
-                f = self.folds[i]
-                out.append(("fold", f.d, f.w))
-            else:
-                d_f = out[-1][1]
-                out.append(("land", d_f, self.point_at(i, d_f, j)))
-        return out
 
 
 class _Bordered:
@@ -420,7 +216,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         check disagrees with the fold count, or the curve needs more than ``max_points``
         points; the partial curve is attached as ``.curve``.
     """
-    from .newton import solve_state
+    from .complementarity import solve_complementarity
 
     if problem.gap is not None:
         raise ValueError("arclength continuation needs a problem without the sigma-gap")
@@ -432,7 +228,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     tr = _Tracer(problem, scale, tol, curve)
     curve._tracer = tr
     w0 = np.zeros(n) if w_start is None else np.asarray(w_start, float)
-    st = solve_state(problem, d_start, w0, tol=tol, max_iter=60)
+    st = solve_complementarity(problem, d_start, w0, tol=tol, max_iter=60)
     curve.n_solves += 1
     if not st.converged:
         raise ConvergenceError("arclength start: Newton did not converge", d=d_start,
@@ -559,7 +355,7 @@ def _locate_fold(tr, p, step, index):
             known[s] = (tr.tangent(w, d, p.t)[-1], w, d)
         return known[s][0]
     try:
-        s = _bracketed_root(t_d, 0.0, step, xtol=1e-12 * step)
+        s = bracketed_root(t_d, 0.0, step, xtol=1e-12 * step)
     except _OffCurve:   # the corrector failed inside the step: the best point found so far
         s = min(known, key=lambda k: abs(known[k][0]))
     _, w, d = known[s]
@@ -568,8 +364,3 @@ def _locate_fold(tr, p, step, index):
 
 class _OffCurve(Exception):
     """The corrector did not converge at a requested arclength offset."""
-
-
-def _bracketed_root(f, lo, hi, *, xtol):
-    """Root of f in [lo, hi] with f(lo) f(hi) <= 0 (scipy's Brent method)."""
-    return optimize.brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=100)

@@ -1,7 +1,7 @@
 """The discrete sphere-flat problem: K w = P(h) - p_c with h = b(r; d) - w (paper 1 eqs 5-10).
 
 Unknowns live on the operator's radial nodes; pressures are piecewise constant on its annuli.
-Sign convention (one place, see :mod:`femadh.conventions`): w > 0 moves the disk surface up,
+Sign convention: w > 0 moves the disk surface up,
 towards the sphere; effect pressures P > 0 are attractive (pull the surface up); the contact
 pressure p_c >= 0 is repulsive.
 """
@@ -10,9 +10,9 @@ import math
 
 import numpy as np
 
-from ..effects import AsperityGap
 from ..errors import ConvergenceError
 from ..indenter import Sphere
+from .constraints import AsperityGap
 
 
 @dataclass(eq=False)
@@ -32,7 +32,7 @@ class ContactProblem:
         The sigma-gap constraint (eq 8) and its contact model; None for a smooth sphere.
     check_laws : bool
         Verify each law's derivative and energy against finite differences of its value
-        (:func:`femadh.effects.check.check_law`) before solving; a LawError names the first
+        (:func:`femadh.laws.check_law`) before solving; a LawError names the first
         inconsistency. Off only for deliberately partial laws (tests).
     """
 
@@ -45,7 +45,7 @@ class ContactProblem:
 
     def __post_init__(self):
         if self.check_laws:
-            from ..effects.check import check_law
+            from ..laws import check_law
 
             for name, law in self.effects.items():
                 check_law(name, law)
@@ -145,59 +145,3 @@ class ContactProblem:
         :meth:`surface_force_stiffness` (each node against its own stiffness, at the gap it
         actually reached). Near 1 a node can snap on its own (lattice trapping)."""
         return float(np.max(-self.dpressure(h) / np.diag(self.K)))
-
-
-@dataclass(eq=False)
-class State:
-    """A converged (or failed) equilibrium at one separation d.
-
-    Attributes
-    ----------
-    d : float
-        Separation of the sphere tip from the undeformed mean plane (m).
-    w, h : ndarray
-        Surface displacement (m, up positive) and gap h = b - w (m) at the nodes.
-    p_effects : dict[str, ndarray]
-        Each effect's pressure (Pa, attractive positive).
-    p_contact : ndarray
-        Contact (asperity elastic) pressure, repulsive positive (Pa): the complementarity
-        multiplier or the paper's Hertz closure, eq (9).
-    active : ndarray of bool
-        Nodes held at h = sigma (complementarity) or inside r_c (Hertz closure).
-    r_c : float
-        Contact radius (m): area-equivalent radius of the active set (complementarity) or the
-        closure's own r_c with h(r_c) = sigma (Hertz closure).
-    n_iter : int
-        Newton iterations of the final corrector.
-    residual : float
-        max_k |w - C (P - p_c)| (m): the residual of eq (6)/(10) itself.
-    converged, stable : bool
-        Newton met the tolerance; the state is a local energy minimum (see newton.py).
-    """
-
-    d: float
-    w: np.ndarray
-    h: np.ndarray
-    p_effects: dict
-    p_contact: np.ndarray
-    active: np.ndarray
-    r_c: float
-    n_iter: int
-    residual: float
-    converged: bool
-    stable: bool
-    lu: object = None  # factorisation of the reduced Jacobian (tangent predictor), transient
-    diagnostics: dict = field(default_factory=dict)
-
-    @property
-    def h0(self):
-        """Gap at the axis, h(0) = d - w(0) (m)."""
-        return float(self.h[0])
-
-    @property
-    def p_total(self):
-        """Net attractive surface pressure (Pa): sum of effects minus contact pressure."""
-        p = -self.p_contact.copy()
-        for v in self.p_effects.values():
-            p += v
-        return p

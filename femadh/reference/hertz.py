@@ -41,21 +41,3 @@ def hertz_displacement(r, contact_radius, p_max, e_star):
     out[o] = p_max / (2.0 * a * e_star) * ((2 * a * a - ro**2) * np.arcsin(a / ro)
                                             + a * np.sqrt(ro**2 - a * a))
     return out
-
-
-def hertz_annulus_force(edges, contact_radius, radius, e_star):
-    """Exact force (N) of the Hertz pressure (eq 9) on each annulus [e_k, e_k+1].
-
-    Integrating p_m sqrt(1 - r^2/a^2) 2 pi r dr gives (4 E*/3R) [(a^2 - r^2)_+^(3/2)] between
-    the edges; the total is the Hertz load 4 E* a^3/(3R).
-    """
-    e = np.asarray(edges, float)
-    g = np.clip(contact_radius**2 - e**2, 0.0, None) ** 1.5
-    return 4.0 * e_star / (3.0 * radius) * (g[:-1] - g[1:])
-
-
-def hertz_annulus_force_drc(edges, contact_radius, radius, e_star):
-    """d/da of :func:`hertz_annulus_force` (N/m)."""
-    e = np.asarray(edges, float)
-    g = np.sqrt(np.clip(contact_radius**2 - e**2, 0.0, None))
-    return 4.0 * e_star / radius * contact_radius * (g[:-1] - g[1:])

@@ -76,8 +76,8 @@ import math
 import numpy as np
 from scipy import special
 
-from femadh.elastic.green import disk_displacement as _half_space_disk
-from femadh.reference.hertz import hertz_displacement as _half_space_hertz
+from .disk import uniform_disk_displacement as _half_space_disk
+from .hertz import hertz_displacement as _half_space_hertz
 
 # Below this x = kh the sinh(x) - x series is used (its 12 terms are exact to round-off there).
 _SERIES_LIMIT = 1.0

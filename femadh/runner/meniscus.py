@@ -6,9 +6,9 @@ import time
 
 import numpy as np
 
-from .. import __version__
-from ..output import write_json
-from .solve import sweep
+from .._version import __version__
+from ..io.writers import write_json
+from ..meniscus.solve import sweep
 
 HEADER = ["method", "p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",
           "neck_radius_m", "liquid", "tip_radius_m"]
@@ -69,7 +69,9 @@ def run_meniscus(scene, out_dir=None, *, write=True, figures=True):
             "scene": scene.resolved, "domain_errors": errors, "timings_s": timings,
             "wall_time_s": wall})
         if figures:
-            plot_forces(scene, results, out / "meniscus_force.png")
+            from ..io.plots import meniscus_forces
+
+            meniscus_forces(scene, results, out / "meniscus_force.png")
     return results, errors, wall
 
 
@@ -77,7 +79,7 @@ def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
     """Meniscus surface of revolution per p/psat (quads) and a .pvd keyed by p/psat."""
     import meshio
 
-    from ..vtk import write_pvd
+    from ..io.vtk import write_pvd
 
     vdir = out / "vtk"
     vdir.mkdir(exist_ok=True)
@@ -100,31 +102,3 @@ def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
                                               point_data={"z": pts[:, 2]}))
         entries.append((x, f"vtk/{name}", 0))
     write_pvd(out / f"meniscus_{tag}.pvd", entries)
-
-
-def plot_forces(scene, results, path):
-    """Force / (4 pi R gamma) vs p/psat per liquid (panels), method (style), radius (colour),
-    in the style of paper 2 Fig 1."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    nl = len(scene.liquids)
-    fig, axes = plt.subplots(1, nl, figsize=(5.2 * nl, 4.3), squeeze=False)
-    styles = {"fe": "-", "shooting": "o", "circular": "--", "no-film": ":"}
-    colors = plt.get_cmap("viridis")(np.linspace(0, 0.85, len(scene.radii)))
-    for ax, lq in zip(axes[0], scene.liquids):
-        for c, R in zip(colors, scene.radii):
-            for meth in scene.methods:
-                res = results[lq.name, R, meth]
-                x = [p for p, r in zip(scene.p_ratios, res) if not isinstance(r, Exception)]
-                f = [r.force_over_4piRgamma for r in res if not isinstance(r, Exception)]
-                ax.plot(x, f, styles.get(meth, "-"), color=c, ms=3,
-                        label=f"{meth}, R = {R * 1e9:g} nm")
-        ax.axhline(1.0, color="grey", lw=0.8)
-        ax.set(xlabel="p/psat", ylabel="F / 4πRγ", title=lq.name, xlim=(0, 1))
-        ax.grid(alpha=0.3)
-    axes[0][0].legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

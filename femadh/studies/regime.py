@@ -25,14 +25,14 @@ import warnings
 
 import numpy as np
 
-from .contact import ContactProblem
-from .contact.arclength import trace_curve
-from .effects import LennardJones
-from .elastic import GreenOperator, RadialGrid
-from .errors import MeshResolutionWarning
-from .indenter import Sphere
-from .reference.adhesion import dmt_contact_radius, jkr_contact_radius
-from .reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
+from ..contact import ContactProblem
+from ..contact.arclength import trace_curve
+from ..elastic import GreenOperator, RadialGrid
+from ..errors import MeshResolutionWarning
+from ..indenter import Sphere
+from ..laws import LennardJones
+from ..reference.adhesion import dmt_contact_radius, jkr_contact_radius
+from ..reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
@@ -205,7 +205,7 @@ def write_regime(pts, out_dir):
     import csv
     from pathlib import Path
 
-    from .plots import regime_figures
+    from ..io.plots import regime_figures
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -14,8 +14,8 @@ FE_LEVELS = ((0.5, 1.0), (0.25, 0.5), (0.125, 0.25), (0.0625, 0.125))
 
 
 def _sweep(problem, scene):
-    from .contact import trace
-    from .output import state_forces
+    from ..contact import trace
+    from ..contact.forces import state_forces
 
     t0 = time.perf_counter()
     a = trace(problem, scene.d_values, branch="approach", tol=scene.tolerance,
@@ -38,9 +38,9 @@ def convergence(scene, *, levels=3, green_factors=(0.25, 0.5, 1, 2), reference_f
     to the peak |F_ex| of the reference, compliance error, and the wall time split into
     mesh / assembly / factorisation / condensation / sweep (s).
     """
-    from .elastic import GreenOperator, RadialGrid
-    from .elastic.fe import FEOperator, FESettings
-    from .scene import build_problem
+    from ..elastic import GreenOperator, RadialGrid
+    from ..elastic.fe import FEOperator, FESettings
+    from ..scene import build_problem
 
     say = progress or (lambda msg: None)
     base = FESettings() if scene.fe_settings is None else scene.fe_settings

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..contact.forces import state_forces
+
 CURVE_HEADER = ["branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
                 "residual_m", "converged"]
 DIAG_HEADER = ["branch", "d_m", "stable", "n_active", "min_gap_minus_sigma_m",
@@ -22,18 +24,6 @@ SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ 
              "F_ela (Greenwood-Williamson asperity elasticity) repulsive positive; "
              "F_ex = F_LJ + F_cap + F_LJa - F_ela - F_el. The force on the sphere is -F_ex; "
              "adhesion shows as F_ex > 0.")
-
-
-def state_forces(problem, state):
-    """(F_LJ, F_el, F_ex) in N for a state (eqs 11-13 with 2 pi r dr area weights).
-
-    F_ex sums every effect (LJ, capillary, ...) minus the contact force.
-    """
-    g = problem.grid
-    f_lj = g.force(state.p_effects["lj"]) if "lj" in state.p_effects else 0.0
-    f_eff = sum(g.force(p) for p in state.p_effects.values())
-    f_el = g.force(state.p_contact)
-    return f_lj, f_el, f_eff - f_el
 
 
 #: extra curve.csv columns, by effect name (only for the effects a scene names), with the sign

@@ -6,12 +6,12 @@ import warnings
 
 import numpy as np
 
-from . import __version__
-from .contact import State, trace
-from .contact.continuation import Jump, Sweep
-from .errors import ConvergenceError, MeshResolutionWarning
-from .output import SIGN_NOTE, RunWriter, state_forces, write_json
-from .scene import Scene, build_problem, load_scene
+from .._version import __version__
+from ..contact import Jump, State, Sweep, trace
+from ..contact.forces import state_forces
+from ..errors import ConvergenceError, MeshResolutionWarning
+from ..io.writers import SIGN_NOTE, RunWriter, write_json
+from ..scene import Scene, build_problem, load_scene
 
 
 #: surface-force stiffness over single-node stiffness above which a run warns
@@ -92,7 +92,7 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
     if not isinstance(scene, Scene) and not hasattr(scene, "p_ratios"):
         scene = load_scene(scene)
     if hasattr(scene, "p_ratios"):  # a [meniscus] scene (paper 2)
-        from .meniscus.run import run_meniscus
+        from .meniscus import run_meniscus
 
         return run_meniscus(scene, out_dir, write=write, figures=figures)
     t0 = time.perf_counter()
@@ -146,7 +146,7 @@ def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
         writer.close()
         write_json(f"{result.out_dir}/summary.json", _summary(result))
         if figures and result.sweeps:
-            from .plots import paper1_panels
+            from ..io.plots import paper1_panels
             paper1_panels(result, f"{result.out_dir}/fig3_panels.png")
     return result
 
@@ -167,7 +167,7 @@ def _run_arclength(scene, problem, result, writer, progress):
     displacement-controlled approach and retract paths, with their jumps, go to curve.csv as
     with the stepping solver. On failure the part of the curve traced so far is written.
     """
-    from .contact.arclength import trace_curve
+    from ..contact.arclength import trace_curve
 
     d = scene.d_values
     step = abs(d[1] - d[0])

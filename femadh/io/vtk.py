@@ -11,34 +11,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-
-def fe_point_fields(operator, u):
-    """Vertex fields of a full displacement DOF vector u of an FEOperator."""
-    from skfem import ElementTriP1
-
-    b = operator.basis
-    E, nu = operator.youngs, operator.nu
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-    mu = E / (2 * (1 + nu))
-    uh = b.interpolate(u)
-    r = b.global_coordinates()[0]
-    g, v = uh.grad, uh
-    e_rr, e_zz, e_tt = g[0, 0], g[1, 1], v[0] / r
-    e_rz = 0.5 * (g[0, 1] + g[1, 0])
-    tr = e_rr + e_zz + e_tt
-    s = {"sigma_rr": lam * tr + 2 * mu * e_rr, "sigma_zz": lam * tr + 2 * mu * e_zz,
-         "sigma_tt": lam * tr + 2 * mu * e_tt, "sigma_rz": 2 * mu * e_rz}
-    b1 = b.with_element(ElementTriP1())
-    out = {k: b1.project(val) for k, val in s.items()}
-    out["von_mises"] = np.sqrt(0.5 * ((out["sigma_rr"] - out["sigma_zz"]) ** 2
-                                      + (out["sigma_zz"] - out["sigma_tt"]) ** 2
-                                      + (out["sigma_tt"] - out["sigma_rr"]) ** 2)
-                               + 3 * out["sigma_rz"] ** 2)
-    nd = b.nodal_dofs
-    disp = np.zeros((b.mesh.p.shape[1], 3))
-    disp[:, 0], disp[:, 1] = u[nd[0]], u[nd[1]]
-    out["displacement"] = disp
-    return out
+from ..elastic.fe.fields import fe_point_fields
 
 
 def write_state(out_dir, branch, index, state, problem):

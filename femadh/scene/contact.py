@@ -1,25 +1,14 @@
-"""Scene files (TOML) -> validated :class:`Scene` -> :class:`ContactProblem`.
-
-The scene file is the user-facing contract. Quantities are strings with units ("2 mm") or
-plain numbers in SI. Unknown keys, missing keys, wrong units and unphysical values raise
-:class:`SceneError` naming the file, the key, the value and what was expected. Only the effects
-a scene names are built.
-"""
+"""Contact scenes (paper 1): the sphere, the materials, the effects (gap laws and the
+sigma-gap), the solver and the sweep, validated into a :class:`Scene` in SI units."""
 from dataclasses import asdict, dataclass, field
 import math
-from pathlib import Path
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python < 3.11
-    import tomli as tomllib
-
-from .effects import AsperityGap, LennardJones
-from .effects.gap import CONTACT_MODELS
-from .errors import SceneError, _MISSING
-from .indenter import PROFILES, Sphere
-from .materials import IsotropicMaterial, composite_modulus
-from .units import to_si
+from ..contact.constraints import CONTACT_MODELS, AsperityGap
+from ..errors import SceneError
+from ..indenter import PROFILES, Sphere
+from ..laws import LennardJones
+from ..materials import IsotropicMaterial, composite_modulus
+from .reader import Reader, scene_name
 
 METHODS = ("green", "fe")
 DIRECTIONS = ("approach", "retract")
@@ -82,72 +71,16 @@ class Scene:
         }
 
 
-class _Reader:
-    """Reads one table with key-by-key checks; remembers the file for error messages."""
-
-    def __init__(self, file, table, prefix):
-        self.file, self.table, self.prefix = file, table, prefix
-        self.used = set()
-
-    def key(self, k):
-        return f"{self.prefix}.{k}" if self.prefix else k
-
-    def error(self, k, value, expected):
-        return SceneError(self.file, self.key(k), value, expected)
-
-    def raw(self, k, default=_MISSING):
-        self.used.add(k)
-        if k in self.table:
-            return self.table[k]
-        if default is _MISSING:
-            raise self.error(k, _MISSING, "this key (it is required)")
-        return default
-
-    def quantity(self, k, dim, *, default=_MISSING, positive=True):
-        v = self.raw(k, default)
-        x = to_si(v, dim, file=self.file, key=self.key(k))
-        if not math.isfinite(x):
-            raise self.error(k, v, "a finite value")
-        if positive and not x > 0:
-            raise self.error(k, v, f"a positive {dim.replace('_', ' ')}")
-        return x
-
-    def choice(self, k, options, default=_MISSING):
-        v = self.raw(k, default)
-        if v not in options:
-            raise self.error(k, v, "one of " + ", ".join(repr(o) for o in options))
-        return v
-
-    def integer(self, k, lo, default=_MISSING):
-        v = self.raw(k, default)
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise self.error(k, v, f"an integer >= {lo}")
-        return v
-
-    def table_at(self, k, default=_MISSING):
-        v = self.raw(k, default)
-        if v is not None and not isinstance(v, dict):
-            raise self.error(k, v, "a table")
-        return v
-
-    def done(self, allowed=None):
-        allowed = set(allowed or []) | self.used
-        for k in self.table:
-            if k not in allowed:
-                raise self.error(k, self.table[k], "no such key here; allowed keys are "
-                                 + ", ".join(sorted(allowed)))
-
-
 def _capillary(file, table):
     """[effects.capillary]: liquid, temperature, relative_pressure, isotherm, smoothing."""
-    from .effects import CapillaryCondensate
-    from .meniscus.kelvin import kelvin_radius
-    from .meniscus.scene import _isotherm, _liquid
-    from .meniscus.isotherms import default_isotherm
-    from .meniscus.liquids import LIQUIDS
+    from ..laws import CapillaryCondensate
+    from ..meniscus.isotherms import default_isotherm
+    from ..meniscus.kelvin import kelvin_radius
+    from ..meniscus.liquids import LIQUIDS
+    from .liquids import read_isotherm, read_liquid
 
-    c = _Reader(file, table, "effects.capillary")
-    liquid = _liquid(c, c.raw("liquid"))
+    c = Reader(file, table, "effects.capillary")
+    liquid = read_liquid(c, c.raw("liquid"))
     temperature = c.quantity("temperature", "temperature", default="298.15 K")
     x = c.raw("relative_pressure")
     if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 < x < 1:
@@ -156,7 +89,7 @@ def _capillary(file, table):
     if iso_raw is None:
         iso = default_isotherm(liquid.name) if liquid.name in LIQUIDS else None
     else:
-        iso = _isotherm(c, iso_raw)
+        iso = read_isotherm(c, iso_raw)
     smoothing = c.raw("smoothing", 0.02)
     if isinstance(smoothing, bool) or not isinstance(smoothing, (int, float)) \
             or not 0 < smoothing <= 0.5:
@@ -170,9 +103,9 @@ def _capillary(file, table):
 
 def _asperity_adhesion(file, table, sigma):
     """[effects.asperity_adhesion]: eq 20 over the contact region."""
-    from .effects import AsperityAdhesion
+    from ..laws import AsperityAdhesion
 
-    t = _Reader(file, table, "effects.asperity_adhesion")
+    t = Reader(file, table, "effects.asperity_adhesion")
     Ra = t.quantity("asperity_radius", "length")
     dg = t.quantity("surface_energy", "surface_energy")
     rho = t.quantity("density", "areal_density", positive=False)
@@ -190,12 +123,11 @@ def _asperity_adhesion(file, table, sigma):
 
 def _asperity_contact(file, table, e_star):
     """[effects.asperity_contact] model = "greenwood-williamson": eqs 23-24 as gap laws."""
-    from .effects import GWAdhesion, GWElastic
-    from .reference.gw import Roughness
+    from ..laws import GWAdhesion, GWElastic, Summits
 
-    t = _Reader(file, table, "effects.asperity_contact")
+    t = Reader(file, table, "effects.asperity_contact")
     t.choice("model", ("greenwood-williamson",))
-    rough = Roughness(t.quantity("rms_height", "length"),
+    rough = Summits(t.quantity("rms_height", "length"),
                       t.quantity("mean_height", "length", positive=False),
                       t.quantity("asperity_radius", "length"),
                       t.quantity("density", "areal_density"))
@@ -207,49 +139,9 @@ def _asperity_contact(file, table, e_star):
     return out
 
 
-def scene_name(top, file):
-    """The [scene] table's name, validated (shared by contact and meniscus scenes)."""
-    s = _Reader(file, top.table_at("scene"), "scene")
-    name = s.raw("name")
-    if not isinstance(name, str) or not name:
-        raise s.error("name", name, "a non-empty string")
-    s.done()
-    return name
-
-
-def load_scene(path):
-    """Read and validate a scene file.
-
-    Parameters
-    ----------
-    path : str or Path
-        The TOML file.
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    SceneError
-        On any malformed, missing, unknown or unphysical entry.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise SceneError(str(path), "(file)", str(path), f"a readable file ({exc.strerror})") \
-            from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(str(path), "(file)", "(TOML text)", f"valid TOML ({exc})") from None
-    return scene_from_dict(data, str(path))
-
-
 def _material(r, k):
     t = r.table_at(k)
-    m = _Reader(r.file, t, r.key(k))
+    m = Reader(r.file, t, r.key(k))
     E = m.quantity("youngs_modulus", "pressure")
     nu = m.raw("poisson_ratio")
     if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
@@ -258,28 +150,20 @@ def _material(r, k):
     return IsotropicMaterial(E, float(nu))
 
 
-def scene_from_dict(data, file=None):
-    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`.
-
-    A scene with a ``[meniscus]`` table is a capillary (paper 2) scene and returns a
-    :class:`~femadh.meniscus.scene.MeniscusScene`; otherwise a contact :class:`Scene`.
-    """
-    top = _Reader(file, data, "")
-    if "meniscus" in data:
-        from .meniscus.scene import parse_meniscus
-
-        return parse_meniscus(top, file)
+def parse_contact(top, file):
+    """Build a contact :class:`Scene` from the top-level Reader of a scene file."""
+    data = top.table
     top.used |= _TOP
     top.done(_TOP)
 
     name = scene_name(top, file)
 
-    sp = _Reader(file, top.table_at("sphere"), "sphere")
+    sp = Reader(file, top.table_at("sphere"), "sphere")
     sphere = Sphere(sp.quantity("radius", "length"),
                     sp.choice("profile", PROFILES, "paraboloid"))
     sp.done()
 
-    mt = _Reader(file, top.table_at("materials"), "materials")
+    mt = Reader(file, top.table_at("materials"), "materials")
     disk = None
     if "composite_modulus" in mt.table:
         if "disk" in mt.table or "slider" in mt.table:
@@ -292,17 +176,17 @@ def scene_from_dict(data, file=None):
         e_star = composite_modulus(disk, slider)
     mt.done()
 
-    ef = _Reader(file, top.table_at("effects", {}), "effects")
+    ef = Reader(file, top.table_at("effects", {}), "effects")
     effects, gap = {}, None
     lj_t = ef.table_at("lennard_jones", None)
     if lj_t is not None:
-        lj = _Reader(file, lj_t, "effects.lennard_jones")
+        lj = Reader(file, lj_t, "effects.lennard_jones")
         effects["lj"] = LennardJones(lj.quantity("hamaker", "energy"),
                                      lj.quantity("equilibrium_distance", "length"))
         lj.done()
     gap_t = ef.table_at("asperity_gap", None)
     if gap_t is not None:
-        g = _Reader(file, gap_t, "effects.asperity_gap")
+        g = Reader(file, gap_t, "effects.asperity_gap")
         gap = AsperityGap(g.quantity("sigma", "length"),
                           g.choice("contact_model", CONTACT_MODELS, "complementarity"))
         g.done()
@@ -329,12 +213,12 @@ def scene_from_dict(data, file=None):
         raise SceneError(file, "effects.asperity_gap.contact_model", gap.contact_model,
                          "'complementarity' unless [effects.lennard_jones] is present")
 
-    so = _Reader(file, top.table_at("solver", {}), "solver")
+    so = Reader(file, top.table_at("solver", {}), "solver")
     method = so.choice("method", METHODS, "green")
     nodes = so.integer("nodes", 8, 200)
     ar = so.raw("analysis_radius", {"delta": "10 nm"})
     if isinstance(ar, dict):
-        arr = _Reader(file, ar, "solver.analysis_radius")
+        arr = Reader(file, ar, "solver.analysis_radius")
         delta = arr.quantity("delta", "length")
         arr.done()
         a = math.sqrt(2.0 * sphere.radius * delta)  # paper 1 sec 4: delta = a^2 / 2R
@@ -352,9 +236,9 @@ def scene_from_dict(data, file=None):
     fe_settings, fe_nu = None, (disk.poisson_ratio if disk is not None else 0.3)
     mesh_t = so.table_at("mesh", None)
     if method == "fe":
-        from .elastic.fe import FESettings
+        from ..elastic.fe import FESettings
 
-        ms = _Reader(file, mesh_t or {}, "solver.mesh")
+        ms = Reader(file, mesh_t or {}, "solver.mesh")
         d0 = FESettings()
         outer = ms.raw("outer_factor", d0.outer_factor)
         growth = ms.raw("growth", d0.growth)
@@ -381,7 +265,7 @@ def scene_from_dict(data, file=None):
                          f"2|r_K| + 2h = {cap.fill_gap * 1e9:.4g} nm, so that the meniscus lies "
                          f"inside it (e.g. analysis_radius = {{ delta = "
                          f"\"{2 * cap.fill_gap * 1e9:.3g} nm\" }})")
-    sw = _Reader(file, top.table_at("sweep"), "sweep")
+    sw = Reader(file, top.table_at("sweep"), "sweep")
     start = sw.quantity("start", "length", positive=False)
     stop = sw.quantity("stop", "length", positive=False)
     step = sw.quantity("step", "length")
@@ -413,7 +297,7 @@ def scene_from_dict(data, file=None):
                          "smooth sphere (no [effects.asperity_gap]): the sweep starts from the "
                          "undeformed surface, which the tip must not touch")
 
-    ou = _Reader(file, top.table_at("output", {}), "output")
+    ou = Reader(file, top.table_at("output", {}), "output")
     out_dir = ou.raw("dir", f"out/{name}")
     if not isinstance(out_dir, str) or not out_dir:
         raise ou.error("dir", out_dir, "a folder path")
@@ -432,25 +316,3 @@ def scene_from_dict(data, file=None):
                  continuation=continuation, raw=data)
 
 
-def build_operator(scene, progress=None):
-    """The scene's SurfaceOperator: Green function or condensed FE, on the scene's grid."""
-    from .elastic import GreenOperator, RadialGrid
-
-    grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
-    if scene.method == "fe":
-        from .elastic.fe import FEOperator
-
-        return FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, scene.fe_settings,
-                          progress=progress)
-    return GreenOperator(grid, scene.e_star)
-
-
-def build_problem(scene, operator=None, progress=None):
-    """The :class:`ContactProblem` of a scene; only the effects it names are built.
-
-    Pass ``operator`` to reuse an already built (e.g. factorised FE) operator.
-    """
-    from .contact import ContactProblem
-
-    operator = operator or build_operator(scene, progress)
-    return ContactProblem(operator, scene.sphere, dict(scene.effects), scene.gap)

@@ -137,24 +137,43 @@ def read_mesh(path, scale=1.0):
     return m.points[used, :2] * scale, remap[tri]
 
 
-def cached_mesh(spec: MeshSpec, cache_dir=None, *, progress=None):
-    """Path of the mesh for ``spec``, built with gmsh on first use and cached by content hash.
-
-    The committed ladder in ``meshes/`` (see meshes/manifest.json) is searched first.
-    """
+def mesh_search_path():
+    """Folders searched for a mesh before the cache: FEMADH_MESH_PATH (os.pathsep-separated),
+    e.g. the repository's committed ladder ``meshes/`` that the tests use."""
     import os
 
-    repo_meshes = Path(__file__).resolve().parents[2] / "meshes"
+    return [Path(p) for p in os.environ.get("FEMADH_MESH_PATH", "").split(os.pathsep) if p]
+
+
+def cached_mesh(spec: MeshSpec, cache_dir=None, *, progress=None):
+    """Path of the mesh for ``spec``, built with gmsh on first use and cached by content hash
+    in ``cache_dir`` (default FEMADH_MESH_CACHE, else ~/.cache/femadh/meshes). Folders of
+    :func:`mesh_search_path` are searched first.
+
+    Safe with concurrent writers: each builds into its own temporary file and renames it into
+    place (atomic on one filesystem), so a reader never sees a half-written mesh and two
+    processes building the same mesh both end with a complete one.
+    """
+    import os
+    import tempfile
+
     name = f"halfspace-{spec.key()}.msh"
-    if (repo_meshes / name).exists():
-        return repo_meshes / name
+    for folder in mesh_search_path():
+        if (folder / name).exists():
+            return folder / name
     cache = Path(cache_dir or os.environ.get("FEMADH_MESH_CACHE") or DEFAULT_CACHE)
     path = cache / name
     if not path.exists():
         if progress:
             progress(f"meshing ({len(spec.surface_points)} surface points, L = "
                      f"{spec.outer_radius:.3g} m) -> {path}")
-        tmp = path.with_suffix(".tmp.msh")
-        build_mesh(spec, tmp)
-        tmp.replace(path)  # atomic: a killed run never leaves a half-written cache entry
+        cache.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".msh", dir=cache)
+        os.close(fd)
+        try:
+            build_mesh(spec, tmp)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
     return path

@@ -15,48 +15,11 @@ import time
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from .grid import RadialGrid
-from .operator import SurfaceOperator
+from ..grid import RadialGrid
+from ..operator import SurfaceOperator
+from .farfield import boussinesq
 from .mesh import MeshSpec, cached_mesh, read_mesh, surface_points_of
-
-
-def axisymmetric_elasticity(lam, mu):
-    """Bilinear form of axisymmetric linear elasticity in (r, z), r-weighted (2 pi r dA).
-
-    Strains: e_rr = du_r/dr, e_zz = du_z/dz, e_tt = u_r / r (hoop), e_rz = (du_r/dz + du_z/dr)/2.
-    a(u, v) = int sigma(u) : eps(v) 2 pi r dr dz with sigma = lam tr(eps) I + 2 mu eps.
-    """
-    from skfem import BilinearForm
-
-    @BilinearForm
-    def form(u, v, w):
-        r = w.x[0]
-        eu = _strains(u, r)
-        ev = _strains(v, r)
-        tr = eu[0] + eu[1] + eu[2]
-        s = (lam * tr + 2 * mu * eu[0], lam * tr + 2 * mu * eu[1], lam * tr + 2 * mu * eu[2],
-             2 * mu * eu[3])
-        return 2 * math.pi * r * (s[0] * ev[0] + s[1] * ev[1] + s[2] * ev[2] + 2 * s[3] * ev[3])
-
-    return form
-
-
-def _strains(u, r):
-    g = u.grad
-    return g[0, 0], g[1, 1], u[0] / r, 0.5 * (g[0, 1] + g[1, 0])
-
-
-def boussinesq(r, z, youngs, nu):
-    """Displacement (u_r, u_z) (m per N) of a unit upward point force at the origin of the
-    half-space z <= 0 (Johnson 1985 eq 3.21a-b with depth -z; upward pull, u_z up)."""
-    G = youngs / (2 * (1 + nu))
-    zeta = -np.asarray(z, float)
-    r = np.asarray(r, float)
-    rho = np.hypot(r, zeta)
-    c = 1.0 / (4 * math.pi * G)
-    u_z = c * (zeta**2 / rho**3 + 2 * (1 - nu) / rho)
-    u_r = -c * (r * zeta / rho**3 - (1 - 2 * nu) * r / (rho * (rho + zeta)))
-    return u_r, u_z
+from .weakform import axisymmetric_elasticity, lame
 
 
 @dataclass
@@ -93,6 +56,14 @@ class FESettings:
             raise ValueError(f"far_field must be 'boussinesq' or 'fixed', got {self.far_field!r}")
 
 
+def mesh_spec(grid, settings):
+    """The half-space mesh of a grid: vertices at its nodes and annulus edges, far boundary at
+    outer_factor x the analysis radius, surface elements surface_fraction x the node spacing."""
+    return MeshSpec(surface_points_of(grid), settings.outer_factor * grid.radius,
+                    settings.growth,
+                    settings.surface_fraction * float(np.min(np.diff(grid.nodes))))
+
+
 class FEOperator(SurfaceOperator):
     """Condensed FE compliance of the axisymmetric half-space on a RadialGrid.
 
@@ -126,14 +97,11 @@ class FEOperator(SurfaceOperator):
         self.grid, self.e_star, self.nu = grid, float(e_star), float(nu)
         self.settings = settings or FESettings()
         self.youngs = self.e_star * (1 - self.nu**2)
-        lam = self.youngs * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
-        mu = self.youngs / (2 * (1 + self.nu))
+        lam, mu = lame(self.youngs, self.nu)
         a = grid.radius
         t = {}
         t0 = time.perf_counter()
-        self.spec = MeshSpec(surface_points_of(grid), self.settings.outer_factor * a,
-                             self.settings.growth,
-                             self.settings.surface_fraction * float(np.min(np.diff(grid.nodes))))
+        self.spec = mesh_spec(grid, self.settings)
         path = mesh_path or cached_mesh(self.spec, progress=progress)
         p, tri = read_mesh(path, scale=a)
         self.mesh = MeshTri(np.ascontiguousarray(p.T), np.ascontiguousarray(tri.T))

@@ -14,9 +14,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .isotherms import BET, GAB, Polynomial, Tabulated, default_isotherm
-from .liquids import LIQUIDS, Liquid
-from .solve import METHODS
+from ..meniscus.isotherms import default_isotherm
+from ..meniscus.liquids import LIQUIDS
+from ..meniscus.solve import METHODS
+from .liquids import read_isotherm, read_liquid
+from .reader import Reader, scene_name
 
 
 @dataclass
@@ -51,17 +53,15 @@ class MeniscusScene:
 
 def parse_meniscus(top, file):
     """Build a MeniscusScene from the top-level _Reader of a scene file."""
-    from ..scene import _Reader, scene_name
-
     top.used |= {"scene", "meniscus", "output"}
     top.done({"scene", "meniscus", "output"})
     name = scene_name(top, file)
-    m = _Reader(file, top.table_at("meniscus"), "meniscus")
+    m = Reader(file, top.table_at("meniscus"), "meniscus")
     radii_raw = m.raw("tip_radius")
     radii_list = radii_raw if isinstance(radii_raw, list) else [radii_raw]
     radii = []
     for i, v in enumerate(radii_list):
-        sub = _Reader(file, {"tip_radius": v}, "meniscus")
+        sub = Reader(file, {"tip_radius": v}, "meniscus")
         radii.append(sub.quantity("tip_radius", "length"))
     sep_raw = m.raw("separation", "contact")
     separation = None if sep_raw == "contact" else m.quantity("separation", "length",
@@ -69,7 +69,7 @@ def parse_meniscus(top, file):
     if separation is not None and separation < 0:
         raise m.error("separation", sep_raw, "'contact' or a solid-solid gap >= 0")
     liq_raw = m.raw("liquid")
-    liquids = [_liquid(m, v) for v in (liq_raw if isinstance(liq_raw, list) else [liq_raw])]
+    liquids = [read_liquid(m, v) for v in (liq_raw if isinstance(liq_raw, list) else [liq_raw])]
     temperature = m.quantity("temperature", "temperature", default="298.15 K")
     iso_raw = m.raw("isotherm", None)
     isotherms = {}
@@ -80,10 +80,10 @@ def parse_meniscus(top, file):
                               f"{lq.name!r} (or model = 'none')")
             isotherms[lq.name] = default_isotherm(lq.name)
         else:
-            isotherms[lq.name] = _isotherm(m, iso_raw)
+            isotherms[lq.name] = read_isotherm(m, iso_raw)
     pr = m.raw("relative_pressure")
     if isinstance(pr, dict):
-        r = _Reader(file, pr, "meniscus.relative_pressure")
+        r = Reader(file, pr, "meniscus.relative_pressure")
         start, stop, num = r.raw("start"), r.raw("stop"), r.integer("num", 2)
         r.done()
         p_ratios = list(np.linspace(start, stop, num)) if all(
@@ -99,7 +99,7 @@ def parse_meniscus(top, file):
         raise m.error("methods", methods, f"a list drawn from {list(METHODS)}")
     elements = m.integer("elements", 2, 16)
     m.done()
-    ou = _Reader(file, top.table_at("output", {}), "output")
+    ou = Reader(file, top.table_at("output", {}), "output")
     out_dir = ou.raw("dir", f"out/{name}")
     vtk = ou.raw("vtk", True)
     if not isinstance(vtk, bool):
@@ -108,63 +108,3 @@ def parse_meniscus(top, file):
     return MeniscusScene(name, file, radii, separation, liquids, temperature, isotherms,
                          [float(x) for x in p_ratios], tuple(methods), elements, out_dir, vtk,
                          top.table)
-
-
-def _liquid(m, v):
-    from ..scene import _Reader
-
-    if isinstance(v, str):
-        if v not in LIQUIDS:
-            raise m.error("liquid", v, f"one of {sorted(LIQUIDS)} or a table "
-                          "{ surface_tension, molar_volume }")
-        return LIQUIDS[v]
-    if not isinstance(v, dict):
-        raise m.error("liquid", v, "a liquid name or a table")
-    t = _Reader(m.file, v, "meniscus.liquid")
-    lq = Liquid(t.raw("name", "user liquid"), t.quantity("surface_tension", "surface_energy"),
-                t.quantity("molar_volume", "molar_volume"), source="scene file")
-    t.done()
-    return lq
-
-
-def _isotherm(m, v):
-    from ..scene import _Reader
-
-    if not isinstance(v, dict):
-        raise m.error("isotherm", v, "a table with model = gab | bet | polynomial | tabulated "
-                      "| none")
-    t = _Reader(m.file, v, "meniscus.isotherm")
-    model = t.choice("model", ("gab", "bet", "polynomial", "tabulated", "none"))
-    if model == "none":
-        iso = None
-    elif model in ("gab", "bet"):
-        tm = t.quantity("monolayer", "length")
-        c = t.raw("c")
-        if isinstance(c, bool) or not isinstance(c, (int, float)) or not c > 0:
-            raise t.error("c", c, "a positive number")
-        if model == "gab":
-            k = t.raw("k")
-            if isinstance(k, bool) or not isinstance(k, (int, float)) or not 0 < k < 1:
-                raise t.error("k", k, "a number in (0, 1)")
-            iso = GAB(tm, float(c), float(k), "scene file")
-        else:
-            iso = BET(tm, float(c), "scene file")
-    elif model == "polynomial":
-        co = t.raw("coefficients")
-        if not isinstance(co, list) or not co:
-            raise t.error("coefficients", co, "a list of lengths, lowest order first")
-        iso = Polynomial(tuple(_Reader(m.file, {"c": c}, "meniscus.isotherm.coefficients")
-                               .quantity("c", "length", positive=False) for c in co),
-                         "scene file")
-    else:
-        x, h = t.raw("p_ratio"), t.raw("thickness")
-        if not isinstance(x, list) or not isinstance(h, list) or len(x) != len(h):
-            raise t.error("thickness", h, "a list as long as p_ratio")
-        hs = tuple(_Reader(m.file, {"h": v2}, "meniscus.isotherm.thickness")
-                   .quantity("h", "length", positive=False) for v2 in h)
-        try:
-            iso = Tabulated(tuple(float(a) for a in x), hs, "scene file")
-        except ValueError as exc:
-            raise t.error("p_ratio", x, str(exc)) from None
-    t.done()
-    return iso

@@ -1,7 +1,7 @@
 """Continuation in the separation d: approach and retract branches, fold detection and jumps.
 
-Each grid step is taken with a predictor (the tangent dw/dd for the complementarity model,
-a secant otherwise) and the Newton corrector. A step is accepted only if the corrector
+Each grid step is taken with a predictor (the tangent dw/dd of the last state, its active set
+frozen) and the semismooth Newton corrector. A step is accepted only if the corrector
 converges to a *stable* state close to the prediction; otherwise the step is halved. When even
 the smallest step fails, the branch has folded (the stable equilibrium ceased to exist: jump-in
 on approach, jump-out on retract). The fold is reported at the last stable d, and the surface
@@ -16,7 +16,8 @@ import time
 import numpy as np
 
 from ..errors import ConvergenceError
-from .newton import solve_state, tangent
+from .complementarity import solve_complementarity, tangent
+from .landing import land
 
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
@@ -77,15 +78,9 @@ def _accept(new, pred_w, d):
     return bool(np.all(change <= MAX_CORRECTION_FRACTION * np.maximum(h_pred, 0) + 1e-15))
 
 
-PREDICTOR = "tangent"
-
-
-def _predict(problem, state, prev, d):
-    """Predicted displacements at d and the active set they imply."""
-    if prev is not None and prev.d != state.d and PREDICTOR == "secant":
-        s = (d - state.d) / (state.d - prev.d)
-        w = state.w + s * (state.w - prev.w)
-    elif state.lu is not None and problem.contact_model != "hertz-closure":
+def _predict(problem, state, d):
+    """Predicted displacements at d (tangent of the last state) and the active set they imply."""
+    if state.lu is not None:
         w = state.w + tangent(problem, state) * (d - state.d)
     else:
         w = state.w.copy()
@@ -94,83 +89,8 @@ def _predict(problem, state, prev, d):
     return w, state.active | (problem.contour(d) - w < problem.sigma)
 
 
-def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
-    """Levenberg-Marquardt descent of the total energy from w (projected onto h >= h_floor).
-
-    Steps solve (H + lam diag(H_el)) dw = -grad with H the symmetric energy Hessian; lam grows
-    until the energy decreases and shrinks after each success, so the iteration slides
-    downhill like an overdamped surface and ends in the basin it rolls into (the physical
-    landing after a fold). Returns the final w and whether the gradient was driven to ~0.
-    """
-    from scipy import linalg as sla
-
-    b = problem.contour(d)
-    upper = b - h_floor
-    w = np.minimum(np.array(w, float), upper)
-    scale_diag = np.diag(problem.S_sym).copy()
-    lam = 1.0
-    e = problem.energy(w, d)
-    g = problem.energy_gradient(w, d)
-    g0 = float(np.max(np.abs(g))) + 1e-300
-    for _ in range(max_iter):
-        at_bound = (w >= upper - 1e-18) & (g < 0)   # pushing further into h < floor
-        free = ~at_bound
-        if float(np.max(np.abs(g[free]), initial=0.0)) <= 1e-10 * g0:
-            return w, True
-        H = problem.energy_hessian(b - w, free)
-        while True:
-            M = H.copy()
-            M[np.diag_indices_from(M)] += lam * scale_diag[free]
-            try:
-                c = sla.cho_factor(M, check_finite=False)
-            except sla.LinAlgError:
-                lam *= 4
-                if lam > 1e12:
-                    return w, False
-                continue
-            dw = np.zeros_like(w)
-            dw[free] = -sla.cho_solve(c, g[free], check_finite=False)
-            w_new = np.minimum(w + dw, upper)
-            e_new = problem.energy(w_new, d)
-            if np.isfinite(e_new) and e_new <= e:
-                break
-            lam *= 4
-            if lam > 1e12:
-                return w, False
-        w, e = w_new, e_new
-        g = problem.energy_gradient(w, d)
-        lam = max(lam / 3, 1e-8)
-    return w, False
-
-
-def land(problem, d, w_start, *, tol, max_iter):
-    """Equilibrium reached by energy descent from w_start at separation d (a jump's landing).
-
-    Levenberg-Marquardt descent of elastic + interaction energy under the bound h >= sigma (or
-    h >= 0.5 z0 for a smooth sphere, never active at a minimum: the LJ repulsion is far steeper),
-    then the Newton corrector of the problem's contact model polishes the state.
-    """
-    b = problem.contour(d)
-    if problem.sigma is not None:
-        h_floor = problem.sigma
-    else:
-        z0s = [getattr(e, "z0", None) for e in problem.effects.values()]
-        h_floor = 0.5 * min(z for z in z0s if z) if any(z0s) else 1e-12
-    w, _ = _lm_descent(problem, d, w_start, h_floor)
-    active = (b - w) <= h_floor * (1 + 1e-9) if problem.sigma is not None else None
-    st = solve_state(problem, d, w, tol=tol, max_iter=max_iter, active0=active, r_c0=None)
-    if not st.converged:
-        # far from the old branch the polish can start slowly (stiff LJ repulsion, pivoted
-        # factorisations): give it a larger budget from where it got to
-        st2 = solve_state(problem, d, st.w, tol=tol, max_iter=4 * max_iter, active0=st.active,
-                          r_c0=None)
-        st2.n_iter += st.n_iter
-        st = st2
-    return st
-
-
-def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
-          progress=None):
+def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
+                progress=None):
     """Follow the stable equilibrium through the separations ``d_values`` (m).
 
     Parameters
@@ -212,12 +132,12 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
 
 
 def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, progress):
-    """The body of :func:`trace`, filling ``sweep`` as it goes."""
+    """The body of :func:`trace_steps`, filling ``sweep`` as it goes."""
     t0 = time.perf_counter()
     d_values = [float(x) for x in d_values]
     sweep.d_current = d_values[0]
     if start is None:
-        state = solve_state(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
+        state = solve_complementarity(problem, d_values[0], np.zeros(problem.grid.n), tol=tol,
                             max_iter=max_iter)
         sweep.n_solves += 1
         if not (state.converged and state.stable):
@@ -230,7 +150,6 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     sweep.states.append(state)
     if on_state:
         on_state(state)
-    prev = None
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -258,12 +177,12 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                     abs(d_next - d_try) < 0.5 * min_step:
                 d_try = d_next
             sweep.d_current = d_try
-            w_pred, act = _predict(problem, state, prev, d_try)
-            new = solve_state(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
-                              active0=act, r_c0=state.r_c, factor=state.lu)
+            w_pred, act = _predict(problem, state, d_try)
+            new = solve_complementarity(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
+                                        active0=act, factor=state.lu)
             sweep.n_solves += 1
             if _accept(new, w_pred, d_try):
-                prev, state = state, new
+                state = new
                 step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
                 continue
             if abs(step) > min_step * 1.5:
@@ -279,7 +198,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # fold after fold at the smallest step: not a physical snap but a branch the
                 # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
                 solves_here = MAX_SOLVES_PER_STEP
-            prev, state = None, landed
+            state = landed
         sweep.states.append(state)
         if on_state:
             on_state(state)

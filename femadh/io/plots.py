@@ -12,7 +12,7 @@ def _pyplot():
 def paper1_panels(result, path, *, max_profiles=12):
     """Paper 1 Fig 3-style panels: (a) w(r), (b) P_LJ(r), (c) P_el(r), (d) forces vs d,
     (e) r_c vs -F_ex, (f) iterations and -log10(residual) per step."""
-    from .reference import dmt_contact_radius, jkr_contact_radius, surface_energy_from_hamaker
+    from ..reference import dmt_contact_radius, jkr_contact_radius, surface_energy_from_hamaker
 
     plt = _pyplot()
     problem, scene = result.problem, result.scene
@@ -84,7 +84,7 @@ def regime_figures(pts, out_dir):
 
     import numpy as np
 
-    from .reference.maugis import lj_dugdale_lambda, maugis_pull_off
+    from ..reference.maugis import lj_dugdale_lambda, maugis_pull_off
 
     plt = _pyplot()
     out = Path(out_dir)
@@ -131,4 +131,29 @@ def regime_figures(pts, out_dir):
         a.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "regime_curves.png", dpi=110)
+    plt.close(fig)
+
+
+def meniscus_forces(scene, results, path):
+    """Force / (4 pi R gamma) vs p/psat per liquid (panels), method (style), radius (colour),
+    in the style of paper 2 Fig 1."""
+    plt = _pyplot()
+    nl = len(scene.liquids)
+    fig, axes = plt.subplots(1, nl, figsize=(5.2 * nl, 4.3), squeeze=False)
+    styles = {"fe": "-", "shooting": "o", "circular": "--", "no-film": ":"}
+    colors = plt.get_cmap("viridis")(np.linspace(0, 0.85, len(scene.radii)))
+    for ax, lq in zip(axes[0], scene.liquids):
+        for c, R in zip(colors, scene.radii):
+            for meth in scene.methods:
+                res = results[lq.name, R, meth]
+                x = [p for p, r in zip(scene.p_ratios, res) if not isinstance(r, Exception)]
+                f = [r.force_over_4piRgamma for r in res if not isinstance(r, Exception)]
+                ax.plot(x, f, styles.get(meth, "-"), color=c, ms=3,
+                        label=f"{meth}, R = {R * 1e9:g} nm")
+        ax.axhline(1.0, color="grey", lw=0.8)
+        ax.set(xlabel="p/psat", ylabel="F / 4πRγ", title=lq.name, xlim=(0, 1))
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -1,0 +1,199 @@
+"""The sigma-gap as a complementarity condition (paper 1 eq 8), solved by semismooth Newton.
+
+Complementarity (eq 8 as h >= sigma, p_c >= 0, (h - sigma) p_c = 0) is solved as a primal-dual
+active-set (semismooth) Newton method on K w = P(h) - p_c. On the active set A the gap is fixed,
+w_A = b_A - sigma, and p_c,A follows from the equation; on the inactive set I, p_c = 0 and
+
+    (K_II + diag(P'(h_I))) dw_I = -(K w - P(h))_I,
+
+a system of the size of the *free* surface only, so deep contacts get cheaper. The active set is
+updated by  i in A  <=>  p_c,i + c (sigma - h_i) > 0, the semismooth Newton step of the
+min-complementarity function. Convergence is declared on the residual of the original equation
+w - C (P - p_c) (m) with an unchanged active set.
+
+Stability of a converged state: :mod:`femadh.contact.stability` (the energy Hessian's inertia).
+"""
+import math
+
+import numpy as np
+from scipy import linalg
+
+from .linalg import TrailingLU, disk_size
+from .stability import is_stable
+from .state import State
+
+#: a chord step (reused factorisation) must cut the residual at least by this factor
+CHORD_RATE = 0.05
+#: above this many nodes a refactorisation (O(N^3)) costs more than many chord steps (O(N^2)):
+#: a chord step there need only cut the residual by CHORD_RATE_LARGE (N = 1600: 35 -> 10
+#: factorisations, 8.5 -> 6.9 s for the Fig 3 sweep; at N = 200 the strict rate is faster)
+LARGE_N, CHORD_RATE_LARGE = 600, 0.15
+#: largest fraction of the current gap one Newton step may close (keeps h > 0 for LJ)
+MAX_GAP_CLOSURE = 0.8
+
+
+def _damping(h, dh_closing):
+    """Step length in (0, 1] so that no gap closes by more than MAX_GAP_CLOSURE of itself."""
+    closing = dh_closing > 0
+    if not np.any(closing):
+        return 1.0
+    return float(min(1.0, np.min(MAX_GAP_CLOSURE * h[closing] / dh_closing[closing])))
+
+
+def _effect_pressures(problem, h):
+    return {name: eff.pressure(h) for name, eff in problem.effects.items()}
+
+
+def _residual(problem, w, p_net):
+    """max |w - C p_net| (m): the residual of eq (6)/(10)."""
+    return float(np.max(np.abs(w - problem.C @ p_net)))
+
+
+#: extra nodes factorised inside the contact edge so a shrinking contact stays covered
+DISK_MARGIN_FRACTION = 0.05
+
+
+def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None):
+    """Equilibrium at separation d (m) from displacements w0 (m): semismooth Newton on the
+    sigma-gap complementarity problem (without a gap, Newton on eq 6).
+
+    Returns a :class:`State` whose ``converged`` flag tells whether ``residual <= tol`` was
+    reached within ``max_iter`` iterations; never raises for non-convergence (the continuation
+    decides what to do). ``active0`` is the predicted active set.
+
+    ``factor`` = (lu, inactive mask) of an earlier Jacobian: while the active set equals that
+    mask the factorisation is reused (chord steps), and refreshed only when the residual stops
+    falling by CHORD_RATE per step. The LJ stiffness P'(h) is a small, slowly varying diagonal
+    next to K, so chord steps converge almost as fast as Newton steps at a fraction of the cost.
+    """
+    K, b = problem.K, problem.contour(d)
+    sigma = problem.sigma
+    n = b.size
+    chord_rate = CHORD_RATE_LARGE if n > LARGE_N else CHORD_RATE
+    w = np.array(w0, dtype=float)
+    if sigma is None:
+        A = np.zeros(n, bool)
+    elif active0 is not None:
+        A = active0.copy()
+    else:
+        A = b - w < sigma
+    seen = set()
+    if isinstance(factor, TrailingLU):
+        lu, lu_I = factor, None
+    else:
+        lu, lu_I = factor if factor is not None else (None, None)
+    fresh = False
+    res, res_prev, it = math.inf, math.inf, 0
+    for it in range(1, max_iter + 1):
+        if sigma is not None:
+            w[A] = b[A] - sigma
+        I = ~A
+        h = b - w
+        if np.any(h[I] <= 0):
+            break  # the guess put the surfaces through each other: hopeless, report failure
+        P = problem.pressure(h)
+        F_I = (K @ w)[I] - P[I]
+        m = disk_size(A)
+        # near the tolerance the residual approaches round-off and no step cuts it by
+        # CHORD_RATE; there a chord step only has to keep making progress
+        stalled = res > (chord_rate if res > 100 * tol else 0.7) * res_prev
+        if m is not None:
+            if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
+                m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+                cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
+                if cand.covers(m):
+                    lu, lu_I, fresh = cand, None, True
+                    res_prev = math.inf
+                else:  # pivoting swapped rows inside the block: use the general path
+                    m = None
+            else:
+                res_prev = res
+        if m is not None:
+            dw = -lu.solve(m, F_I)
+        else:
+            if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
+                    or stalled:
+                idx = np.flatnonzero(I)
+                M = K[idx[:, None], idx]
+                M[np.diag_indices_from(M)] += problem.dpressure(h[I])
+                lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+                res_prev = math.inf
+            else:
+                res_prev = res
+            dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+        alpha = _damping(h[I], dw)
+        w[I] += alpha * dw
+        h = b - w
+        P = problem.pressure(h)
+        pc = np.zeros(n)
+        if sigma is not None:
+            pc[A] = P[A] - (K @ w)[A]
+            new_A = (A & (pc > 0)) | (I & (h < sigma))
+        else:
+            new_A = A
+        res = _residual(problem, w, P - pc)
+        if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
+            factor = lu if isinstance(lu, TrailingLU) else (lu, lu_I)
+            return _finish(problem, d, w, h, pc, A, it, res, factor, fresh)
+        key = new_A.tobytes()
+        if key in seen and not np.array_equal(new_A, A):
+            # The active set cycles (non-convex LJ near the contact edge): accept only the
+            # additions/removals adjacent to the current contact boundary to break the cycle.
+            new_A = _restrict_change(A, new_A)
+        seen.add(key)
+        if not np.array_equal(new_A, A):
+            res = math.inf
+        A = new_A
+    h = b - w
+    pc = np.zeros(n)
+    if sigma is not None and np.all(h[~A] > 0):
+        pc[A] = problem.pressure(h)[A] - (K @ w)[A]
+    return State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300)), pc, A,
+                 _area_radius(problem, A), it, res, False, False, None)
+
+
+def _restrict_change(A, new_A):
+    """Change only the outermost changing node, a slow but non-cycling active-set update."""
+    diff = np.flatnonzero(A != new_A)
+    out = A.copy()
+    k = diff[-1]
+    out[k] = new_A[k]
+    return out
+
+
+def _area_radius(problem, A):
+    """Contact radius (m) of an active set: sqrt(active area / pi)."""
+    return math.sqrt(float(problem.areas[A].sum()) / math.pi)
+
+
+def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
+    """Package a converged state; its stability is the inertia of the energy Hessian on the
+    free nodes (:func:`femadh.contact.stability.is_stable`), never read off the Newton
+    factorisation (that one is of the collocation Jacobian, whose pivot signs do not give
+    the Hessian's inertia)."""
+    return State(d, w, h, _effect_pressures(problem, h), pc, A.copy(),
+                 _area_radius(problem, A), it, res, True, is_stable(problem, h, ~A), factor)
+
+
+def tangent(problem, state):
+    """dw/dd at a converged complementarity state, with its active set frozen (m/m).
+
+    From K w = P(b - w) - p_c with db/dd = 1: on A, dw/dd = 1; on I,
+    (K_II + D_I) t_I = D_I - K_IA 1. Reuses the corrector's factorisation.
+    """
+    A = state.active
+    I = ~A
+    t = np.ones(state.w.size)
+    D = problem.dpressure(state.h)
+    rhs = D[I] - problem.K[np.ix_(I, A)].sum(axis=1)
+    m = disk_size(A)
+    if isinstance(state.lu, TrailingLU) and m is not None and state.lu.covers(m):
+        t[I] = state.lu.solve(m, rhs)
+        return t
+    if isinstance(state.lu, TrailingLU) or state.lu is None:
+        return np.zeros(state.w.size)  # no factorisation of this set at hand: zeroth order
+    lu, lu_I = state.lu
+    if lu_I is None or not np.array_equal(lu_I, I):
+        return np.zeros(state.w.size)  # no factorisation of this set at hand: zeroth order
+    t[I] = linalg.lu_solve(lu, rhs, check_finite=False)
+    return t

@@ -1,0 +1,2 @@
+"""Outputs: csv/json writers (:mod:`.writers`), VTK for ParaView/PyVista (:mod:`.vtk`),
+figures (:mod:`.plots`)."""
