@@ -4,7 +4,10 @@ Python API::
 
     import femadh
     scene = femadh.load_scene("validation/scenes/paper1_fig3.toml")
-    result = femadh.run(scene)          # RunResult: sweeps, jumps, curves, status
+    result = femadh.run(scene)                         # writes nothing; a ContactResult
+    result.curve("approach")["F_ex"]                   # arrays of every force column
+    softer = scene.replace({"effects.asperity_gap.sigma": "0.5 nm"})   # validated again
+    femadh.run(softer, "out/sigma-0.5")                # csv, json, figures into that folder
 """
 from ._version import __version__  # noqa: F401  (the package version, femadh.__version__)
 
@@ -15,7 +18,14 @@ def load_scene(path):
     return _load(path)
 
 
+def scene_from_dict(data, file=None):
+    """Validate a scene built in code (numbers for dimensional keys are SI)."""
+    from .scene import scene_from_dict as _from_dict
+    return _from_dict(data, file, bare_numbers=True)
+
+
 def run(scene, out_dir=None, **kwargs):
-    """Solve a scene; see :func:`femadh.runner.run`."""
+    """Solve a scene (writes into ``out_dir`` only if given); see
+    :func:`femadh.runner.contact.run`."""
     from .runner.contact import run as _run
     return _run(scene, out_dir, **kwargs)

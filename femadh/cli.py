@@ -1,31 +1,68 @@
-"""Command line: ``femadh run SCENE``, ``femadh check SCENE``."""
+"""Command line: ``femadh run SCENE``, ``check``, ``keys``, ``mesh``, ``render``, ``study``,
+``regime``.
+
+Every user mistake or fault ends in one ``femadh: error:`` line per problem, never a
+traceback. Exit codes: 0 done; 2 the scene or the command line is wrong; 3 a solve failed
+(the states computed before it are kept); 4 an output cannot be written; 5 an optional
+dependency is missing; 130 / 143 interrupted by SIGINT / SIGTERM (completed states kept,
+``--resume`` continues); 1 an internal error (a bug: set FEMADH_DEBUG=1 for its traceback).
+"""
 import argparse
+import os
 import sys
 
-from .errors import FemadhError
+from ._version import __version__
+from .errors import (DependencyError, FemadhError, Interrupted, OutputError,
+                     SceneError)
+
+EXIT_SCENE, EXIT_SOLVE, EXIT_OUTPUT, EXIT_DEPENDENCY, EXIT_BUG = 2, 3, 4, 5, 1
 
 
 def _parser():
     p = argparse.ArgumentParser(
         prog="femadh",
-        description="Adhesion of a sphere on an elastic flat: Lennard-Jones surface forces, "
-                    "the asperity sigma-gap and elasticity (Green function), swept in the "
-                    "separation d. Scenes are TOML files; see validation/scenes/ for examples.")
-    sub = p.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="solve a scene's force-separation sweep and write results",
-                       description="Solve a scene and write curve.csv, diagnostics.csv, "
-                                   "fields.csv, summary.json and fig3_panels.png.")
+        description="Adhesion of a sphere on an elastic flat (MEMS/NEMS stiction): "
+                    "Lennard-Jones surface forces, the asperity sigma-gap, capillary menisci "
+                    "and the elastic half-space (Green function or finite elements), swept in "
+                    "the separation d. Scenes are TOML files; see validation/scenes/ for "
+                    "examples and `femadh keys` for every key.",
+        epilog="exit codes: 0 done, 2 bad scene/arguments, 3 solve failed (states kept), "
+               "4 output not writable, 5 missing dependency, 130/143 interrupted.")
+    p.add_argument("--version", action="version", version=f"femadh {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    r = sub.add_parser("run", help="solve a scene and write its results and figures",
+                       description="Solve a scene; write curve.csv, diagnostics.csv, "
+                                   "fields.csv, jumps.csv, summary.json and its figures "
+                                   "(meniscus scenes: meniscus.csv, profiles.csv).")
     r.add_argument("scene", help="scene file (TOML)")
     r.add_argument("--out", help="output folder (default: the scene's [output] dir)")
+    g = r.add_mutually_exclusive_group()
+    g.add_argument("--overwrite", action="store_true",
+                   help="replace the results of a previous run in the output folder")
+    g.add_argument("--resume", action="store_true",
+                   help="continue an interrupted or failed run in the output folder")
     r.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     r.add_argument("--quiet", action="store_true", help="no progress bar or summary lines")
-    c = sub.add_parser("check", help="validate a scene file without solving it")
+    c = sub.add_parser("check", help="validate a scene without solving it",
+                       description="Validate every key, the optional dependencies the scene "
+                                   "needs and its memory estimate.")
     c.add_argument("scene", help="scene file (TOML)")
+    sub.add_parser("keys", help="print every scene key (markdown reference page)")
     m = sub.add_parser("mesh", help="build (or fetch from cache) the FE mesh of a scene",
                        description="Mesh the half-space of a scene with gmsh (cached by a hash "
                                    "of its parameters) and write it as .msh and .vtu.")
     m.add_argument("scene", help="scene file (TOML)")
     m.add_argument("--out", help="output folder (default: the scene's [output] dir)")
+    rd = sub.add_parser("render", help="PNG of an FE run's deformed zone (PyVista)",
+                        description="Render a state of an FE run off-screen: the deformed "
+                                    "near-contact zone coloured by a stress or displacement "
+                                    "field, and the surface pressure.")
+    rd.add_argument("run_dir", help="output folder of an FE run (with approach.pvd)")
+    rd.add_argument("--state", type=int, default=-1,
+                    help="state number (default: the last of the approach)")
+    rd.add_argument("--field", default="von_mises", help="field to colour by "
+                    "(default von_mises; e.g. sigma_zz, displacement)")
+    rd.add_argument("--png", help="output PNG (default RUN_DIR/render.png)")
     s = sub.add_parser("study", help="convergence and accuracy-vs-time studies",
                        description="convergence: the FE mesh ladder against the Green function "
                                    "on the scene's nodes, and the Green function in N; writes "
@@ -34,154 +71,238 @@ def _parser():
     s.add_argument("scene", help="scene file (TOML)")
     s.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
     s.add_argument("--out", help="output folder (default: <scene output dir>/study)")
-    g = sub.add_parser(
+    rg = sub.add_parser(
         "regime", help="smooth-sphere LJ adhesion map vs the Tabor parameter",
         description="Trace the force-separation curve of a smooth elastic sphere with LJ "
                     "surface forces (no sigma-gap) through its folds for a range of Tabor "
                     "parameters mu = (R dg^2/(E*^2 z0^3))^(1/3); writes regime.csv (pull-off / "
                     "pi R dg vs Maugis-Dugdale, jump-in/out d / z0, hysteresis), "
                     "regime_map.png and regime_curves.png.")
-    g.add_argument("--mu", type=float, nargs=2, default=(0.1, 5.0), metavar=("FROM", "TO"),
-                   help="Tabor parameter range (default 0.1 5)")
-    g.add_argument("--points", type=int, default=20, help="log-spaced points (default 20)")
-    g.add_argument("--radius", default="1 um", help="sphere radius (default '1 um')")
-    g.add_argument("--hamaker", default="1e-19 J", help="Hamaker constant (default '1e-19 J')")
-    g.add_argument("--z0", default="0.165 nm", help="LJ equilibrium distance (default "
-                                                    "'0.165 nm')")
-    g.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
+    rg.add_argument("--mu", type=float, nargs=2, default=(0.1, 5.0), metavar=("FROM", "TO"),
+                    help="Tabor parameter range (default 0.1 5)")
+    rg.add_argument("--points", type=int, default=20, help="log-spaced points (default 20)")
+    rg.add_argument("--radius", default="1 um", help="sphere radius (default '1 um')")
+    rg.add_argument("--hamaker", default="1e-19 J", help="Hamaker constant (default '1e-19 J')")
+    rg.add_argument("--z0", default="0.165 nm", help="LJ equilibrium distance (default "
+                                                     "'0.165 nm')")
+    rg.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
     return p
+
+
+def _error(msg):
+    for line in str(msg).splitlines() or [""]:
+        print(f"femadh: error: {line}", file=sys.stderr)
+
+
+def main(argv=None):
+    """Entry point; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        from ._threads import blas_threads
+
+        with blas_threads():
+            return _dispatch(args)
+    except SceneError as exc:
+        _error(exc)
+        return EXIT_SCENE
+    except DependencyError as exc:
+        _error(exc)
+        return EXIT_DEPENDENCY
+    except OutputError as exc:
+        _error(exc)
+        return EXIT_OUTPUT
+    except Interrupted as exc:
+        _error(f"{exc}; nothing was being written")
+        return exc.exit_code
+    except KeyboardInterrupt:
+        _error("interrupted")
+        return 130
+    except FemadhError as exc:
+        _error(exc)
+        return EXIT_SOLVE
+    except MemoryError:
+        _error("out of memory: reduce [solver] nodes or the sweep (femadh check estimates the "
+               "memory a scene needs)")
+        return EXIT_SCENE
+    except Exception as exc:     # a bug: one line, the traceback on request
+        if os.environ.get("FEMADH_DEBUG"):
+            raise
+        _error(f"internal error {type(exc).__name__}: {exc} (a bug in femadh; run with "
+               "FEMADH_DEBUG=1 for the traceback and please report it)")
+        return EXIT_BUG
+
+
+def _dispatch(args):
+    if args.command == "keys":
+        from .scene import reference_page
+
+        print(reference_page())
+        return 0
+    if args.command == "regime":
+        return _regime(args)
+    if args.command == "render":
+        return _render(args)
+    from .scene import load_scene
+    from .scene.resources import check_resources
+
+    scene = load_scene(args.scene)
+    check_resources(scene)
+    if args.command == "check":
+        return _check(scene, args.scene)
+    if args.command == "mesh":
+        _require_contact(scene, "mesh")
+        return _mesh(scene, args.out)
+    if args.command == "study":
+        _require_contact(scene, "study convergence")
+        return _study(scene, args)
+    return _run(scene, args)
+
+
+def _require_contact(scene, what):
+    if scene.kind != "contact":
+        raise SceneError(scene.path, "meniscus", "(a meniscus scene)",
+                         f"a contact scene: `femadh {what}` works on the elastic half-space "
+                         "of a contact scene")
+
+
+def _check(scene, path):
+    if scene.kind == "meniscus":
+        n = len(scene.liquids) * len(scene.radii) * len(scene.methods) * len(scene.p_ratios)
+        print(f"{path}: ok (meniscus: {len(scene.liquids)} liquids, {len(scene.radii)} radii, "
+              f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves)")
+        return 0
+    from .scene.resources import memory_estimate
+
+    mem, _ = memory_estimate(scene)
+    print(f"{path}: ok ({len(scene.d_values)} separations, {', '.join(scene.directions)}, "
+          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB)")
+    return 0
+
+
+def _run(scene, args):
+    from .runner.contact import run
+
+    out = args.out or scene.output_dir
+    res = run(scene, out, figures=not args.no_figures,
+              progress=False if args.quiet else None, overwrite=args.overwrite,
+              resume=args.resume)
+    if not args.quiet:
+        _report(res)
+    if res.status == "interrupted":
+        _error(f"{res.error}: the states computed before it are kept in {res.out_dir}; "
+               f"`femadh run {args.scene} --resume` continues the run")
+        return getattr(res, "exit_code", 130)
+    if res.status != "converged":
+        _error(f"{res.error}; what was computed before it is kept in {res.out_dir}")
+        return EXIT_SOLVE
+    return 0
+
+
+def _report(res):
+    if res.kind == "meniscus":
+        for (liq, R, meth), c in res.curves.items():
+            import numpy as np
+
+            ok = np.isfinite(c["force_over_4piRgamma"])
+            if ok.any():
+                k = int(np.nanargmax(c["force_over_4piRgamma"]))
+                print(f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: max F/4piRgamma = "
+                      f"{c['force_over_4piRgamma'][k]:.4f} at p/psat = {c['p_ratio'][k]:.3g}"
+                      + (f"  ({int((~ok).sum())} p/psat without meniscus)" if (~ok).any()
+                         else ""))
+        for e in res.errors[:5]:
+            print(f"femadh: note: no meniscus for {e['liquid']} R = {e['tip_radius_m']:g} m "
+                  f"{e['method']} at p/psat = {e['p_ratio']:g}: {e['error']}", file=sys.stderr)
+        print(f"results in {res.out_dir} ({res.wall_time:.2f} s)")
+        return
+    from .runner.report import headline_lines
+
+    for line in headline_lines(res):
+        print(line)
+    print(f"results in {res.out_dir} ({res.wall_time:.2f} s)")
+
+
+def _study(scene, args):
+    from .studies.convergence import convergence, default_progress, write_convergence
+
+    if not 1 <= args.levels <= 4:
+        raise SceneError("command line", "--levels", args.levels, "an integer from 1 to 4")
+    rows = convergence(scene, levels=args.levels, progress=default_progress())
+    path = write_convergence(rows, args.out or f"{scene.output_dir}/study", scene.name)
+    print(path.read_text())
+    return 0
 
 
 def _regime(args):
     import numpy as np
 
-    from .errors import SceneError
     from .studies.convergence import default_progress
     from .studies.regime import regime_map, write_regime
     from .units import to_si
 
     lo, hi = args.mu
-    if not (0 < lo < hi) or args.points < 1:
-        print("femadh: error: --mu needs 0 < FROM < TO and --points >= 1", file=sys.stderr)
-        return 2
-    try:
-        kw = {k: to_si(getattr(args, a), dim, file="command line", key=f"--{a}")
-              for k, a, dim in (("radius", "radius", "length"), ("hamaker", "hamaker", "energy"),
-                                ("z0", "z0", "length"))}
-    except SceneError as exc:
-        print(f"femadh: error: {exc}", file=sys.stderr)
-        return 2
-    mus = np.geomspace(lo, hi, args.points) if args.points > 1 else [lo]
-    say = default_progress()
-    pts = regime_map(mus, progress=(lambda i, p: say(
-        f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
-        if say else None, **kw)
-    path = write_regime(pts, args.out)
+    if not (0 < lo < hi):
+        raise SceneError("command line", "--mu", list(args.mu), "0 < FROM < TO")
+    if args.points < 1:
+        raise SceneError("command line", "--points", args.points, "an integer >= 1")
+    kw = {k: to_si(getattr(args, a), dim, file="command line", key=f"--{a}")
+          for k, a, dim in (("radius", "radius", "length"), ("hamaker", "hamaker", "energy"),
+                            ("z0", "z0", "length"))}
+    from .io.run_folder import RunFolder
+
+    # claim the folder first: a read-only or occupied --out fails before the map is computed
+    with RunFolder(args.out, "regime", "regime", "overwrite"):
+        mus = np.geomspace(lo, hi, args.points) if args.points > 1 else [lo]
+        say = default_progress()
+        pts = regime_map(mus, progress=(lambda i, p: say(
+            f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
+            if say else None, **kw)
+        path = write_regime(pts, args.out)
     print(path.read_text(), end="")
     print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")
     return 0
 
 
-def main(argv=None):
-    args = _parser().parse_args(argv)
-    if args.command == "regime":
-        return _regime(args)
-    from .runner.contact import run
-    from .scene import load_scene
+def _render(args):
+    from .io.render import render_run
 
-    try:
-        scene = load_scene(args.scene)
-        if args.command == "check":
-            if hasattr(scene, "p_ratios"):
-                print(f"{args.scene}: ok (meniscus: {len(scene.liquids)} liquids, "
-                      f"{len(scene.radii)} radii, {len(scene.p_ratios)} p/psat, "
-                      f"methods {', '.join(scene.methods)})")
-            else:
-                print(f"{args.scene}: ok ({len(scene.d_values)} separations, "
-                      f"{', '.join(scene.directions)}, {scene.nodes} nodes, {scene.method})")
-            return 0
-        if args.command == "mesh":
-            return _mesh(scene, args.out)
-        if args.command == "study":
-            from .studies.convergence import convergence, default_progress, write_convergence
-
-            if not 1 <= args.levels <= 4:
-                print("femadh: error: --levels must be 1 to 4", file=sys.stderr)
-                return 2
-            rows = convergence(scene, levels=args.levels, progress=default_progress())
-            path = write_convergence(rows, args.out or f"{scene.output_dir}/study", scene.name)
-            print(path.read_text())
-            return 0
-        if args.command == "run" and hasattr(scene, "p_ratios"):
-            return _run_meniscus(scene, args)
-        res = run(scene, args.out, figures=not args.no_figures,
-                  progress=False if args.quiet else None)
-    except FemadhError as exc:
-        print(f"femadh: error: {exc}", file=sys.stderr)
-        return 2
-    if not args.quiet:
-        for b, sw in res.sweeps.items():
-            c = res.curve(b)
-            k = c["F_ex"].argmax()
-            print(f"{b}: {len(sw.states)} states, max adhesion F_ex = {c['F_ex'][k] * 1e3:.4g} mN"
-                  f" at d = {c['d'][k] * 1e9:.3g} nm, F_LJ(d = {c['d'][-1] * 1e9:.3g} nm) = "
-                  f"{c['F_LJ'][-1] * 1e3:.4g} mN")
-        for j in res.jumps:
-            where = (f"±{j.resolution * 1e9:.1e} nm" if j.resolution > 0 else
-                     "traced fold, dd/ds = 0")
-            print(f"jump ({j.branch}): branch folds at d = {j.d_fold * 1e9:.4f} nm "
-                  f"({where}), h0 {j.before.h0 * 1e9:.3f} -> {j.after.h0 * 1e9:.3f} nm")
-        print(f"results in {res.out_dir} ({res.wall_time:.2f} s)")
-    if res.status != "converged":
-        print(f"femadh: error: {res.error}; states computed before it are kept in "
-              f"{res.out_dir}", file=sys.stderr)
-        return 3
-    return 0
-
-
-def _run_meniscus(scene, args):
-    from .runner.meniscus import run_meniscus
-
-    results, errors, wall = run_meniscus(scene, args.out, figures=not args.no_figures)
-    if not args.quiet:
-        for (liq, R, meth), res in results.items():
-            ok = [r for r in res if not isinstance(r, Exception)]
-            if ok:
-                best = max(ok, key=lambda r: r.force_over_4piRgamma)
-                print(f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: max F/4piRgamma = "
-                      f"{best.force_over_4piRgamma:.4f} at h = {best.film * 1e9:.3f} nm, "
-                      f"r_K = {best.kelvin_radius * 1e9:.3f} nm"
-                      + (f"  ({len(res) - len(ok)} p/psat without meniscus)" if len(ok) < len(res)
-                         else ""))
-        print(f"results in {args.out or scene.output_dir} ({wall:.2f} s)")
-    for e in errors[:5]:
-        print(f"femadh: note: no meniscus for {e['liquid']} R = {e['tip_radius_m']:g} m "
-              f"{e['method']} at p/psat = {e['p_ratio']:g}: {e['error']}", file=sys.stderr)
+    png = render_run(args.run_dir, state=args.state, field=args.field, png=args.png)
+    print(f"rendered {png}")
     return 0
 
 
 def _mesh(scene, out):
     from pathlib import Path
-    import shutil
 
-    import meshio
+    import numpy as np
 
     from .elastic import RadialGrid
     from .elastic.fe import FESettings, mesh_spec
     from .elastic.fe.mesh import cached_mesh, read_mesh
+    from .io.atomic import save_atomic
+
+    import meshio
+    import shutil
 
     st = scene.fe_settings or FESettings()
     grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
     spec = mesh_spec(grid, st)
-    src = cached_mesh(spec, progress=lambda m: print(m, file=sys.stderr))
     out = Path(out or scene.output_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    shutil.copy(src, out / "mesh.msh")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the output folder {out}: {exc.strerror}") from None
+    if not os.access(out, os.W_OK):
+        raise OutputError(f"output folder {out} is not writable")
+    src = cached_mesh(spec, progress=lambda m: print(m, file=sys.stderr))
+    save_atomic(out / "mesh.msh", lambda p: shutil.copy(src, p))
     p, tri = read_mesh(src, scale=grid.radius)
-    pts = __import__("numpy").column_stack([p, 0 * p[:, 0]])
-    meshio.write(out / "mesh.vtu", meshio.Mesh(pts, [("triangle", tri)]))
-    print(f"{len(p)} vertices, {len(tri)} triangles (P2: {2 * (len(p) + len(p) + len(tri))} "
-          f"DOFs approx.); mesh {spec.key()} -> {out / 'mesh.msh'} (cached at {src})")
+    pts = np.column_stack([p, 0 * p[:, 0]])
+    save_atomic(out / "mesh.vtu",
+                lambda f: meshio.write(f, meshio.Mesh(pts, [("triangle", tri)]),
+                                       file_format="vtu"))
+    print(f"{len(p)} vertices, {len(tri)} triangles; mesh {spec.key()} -> {out / 'mesh.msh'} "
+          f"(cached at {src})")
     return 0
 
 

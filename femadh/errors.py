@@ -19,6 +19,17 @@ class SceneError(FemadhError, ValueError):
         super().__init__(f"{where}[{key}] = {shown}: expected {expected}")
 
 
+class SceneErrors(SceneError):
+    """Several things wrong with one scene: all of them, one per line (``errors``)."""
+
+    def __init__(self, errors):
+        self.errors = list(errors)
+        first = self.errors[0]
+        self.file, self.key, self.value, self.expected = (first.file, first.key, first.value,
+                                                          first.expected)
+        Exception.__init__(self, "\n".join(str(e) for e in self.errors))
+
+
 class _Missing:
     def __repr__(self):
         return "(missing)"
@@ -52,6 +63,27 @@ class LawError(FemadhError, ValueError):
 
 class DomainError(FemadhError, ValueError):
     """A physical model is asked for a state outside its domain of validity."""
+
+
+class OutputError(FemadhError, OSError):
+    """An output file or folder cannot be written (permissions, disk full, a file where a
+    folder is needed, a folder in use or holding another run): names the path and why."""
+
+
+class DependencyError(FemadhError, ImportError):
+    """An optional dependency a scene needs is not installed: says which extra to install."""
+
+
+class Interrupted(FemadhError):
+    """A run stopped by SIGINT or SIGTERM at a safe point (completed states are kept)."""
+
+    def __init__(self, signum):
+        import signal
+
+        self.signum = signum
+        self.exit_code = 128 + signum
+        name = signal.Signals(signum).name
+        super().__init__(f"interrupted by {name}")
 
 
 class MeshResolutionWarning(UserWarning):

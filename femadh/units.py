@@ -29,17 +29,35 @@ DIMENSIONS = {
 }
 
 
-def to_si(value, dimension, *, file=None, key=None):
+_NUMBER_UNIT = None
+
+
+def _split(text):
+    """('25', 'degC') from '25 degC': offset units (degC, degF) need the magnitude apart."""
+    import re
+
+    global _NUMBER_UNIT
+    if _NUMBER_UNIT is None:
+        _NUMBER_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+    m = _NUMBER_UNIT.match(text)
+    return (m.group(1), m.group(2)) if m else (None, None)
+
+
+def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     """Convert a scene value to a float in SI units.
 
     Parameters
     ----------
     value : str or float or int
-        ``"2 mm"``-style string (any unit pint knows) or a plain number, taken as SI.
+        ``"2 mm"``-style string (any unit pint knows, offset temperatures such as "25 degC"
+        included) or a plain number, taken as SI.
     dimension : str
         One of :data:`DIMENSIONS`.
     file, key : str, optional
         Where the value came from, for the error message.
+    bare_numbers : bool
+        Whether a plain number is accepted as SI for a dimensional quantity. Scene *files*
+        refuse it (``radius = 2`` would silently mean 2 m); scenes built in code accept it.
 
     Raises
     ------
@@ -50,16 +68,22 @@ def to_si(value, dimension, *, file=None, key=None):
     if isinstance(value, bool):
         raise SceneError(file, key, value, words)
     if isinstance(value, (int, float)):
+        if not bare_numbers and dimension != "dimensionless":
+            raise SceneError(file, key, value, f"{words}: a bare number has no unit (write it "
+                             f"with its unit, e.g. '{value:g} {si.replace('^', '')}' if SI is "
+                             "meant)")
         return float(value)
     if not isinstance(value, str):
         raise SceneError(file, key, value, words)
     ureg = _registry()
     try:
-        q = ureg.Quantity(value.replace("^", "**"))
+        mag, unit = _split(value)
+        if mag is not None and unit:
+            q = ureg.Quantity(float(mag), unit.replace("^", "**"))
+        else:
+            q = ureg.Quantity(value.replace("^", "**"))
     except Exception as exc:  # pint raises many types for unparsable input
         raise SceneError(file, key, value, f"{words} (could not parse: {exc})") from None
-    if dimension == "temperature" and not q.dimensionless and q.check("[temperature]"):
-        return float(q.to("K").magnitude)
     if not isinstance(q, ureg.Quantity):
         return float(q)
     if dimension == "dimensionless":
@@ -67,8 +91,7 @@ def to_si(value, dimension, *, file=None, key=None):
             raise SceneError(file, key, value, words)
         return float(q.to("").magnitude)
     if q.dimensionless:
-        raise SceneError(file, key, value, f"{words}; a bare number in a string has no unit "
-                         f"(write it as a plain TOML number to mean SI)")
+        raise SceneError(file, key, value, f"{words}; a bare number in a string has no unit")
     if not q.check(dim):
         raise SceneError(file, key, value, f"{words}, but it has units of {q.units:~}")
     return float(q.to(si.replace("^", "**")).magnitude)

@@ -59,7 +59,7 @@ def check_curve_against_fields(out_dir, rel=1e-12):
     fields = list(csv.DictReader(open(out / "fields.csv")))
     groups, order = {}, []
     for r in fields:
-        key = (r["branch"], r["d_m"])
+        key = (r["state"], r["branch"], r["d_m"])
         if key not in groups:
             groups[key] = []
             order.append(key)
@@ -69,7 +69,7 @@ def check_curve_against_fields(out_dir, rel=1e-12):
              "F_cap_N": ("P_cap_Pa", 1.0), "F_LJa_N": ("P_LJa_Pa", 1.0),
              "F_ela_N": ("P_ela_Pa", -1.0)}
     for row, key in zip(curve, order):
-        assert (row["branch"], row["d_m"]) == key
+        assert (row["state"], row["branch"], row["d_m"]) == key
         rows = groups[key]
         r = np.array([float(x["r_m"]) for x in rows])
         edges = np.concatenate([[0.0], 0.5 * (r[1:] + r[:-1]), [a]])

@@ -132,15 +132,16 @@ def test_scene_with_arclength_continuation_matches_stepping(tmp_path):
     assert ra.status == rs.status == "converged"
     res = 0.1e-9 * 2.0**-10 * 1.01
     for b in ("approach", "retract"):
-        ja, js = ra.sweeps[b].jumps, rs.sweeps[b].jumps
+        ja = [j for j in ra.jumps if j["branch"] == b]
+        js = [j for j in rs.jumps if j["branch"] == b]
         assert len(ja) == len(js) == 1
-        assert ja[0].d_fold == pytest.approx(js[0].d_fold, abs=res)
+        assert ja[0]["d_fold_m"] == pytest.approx(js[0]["d_fold_m"], abs=res)
     rows = list(csv.DictReader(open(tmp_path / "arc" / "equilibrium_curve.csv")))
     assert any(r["stable"] == "False" for r in rows)
     signs = np.sign([float(r["dd_ds"]) for r in rows])
     assert np.count_nonzero(np.diff(signs)) == 2           # two folds: one S
     assert check_curve_against_fields(tmp_path / "arc") == sum(
-        len(ra.sweeps[b].states) for b in ra.sweeps)
+        len(c["d_m"]) for c in ra.branches.values())
 
 
 def test_arclength_with_sigma_gap_is_a_scene_error(tmp_path):

@@ -13,7 +13,7 @@ import pytest
 from femadh.contact import AsperityGap, ContactProblem
 from femadh.contact import closure as cl
 from femadh.contact.closure import trace as cl_trace
-from femadh.laws import AsperityAdhesion, LennardJones
+from femadh.laws import LennardJones, eq20_pressure
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.errors import ConvergenceError
 from femadh.indenter import Sphere
@@ -26,12 +26,11 @@ R2MM = 2e-3
 TOL = 1e-19  # the scenes' tolerance, 1e-10 nm
 
 
-def problem(n, sigma, *, hamaker=HAMAKER, extra=None, laws=None, check_laws=True):
+def problem(n, sigma, *, hamaker=HAMAKER, adhesion=0.0, laws=None, check_laws=True):
     a = math.sqrt(2 * R2MM * 10e-9)                 # delta = a^2/2R = 10 nm, as the paper
     eff = laws if laws is not None else {"lj": LennardJones(hamaker, Z0)}
-    eff = dict(eff, **(extra or {}))
     return ContactProblem(GreenOperator(RadialGrid.uniform(a, n), E_STAR), Sphere(R2MM), eff,
-                          AsperityGap(sigma, "hertz-closure"), check_laws=check_laws)
+                          AsperityGap(sigma, "hertz-closure", adhesion), check_laws=check_laws)
 
 
 def grid(start, stop, step=0.2):
@@ -269,16 +268,16 @@ def test_asperity_adhesion_acts_over_the_contact_only():
     """Eq 20 in the closure: the constant P_LJa on r < r_c (force P_LJa pi r_c^2 exactly); it
     makes touch-down a snap and raises the adhesion (sec 6, rho = 179 um^-2, sigma = 1.08 nm)."""
     sigma = 1.08e-9
-    ad = AsperityAdhesion.from_asperities(0.94e-6, 0.06, 179e12, 0.5, sigma)
+    p_lja = eq20_pressure(0.94e-6, 0.06, 179e12, 0.5)
     p0 = problem(100, sigma)
-    p1 = problem(100, sigma, extra={"asperity_adhesion": ad})
+    p1 = problem(100, sigma, adhesion=p_lja)
     ds = grid(1.4, 0.4)
     s0 = cl.trace_closure(p0, ds, branch="approach", tol=TOL)
     s1 = cl.trace_closure(p1, ds, branch="approach", tol=TOL)
     for s in s1.states:
         F_a = p1.grid.force(s.p_effects["asperity_adhesion"])
         # measured 2.2e-16 relative
-        assert F_a == pytest.approx(ad.pressure_value * math.pi * s.r_c**2, rel=2e-15, abs=0)
+        assert F_a == pytest.approx(p_lja * math.pi * s.r_c**2, rel=2e-15, abs=0)
     f0 = max(state_forces(p0, s)[2] for s in s0.states)
     f1 = max(state_forces(p1, s)[2] for s in s1.states)
     # eq 20's pull grows with the contact (P_LJa D(r_c, r_c) ~ r_c): touch-down is a fold and

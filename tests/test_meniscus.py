@@ -140,8 +140,8 @@ def test_meniscus_scene_runs_and_writes(tmp_path):
     from femadh.runner.meniscus import HEADER
 
     sc = femadh.load_scene("validation/scenes/paper2_ethanol_100nm.toml")
-    results, errors, _ = femadh.run(sc, str(tmp_path))
-    assert not errors
+    res = femadh.run(sc, str(tmp_path))
+    assert res.status == "converged" and not res.errors
     lines = (tmp_path / "meniscus.csv").read_text().splitlines()
     assert lines[0].startswith("method,p_ratio,film_m,kelvin_radius_m,force_N,"
                                "force_over_4piRgamma,neck_radius_m")

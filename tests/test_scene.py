@@ -40,8 +40,8 @@ def test_fig3_scene_loads_in_si():
 
 @pytest.mark.parametrize("old,new,key,expect", [
     ('poisson_ratio = 0.3', 'poisson_ratio = 0.5', "materials.disk.poisson_ratio", "(-1, 0.5)"),
-    ('"163 GPa"', '"-163 GPa"', "materials.disk.youngs_modulus", "positive"),
-    ('sigma = "1.0 nm"', 'sigma = "0 nm"', "effects.asperity_gap.sigma", "positive"),
+    ('"163 GPa"', '"-163 GPa"', "materials.disk.youngs_modulus", "a pressure > 0"),
+    ('sigma = "1.0 nm"', 'sigma = "0 nm"', "effects.asperity_gap.sigma", "a length > 0"),
     ('radius = "2 mm"', 'radius = "2 GPa"', "sphere.radius", "length"),
     ('stop = "-5 nm"', 'stop = "5 nm"', "sweep.stop", "below start"),
     ('nodes = 200', 'nodez = 200', "solver.nodez", "no such key"),

@@ -181,7 +181,7 @@ def _hessian_stable(problem, w, d):
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
-                max_points=5000, progress=None):
+                max_points=5000, progress=None, on_point=None):
     """Follow the equilibrium curve from separation d_start until it passes d_end (m).
 
     Parameters
@@ -200,6 +200,8 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         Largest step length (default: 20 * ds).
     progress : callable(float), optional
         Called with the fraction of |d_end - d_start| covered so far.
+    on_point : callable(int, CurvePoint), optional
+        Called with each point as it is accepted (streams it to disk; may raise to stop).
 
     Notes
     -----
@@ -239,6 +241,8 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     curve.points.append(CurvePoint(d_start, st.w.copy(), t, _hessian_stable(problem, st.w,
                                                                              d_start),
                                    st.n_iter, st.residual))
+    if on_point:
+        on_point(0, curve.points[0])
     step, ds_min = ds, ds * MIN_STEP_FRACTION
     weights = np.r_[np.full(n, tr.omega), 1.0]
 
@@ -320,7 +324,9 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         if progress:
             progress(min(1.0, (d - d_start) / (d_end - d_start)))
         if direction * (d - d_end) >= 0:
-            break
+            break           # (the last point is recomputed at d_end before it is streamed)
+        if on_point:
+            on_point(len(curve.points) - 1, q)
         if len(curve.points) >= max_points:
             raise fail(f"arclength continuation needed more than {max_points} points",
                        d, res, it)
@@ -333,6 +339,8 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             raise fail(f"arclength end point: {exc}", d_end, math.nan, 0) from None
         curve.points[-1] = CurvePoint(d_end, w, tr.tangent(w, d_end, b.t), b.stable, b.n_iter,
                                       _residual(problem, w, d_end))
+    if on_point and len(curve.points) > 1:
+        on_point(len(curve.points) - 1, curve.points[-1])
     curve.n_factor = tr.lin.n_factor
     curve.n_krylov = tr.lin.n_krylov
     curve.wall_time = time.perf_counter() - t0

@@ -40,8 +40,14 @@ def _damping(h, dh_closing):
     return float(min(1.0, np.min(MAX_GAP_CLOSURE * h[closing] / dh_closing[closing])))
 
 
-def _effect_pressures(problem, h):
-    return {name: eff.pressure(h) for name, eff in problem.effects.items()}
+def _effect_pressures(problem, h, A=None):
+    """Each law's pressure at gaps h; with the eq 20 adhesion on the contact set (A), its
+    P_LJa on the contact nodes as "asperity_adhesion"."""
+    out = {name: eff.pressure(h) for name, eff in problem.effects.items()}
+    adh = problem.gap.adhesion if problem.gap is not None else 0.0
+    if adh and A is not None:
+        out["asperity_adhesion"] = np.where(A, adh, 0.0)
+    return out
 
 
 def _residual(problem, w, p_net):
@@ -68,6 +74,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     """
     K, b = problem.K, problem.contour(d)
     sigma = problem.sigma
+    adhesion = problem.gap.adhesion if problem.gap is not None else 0.0
     n = b.size
     chord_rate = CHORD_RATE_LARGE if n > LARGE_N else CHORD_RATE
     w = np.array(w0, dtype=float)
@@ -128,7 +135,9 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         pc = np.zeros(n)
         if sigma is not None:
             pc[A] = P[A] - (K @ w)[A]
-            new_A = (A & (pc > 0)) | (I & (h < sigma))
+            # a contact node stays while its asperities push (lambda = pc + P_LJa > 0: with
+            # eq 20 on the contact set it holds a net tension up to P_LJa) ...
+            new_A = (A & (pc + adhesion > 0)) | (I & (h < sigma))
         else:
             new_A = A
         res = _residual(problem, w, P - pc)
@@ -148,7 +157,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     pc = np.zeros(n)
     if sigma is not None and np.all(h[~A] > 0):
         pc[A] = problem.pressure(h)[A] - (K @ w)[A]
-    return State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300)), pc, A,
+    return State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300), A),
+                 _contact_pressure(problem, pc, A), A,
                  _area_radius(problem, A), it, res, False, False, None)
 
 
@@ -171,8 +181,16 @@ def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
     free nodes (:func:`femadh.contact.stability.is_stable`), never read off the Newton
     factorisation (that one is of the collocation Jacobian, whose pivot signs do not give
     the Hessian's inertia)."""
-    return State(d, w, h, _effect_pressures(problem, h), pc, A.copy(),
-                 _area_radius(problem, A), it, res, True, is_stable(problem, h, ~A), factor)
+    return State(d, w, h, _effect_pressures(problem, h, A), _contact_pressure(problem, pc, A),
+                 A.copy(), _area_radius(problem, A), it, res, True, is_stable(problem, h, ~A),
+                 factor)
+
+
+def _contact_pressure(problem, pc, A):
+    """The asperities' elastic (repulsive) pressure lambda >= 0 on the contact nodes: the net
+    contact traction pc plus the eq 20 adhesion they carry (pc alone without it)."""
+    adh = problem.gap.adhesion if problem.gap is not None else 0.0
+    return pc + adh * A if adh else pc
 
 
 def tangent(problem, state):

@@ -22,7 +22,7 @@ def solve_state(problem, d, w0, *, tol, max_iter=40, **kw):
 
 
 def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
-          progress=None):
+          on_jump=None, progress=None):
     """Follow the stable equilibrium through the separations ``d_values`` (m), folds located
     and landed on; returns a :class:`~femadh.contact.stepping.Sweep`. Raises ConvergenceError
     with the partial sweep attached (``exc.sweep``)."""
@@ -30,11 +30,12 @@ def trace(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=N
         from .closure import trace_closure
 
         sweep = trace_closure(problem, d_values, branch=branch, tol=tol, start=start,
-                              max_iter=max_iter, on_state=on_state)
+                              max_iter=max_iter, on_state=on_state, on_jump=on_jump)
         if progress:
             progress(len(d_values) - 1)
         return sweep
     from .stepping import trace_steps
 
     return trace_steps(problem, d_values, branch=branch, tol=tol, start=start,
-                       max_iter=max_iter, on_state=on_state, progress=progress)
+                       max_iter=max_iter, on_state=on_state, on_jump=on_jump,
+                       progress=progress)

@@ -90,7 +90,7 @@ def _predict(problem, state, d):
 
 
 def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
-                progress=None):
+                on_jump=None, progress=None):
     """Follow the stable equilibrium through the separations ``d_values`` (m).
 
     Parameters
@@ -106,6 +106,8 @@ def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_s
         Converged state at d_values[0] to continue from (else solved from w = 0).
     on_state : callable(State), optional
         Called with each converged grid state as soon as it exists (writes it to disk).
+    on_jump : callable(Jump), optional
+        Called with each fold and its landing as soon as it is found.
     progress : callable(int), optional
         Called with the number of grid steps finished.
 
@@ -119,7 +121,8 @@ def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_s
     sweep = Sweep(branch)
     try:
         return _trace(sweep, problem, d_values, branch=branch, tol=tol, start=start,
-                      max_iter=max_iter, on_state=on_state, progress=progress)
+                      max_iter=max_iter, on_state=on_state, on_jump=on_jump,
+                      progress=progress)
     except ConvergenceError as exc:
         # every failure carries the states computed so far and the separation it happened at
         if exc.d is None and math.isfinite(sweep.d_current):
@@ -131,7 +134,8 @@ def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_s
         raise
 
 
-def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, progress):
+def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, on_jump,
+           progress):
     """The body of :func:`trace_steps`, filling ``sweep`` as it goes."""
     t0 = time.perf_counter()
     d_values = [float(x) for x in d_values]
@@ -193,6 +197,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             sweep.n_solves += 1
             _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol, sweep)
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
+            if on_jump:
+                on_jump(sweep.jumps[-1])
             jumps_here += 1
             if jumps_here > MAX_JUMPS_PER_STEP:
                 # fold after fold at the smallest step: not a physical snap but a branch the

@@ -1,5 +1,17 @@
-"""Figures a researcher would draw from a run (matplotlib, Agg backend, PNG)."""
+"""Figures a researcher would draw for a run (matplotlib, Agg backend, PNG, written atomically).
+
+- every contact scene: ``force_curve.png`` - force on the sphere against separation, approach
+  and retract, each active effect's force, the jumps, a zoom on the adhesion peak, the DMT and
+  JKR pull-off of the scene's own work of adhesion; for arclength runs the traced equilibrium
+  curve with its unstable branch;
+- sigma-gap LJ scenes (paper 1 Figs 3-4): ``fig3_panels.png`` - the paper's panels (deformation,
+  LJ and contact pressure profiles, forces, contact radius with JKR/DMT, iterations);
+- meniscus scenes: ``meniscus_force.png`` (paper 2 Fig 1 style); regime maps: their figures.
+Units are chosen from the magnitudes (nm or um, pN ... mN).
+"""
 import numpy as np
+
+from .atomic import save_atomic
 
 
 def _pyplot():
@@ -9,68 +21,187 @@ def _pyplot():
     return plt
 
 
-def paper1_panels(result, path, *, max_profiles=12):
+def force_unit(values):
+    """(scale, label) so that values * scale are between 1 and 1000 in the returned unit."""
+    m = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
+    for scale, label in ((1e12, "pN"), (1e9, "nN"), (1e6, "µN"), (1e3, "mN")):
+        if m * scale < 1000:
+            return scale, label
+    return 1.0, "N"
+
+
+def length_unit(values):
+    """(scale, label) for lengths: nm below 1 um, else um (mm above 1 mm)."""
+    m = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
+    if m < 1e-6:
+        return 1e9, "nm"
+    if m < 1e-3:
+        return 1e6, "µm"
+    return 1e3, "mm"
+
+
+def contact_figures(res, folder):
+    """The figures of a contact run into ``folder``; returns their paths."""
+    from pathlib import Path
+
+    folder = Path(folder)
+    paths = [force_curve(res, folder / "force_curve.png")]
+    sc = res.scene
+    if "lj" in sc.effects and sc.gap is not None and res.profiles:
+        paths.append(paper1_panels(res, folder / "fig3_panels.png"))
+    return paths
+
+
+def _effect_lines(res):
+    """(column, sign on the sphere, label) of each force the run has: the force on the
+    sphere is minus the force on the disk."""
+    from ..laws.registry import outputs
+
+    labels = {o.force: o.label for o in outputs().values()}
+    out = [("F_ex_N", -1.0, "total (−F_ex)")]
+    cols = next(iter(res.branches.values())).keys()
+    for c in cols:
+        if c.startswith("F_") and c not in ("F_ex_N",):
+            if c == "F_el_N":
+                out.append((c, 1.0, "asperity contact (σ-gap)"))
+            else:
+                sign = -1.0 if c != "F_ela_N" else 1.0
+                out.append((c, sign, labels.get(c, c)))
+    return out
+
+
+def force_curve(res, path):
+    """Force on the sphere (adhesive negative) against the separation d."""
+    plt = _pyplot()
+    sc = res.scene
+    allF = np.concatenate([c["F_ex_N"] for c in res.branches.values()])
+    alld = np.concatenate([c["d_m"] for c in res.branches.values()])
+    fs, fl = force_unit(allF)
+    ls, ll = length_unit(alld)
+    fig, ax = plt.subplots(figsize=(8.5, 5.2))
+    styles = {"approach": "-", "retract": "--"}
+    lines = _effect_lines(res)
+    for i, (col, sign, label) in enumerate(lines):
+        for b, c in res.branches.items():
+            if col not in c or (col != "F_ex_N" and not np.any(c[col])):
+                continue
+            ax.plot(c["d_m"] * ls, sign * c[col] * fs, styles.get(b, "-"),
+                    color="k" if col == "F_ex_N" else f"C{i}",
+                    lw=2 if col == "F_ex_N" else 1,
+                    label=f"{label}, {b}")
+    if res.equilibrium_curve is not None and len(res.equilibrium_curve["d_m"]):
+        e = res.equilibrium_curve
+        Fu = np.where(~e["stable"], -e["F_ex_N"], np.nan)
+        ax.plot(e["d_m"] * ls, Fu * fs, ":", color="grey", lw=1.5,
+                label="unstable equilibria (traced)")
+    for j in res.jumps:
+        ax.annotate("", xy=(j["d_land_m"] * ls, -j["F_ex_after_N"] * fs),
+                    xytext=(j["d_fold_m"] * ls, -j["F_ex_before_N"] * fs),
+                    arrowprops={"arrowstyle": "->", "color": "C3", "lw": 1.2})
+    hl = res.headline
+    if hl.get("work_of_adhesion_J_per_m2"):
+        W = hl["work_of_adhesion_J_per_m2"]
+        for val, name, st in ((hl["dmt_pull_off_N"], "DMT 2πRW", "-."),
+                              (hl["jkr_pull_off_N"], "JKR 1.5πRW", ":")):
+            ax.axhline(-val * fs, color="grey", ls=st, lw=0.8,
+                       label=f"{name} (W = {W:.3g} J/m²)")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set(xlabel=f"separation d ({ll})", ylabel=f"force on the sphere ({fl}), adhesion < 0",
+           title=f"{sc.name}: R = {sc.sphere.radius * length_unit([sc.sphere.radius])[0]:g} "
+                 f"{length_unit([sc.sphere.radius])[1]}, E* = {sc.e_star / 1e9:.3g} GPa"
+                 + (f", σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})"
+                    if sc.gap else ", smooth sphere"))
+    _adhesion_zoom(ax, res, fs, ls)
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    save_atomic(path, lambda p: fig.savefig(p, dpi=110))
+    plt.close(fig)
+    return path
+
+
+def _adhesion_zoom(ax, res, fs, ls):
+    """An inset around the adhesion peak when the repulsive range dwarfs it."""
+    tot = -np.concatenate([c["F_ex_N"] for c in res.branches.values()])
+    d = np.concatenate([c["d_m"] for c in res.branches.values()])
+    peak = float(np.min(tot))
+    if peak >= 0 or np.max(tot) < 5 * abs(peak):
+        return
+    k = int(np.argmin(tot))
+    near = np.abs(tot) <= 3 * abs(peak)
+    ins = ax.inset_axes([0.08, 0.45, 0.38, 0.4])
+    for b, c in res.branches.items():
+        sel = np.abs(c["F_ex_N"]) <= 3 * abs(peak)
+        ins.plot(c["d_m"][sel] * ls, -c["F_ex_N"][sel] * fs, "-" if b == "approach" else "--",
+                 color="k", lw=1.2)
+    ins.axhline(0, color="k", lw=0.5)
+    ins.set_title(f"adhesion peak {peak * fs:.4g} at d = {d[k] * ls:.3g}", fontsize=7)
+    ins.tick_params(labelsize=6)
+    ins.set_xlim(np.min(d[near]) * ls, np.max(d[near]) * ls)
+    ins.grid(alpha=0.3)
+
+
+def paper1_panels(res, path):
     """Paper 1 Fig 3-style panels: (a) w(r), (b) P_LJ(r), (c) P_el(r), (d) forces vs d,
-    (e) r_c vs -F_ex, (f) iterations and -log10(residual) per step."""
-    from ..reference import dmt_contact_radius, jkr_contact_radius, surface_energy_from_hamaker
+    (e) r_c vs -F_ex with JKR/DMT of the scene's own work of adhesion, (f) iterations and
+    -log10(residual) per state."""
+    from ..reference import dmt_contact_radius, jkr_contact_radius
 
     plt = _pyplot()
-    problem, scene = result.problem, result.scene
-    r_um = problem.grid.nodes * 1e6
+    sc = res.scene
+    rs, rl = length_unit(res.nodes)
     fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
     ax = ax.ravel()
-    first = next(iter(result.sweeps))
-    states = result.sweeps[first].states
-    pick = states[:: max(1, len(states) // max_profiles)]
+    first = next(iter(res.profiles))
+    prof = res.profiles[first]
     cmap = plt.get_cmap("viridis")
-    for i, s in enumerate(pick):
-        c = cmap(i / max(1, len(pick) - 1))
-        lbl = f"{s.d * 1e9:.2f}"
-        ax[0].plot(r_um, s.w * 1e9, color=c, label=lbl)
-        ax[1].plot(r_um, s.p_effects.get("lj", 0 * s.w) * 1e-6, color=c)
-        ax[2].plot(r_um, s.p_contact * 1e-6, color=c)
-    ax[0].set(xlabel="r (µm)", ylabel="w (nm)", title=f"(a) disk deformation, {first}")
+    n = len(prof["d_m"])
+    for i in range(n):
+        c = cmap(i / max(1, n - 1))
+        ax[0].plot(res.nodes * rs, prof["w_m"][i] * 1e9, color=c,
+                   label=f"{prof['d_m'][i] * 1e9:.2f}")
+        ax[1].plot(res.nodes * rs, prof["P_LJ_Pa"][i] * 1e-6, color=c)
+        ax[2].plot(res.nodes * rs, prof["P_el_Pa"][i] * 1e-6, color=c)
+    ax[0].set(xlabel=f"r ({rl})", ylabel="w (nm)", title=f"(a) disk deformation, {first}")
     ax[0].legend(title="d (nm)", fontsize=6, ncol=2)
-    ax[1].set(xlabel="r (µm)", ylabel="P_LJ (MPa)", title="(b) LJ pressure")
-    ax[2].set(xlabel="r (µm)", ylabel="P_el (MPa)", title="(c) contact pressure")
+    ax[1].set(xlabel=f"r ({rl})", ylabel="P_LJ (MPa)", title="(b) LJ pressure")
+    ax[2].set(xlabel=f"r ({rl})", ylabel="P_el (MPa)", title="(c) contact pressure")
+    allF = np.concatenate([np.abs(c[k]) for c in res.branches.values()
+                           for k in ("F_LJ_N", "F_ex_N", "F_el_N")])
+    fs, fl = force_unit(allF)
     styles = {"approach": "-o", "retract": "--s"}
-    for b in result.sweeps:
-        c = result.curve(b)
+    for b, c in res.branches.items():
         st = styles.get(b, "-")
-        ax[3].plot(c["d"] * 1e9, -c["F_LJ"] * 1e3, st, ms=3, label=f"-F_LJ {b}")
-        ax[3].plot(c["d"] * 1e9, -c["F_ex"] * 1e3, st, ms=3, label=f"-F_ex {b}")
-        ax[3].plot(c["d"] * 1e9, c["F_el"] * 1e3, st, ms=3, label=f"F_el {b}")
-        ax[4].plot(-c["F_ex"] * 1e3, c["r_c"] * 1e6, st, ms=3, label=f"femadh {b}")
-        sw = result.sweeps[b]
-        ax[5].plot([s.d * 1e9 for s in sw.states], [s.n_iter for s in sw.states], st, ms=3,
-                   label=f"iterations {b}")
-        ax[5].plot([s.d * 1e9 for s in sw.states],
-                   [-np.log10(max(s.residual / 1e-9, 1e-300)) for s in sw.states], st, ms=3,
-                   label=f"-log10(residual/nm) {b}")
-    for j in result.jumps:
-        ax[3].axvline(j.d_fold * 1e9, color="grey", lw=0.8, ls=":")
-    ax[3].set(xlabel="d (nm)", ylabel="force on slider (mN)", title="(d) forces vs separation")
+        ax[3].plot(c["d_m"] * 1e9, -c["F_LJ_N"] * fs, st, ms=3, label=f"-F_LJ {b}")
+        ax[3].plot(c["d_m"] * 1e9, -c["F_ex_N"] * fs, st, ms=3, label=f"-F_ex {b}")
+        ax[3].plot(c["d_m"] * 1e9, c["F_el_N"] * fs, st, ms=3, label=f"F_el {b}")
+        ax[4].plot(-c["F_ex_N"] * fs, c["r_c_m"] * rs, st, ms=3, label=f"femadh {b}")
+        ax[5].plot(c["d_m"] * 1e9, c["n_iter"], st, ms=3, label=f"iterations {b}")
+        ax[5].plot(c["d_m"] * 1e9, -np.log10(np.maximum(c["residual_m"] / 1e-9, 1e-300)), st,
+                   ms=3, label=f"-log10(residual/nm) {b}")
+    for j in res.jumps:
+        ax[3].axvline(j["d_fold_m"] * 1e9, color="grey", lw=0.8, ls=":")
+    ax[3].set(xlabel="d (nm)", ylabel=f"force on slider ({fl})", title="(d) forces vs separation")
     ax[3].legend(fontsize=7)
-    if "lj" in scene.effects and scene.gap is not None:
-        lj = scene.effects["lj"]
-        dg = surface_energy_from_hamaker(lj.hamaker, scene.gap.sigma, lj.z0)  # eq 17
-        allF = np.concatenate([-result.curve(b)["F_ex"] for b in result.sweeps])
-        F = np.linspace(min(allF.min(), -2 * np.pi * scene.sphere.radius * dg), allF.max(), 200)
-        R, E = scene.sphere.radius, scene.e_star
-        ax[4].plot(F * 1e3, [jkr_contact_radius(f, R, E, dg) * 1e6 for f in F], "k-", lw=1,
-                   label="JKR (eq 17 Δγ)")
-        ax[4].plot(F * 1e3, [dmt_contact_radius(f, R, E, dg) * 1e6 for f in F], "k--", lw=1,
-                   label="DMT (eq 17 Δγ)")
-    ax[4].set(xlabel="-F_ex, force on slider (mN)", ylabel="r_c (µm)", title="(e) contact radius")
+    W = res.headline.get("work_of_adhesion_J_per_m2")
+    if W:
+        allEx = np.concatenate([-c["F_ex_N"] for c in res.branches.values()])
+        R, E = sc.sphere.radius, sc.e_star
+        F = np.linspace(min(allEx.min(), -2 * np.pi * R * W), allEx.max(), 200)
+        ax[4].plot(F * fs, [jkr_contact_radius(f, R, E, W) * rs for f in F], "k-", lw=1,
+                   label=f"JKR (W = {W:.3g} J/m²)")
+        ax[4].plot(F * fs, [dmt_contact_radius(f, R, E, W) * rs for f in F], "k--", lw=1,
+                   label="DMT")
+    ax[4].set(xlabel=f"-F_ex, force on slider ({fl})", ylabel=f"r_c ({rl})",
+              title="(e) contact radius")
     ax[4].legend(fontsize=7)
     ax[5].set(xlabel="d (nm)", title="(f) iterations, -log10 residual")
     ax[5].legend(fontsize=7)
-    fig.suptitle(f"{scene.name}: R = {scene.sphere.radius * 1e3:g} mm, "
-                 f"E* = {scene.e_star / 1e9:.1f} GPa, "
-                 + (f"σ = {scene.gap.sigma * 1e9:g} nm ({scene.gap.contact_model})"
-                    if scene.gap else "smooth sphere"))
+    Rs, Rl = length_unit([sc.sphere.radius])
+    fig.suptitle(f"{sc.name}: R = {sc.sphere.radius * Rs:g} {Rl}, E* = {sc.e_star / 1e9:.1f} GPa, "
+                 f"σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_atomic(path, lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
     return path
 
@@ -111,7 +242,7 @@ def regime_figures(pts, out_dir):
     for a in ax:
         a.grid(alpha=0.3, which="both")
     fig.tight_layout()
-    fig.savefig(out / "regime_map.png", dpi=110)
+    save_atomic(out / "regime_map.png", lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
     # the traced curves themselves, unstable branches dashed, paths of the experiment
     show = [p for p in pts if p.mu in (pts[0].mu, pts[len(pts) // 2].mu, pts[-1].mu)] or pts[:3]
@@ -130,30 +261,33 @@ def regime_figures(pts, out_dir):
         a.grid(alpha=0.3)
         a.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "regime_curves.png", dpi=110)
+    save_atomic(out / "regime_curves.png", lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
 
 
-def meniscus_forces(scene, results, path):
-    """Force / (4 pi R gamma) vs p/psat per liquid (panels), method (style), radius (colour),
-    in the style of paper 2 Fig 1."""
+def meniscus_forces(res, path):
+    """Force / (4 pi R gamma) against p/psat per liquid (panels), method (style), radius
+    (colour), in the style of paper 2 Fig 1; from a MeniscusRunResult."""
     plt = _pyplot()
+    scene = res.scene
     nl = len(scene.liquids)
     fig, axes = plt.subplots(1, nl, figsize=(5.2 * nl, 4.3), squeeze=False)
     styles = {"fe": "-", "shooting": "o", "circular": "--", "no-film": ":"}
     colors = plt.get_cmap("viridis")(np.linspace(0, 0.85, len(scene.radii)))
     for ax, lq in zip(axes[0], scene.liquids):
         for c, R in zip(colors, scene.radii):
+            Rs, Rl = length_unit([R])
             for meth in scene.methods:
-                res = results[lq.name, R, meth]
-                x = [p for p, r in zip(scene.p_ratios, res) if not isinstance(r, Exception)]
-                f = [r.force_over_4piRgamma for r in res if not isinstance(r, Exception)]
-                ax.plot(x, f, styles.get(meth, "-"), color=c, ms=3,
-                        label=f"{meth}, R = {R * 1e9:g} nm")
+                cur = res.curves.get((lq.name, R, meth))
+                if cur is None:
+                    continue
+                ax.plot(cur["p_ratio"], cur["force_over_4piRgamma"], styles.get(meth, "-"),
+                        color=c, ms=3, label=f"{meth}, R = {R * Rs:g} {Rl}")
         ax.axhline(1.0, color="grey", lw=0.8)
         ax.set(xlabel="p/psat", ylabel="F / 4πRγ", title=lq.name, xlim=(0, 1))
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=6, ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_atomic(path, lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
+    return path

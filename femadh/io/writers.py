@@ -1,22 +1,30 @@
-"""Writers for run results: csv (streamed as each state is computed), json summary.
+"""The csv files of a contact run, streamed as each state is computed.
 
-Each converged state reaches disk as soon as it exists, so an interrupted or failed run keeps
-everything it computed.
+Per state (numbered in the order the run computed it, column ``state``): its node fields go to
+``fields.csv``, its diagnostics to ``diagnostics.csv``, its VTK files (FE) to ``vtk/``, and last
+its row to ``curve.csv``: curve.csv is the commit record. Each file grows by whole chunks
+(:class:`~femadh.io.atomic.RowLog`), so no reader sees a torn line, and a state is in all the
+files or, after a kill between two of them, only in those written before curve.csv - which a
+resumed run (and :func:`read_run`) cuts back to the committed states.
 """
 import csv
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 
 from ..contact.forces import state_forces
+from ..laws.registry import outputs
+from .atomic import RowLog
 
-CURVE_HEADER = ["branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
-                "residual_m", "converged"]
-DIAG_HEADER = ["branch", "d_m", "stable", "n_active", "min_gap_minus_sigma_m",
-               "min_contact_pressure_Pa", "eq10_violation_inside_m"]
-FIELD_HEADER = ["branch", "d_m", "r_m", "w_m", "h_m", "P_LJ_Pa", "P_el_Pa"]
+CURVE_HEADER = ["state", "branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m",
+                "n_iter", "residual_m", "converged", "stable"]
+DIAG_HEADER = ["state", "branch", "d_m", "n_active", "min_gap_minus_sigma_m",
+               "min_contact_pressure_Pa", "eq10_violation_inside_m", "node_softening_ratio"]
+FIELD_HEADER = ["state", "branch", "d_m", "r_m", "w_m", "h_m", "P_LJ_Pa", "P_el_Pa"]
+JUMP_HEADER = ["branch", "d_fold_m", "d_land_m", "resolution_m", "F_ex_before_N",
+               "F_ex_after_N", "h0_before_m", "h0_after_m", "energy_released_J"]
+EQ_CURVE_HEADER = ["arc_index", "d_m", "h0_m", "F_ex_N", "stable", "dd_ds", "residual_m"]
 
 SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ = sum P_LJ dA "
              "(attractive positive), F_el = sigma-gap contact force, repulsive positive; "
@@ -26,109 +34,183 @@ SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ 
              "adhesion shows as F_ex > 0.")
 
 
-#: extra curve.csv columns, by effect name (only for the effects a scene names), with the sign
-#: that makes them positive in their own sense (attractive, or repulsive for asperity_elastic);
-#: fields.csv gets the matching pressure column (attractive positive, as the law returns it)
-EFFECT_COLUMNS = {"capillary": ("F_cap_N", 1.0), "asperity_adhesion": ("F_LJa_N", 1.0),
-                  "asperity_elastic": ("F_ela_N", -1.0)}
-EFFECT_FIELDS = {"capillary": "P_cap_Pa", "asperity_adhesion": "P_LJa_Pa",
-                 "asperity_elastic": "P_ela_Pa"}
-
-
-class RunWriter:
-    """Streams curve.csv, diagnostics.csv and fields.csv rows into an output folder."""
-
-    def __init__(self, out_dir, problem, vtk=False):
-        self.dir = Path(out_dir)
-        self.dir.mkdir(parents=True, exist_ok=True)
-        self.problem = problem
-        self.vtk = vtk
-        self._pvd = {}
-        self._files = {}
-        self._writers = {}
-        self.extra = [k for k in EFFECT_COLUMNS if k in problem.effects]
-        curve_header = CURVE_HEADER + [EFFECT_COLUMNS[k][0] for k in self.extra]
-        field_header = FIELD_HEADER + [EFFECT_FIELDS[k] for k in self.extra]
-        for name, header in (("curve", curve_header), ("diagnostics", DIAG_HEADER),
-                             ("fields", field_header)):
-            f = open(self.dir / f"{name}.csv", "w", newline="")
-            w = csv.writer(f)
-            w.writerow(header)
-            self._files[name], self._writers[name] = f, w
-
-    def write_state(self, branch, state):
-        p = self.problem
-        f_lj, f_el, f_ex = state_forces(p, state)
-        self._writers["curve"].writerow([
-            branch, _g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
-            state.n_iter, _g(state.residual), state.converged]
-            + [_g(EFFECT_COLUMNS[k][1] * p.grid.force(state.p_effects[k])) for k in self.extra])
-        sigma = p.sigma
-        self._writers["diagnostics"].writerow([
-            branch, _g(state.d), state.stable, int(state.active.sum()),
-            _g(float(np.min(state.h) - sigma)) if sigma is not None else "",
-            _g(float(np.min(state.p_contact))) if state.active.any() else "",
-            _g(state.diagnostics.get("eq10_violation_inside_m", 0.0))])
-        p_lj = state.p_effects.get("lj", np.zeros_like(state.w))
-        rows = np.column_stack([np.full(state.w.size, state.d), p.grid.nodes, state.w, state.h,
-                                p_lj, state.p_contact]
-                               + [state.p_effects[k] for k in self.extra])
-        fw = self._writers["fields"]
-        for row in rows:
-            fw.writerow([branch] + [_g(x) for x in row])
-        for f in self._files.values():
-            f.flush()
-        if self.vtk:
-            from .vtk import write_pvd, write_state
-
-            entries = self._pvd.setdefault(branch, [])
-            vol, surf = write_state(self.dir, branch, len(entries) // 2, state, p)
-            t = round(state.d * 1e9, 9)
-            entries += [(t, vol, 0), (t, surf, 1)]
-            write_pvd(self.dir / f"{branch}.pvd", entries)
-
-    def write_equilibrium_curve(self, points, states):
-        """equilibrium_curve.csv: every traced point of an arclength curve in arc order,
-        stable or not, with the tangent's dd/ds (its sign changes at each fold)."""
-        with open(self.dir / "equilibrium_curve.csv", "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["arc_index", "d_m", "h0_m", "F_ex_N", "stable", "dd_ds",
-                        "residual_m"])
-            for i, (pt, st) in enumerate(zip(points, states)):
-                w.writerow([i, _g(st.d), _g(st.h0), _g(state_forces(self.problem, st)[2]),
-                            st.stable, _g(pt.t_d), _g(st.residual)])
-
-    def close(self):
-        for f in self._files.values():
-            f.close()
+def extra_outputs(problem):
+    """The registered outputs of the laws a problem carries beyond LJ (and eq 20 on the
+    contact set), in registry order."""
+    names = set(problem.effects)
+    if problem.gap is not None and problem.gap.adhesion:
+        names.add("asperity_adhesion")
+    return [o for name, o in outputs().items() if name != "lj" and name in names]
 
 
 def _g(x):
-    return repr(float(x)) if math.isfinite(x) else str(x)
+    x = float(x)
+    return repr(x) if math.isfinite(x) else str(x)
 
 
-def write_json(path, data):
-    Path(path).write_text(json.dumps(data, indent=2, default=_json_default) + "\n")
+def state_row(problem, state, extra):
+    """The curve.csv values of a state after ``state`` and ``branch`` (forces in N)."""
+    f_lj, f_el, f_ex = state_forces(problem, state)
+    g = problem.grid
+    return ([_g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
+             state.n_iter, _g(state.residual), state.converged, state.stable]
+            + [_g(o.sign * g.force(state.p_effects[o.name])) for o in extra])
 
 
-def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, np.bool_):
-        return bool(o)
-    raise TypeError(type(o))
+class ContactWriter:
+    """Streams a contact run's csv files (and VTK for FE) into a claimed run folder.
+
+    Parameters
+    ----------
+    folder : RunFolder
+    problem : ContactProblem
+    vtk : bool
+    resume : dict or None
+        ``{"states": k, "jumps": j, "fields_rows": n, "diagnostics_rows": k, "eq_rows": e}``:
+        continue after the first k committed states (files are cut back to them).
+    """
+
+    def __init__(self, folder, problem, vtk=False, resume=None):
+        self.dir = Path(folder.path)
+        self.problem, self.vtk = problem, vtk
+        self.extra = extra_outputs(problem)
+        r = resume or {}
+        keep = (lambda key: r.get(key)) if resume else (lambda key: None)
+        self.curve = RowLog(self.dir / "curve.csv",
+                            CURVE_HEADER + [o.force for o in self.extra], keep("states"))
+        self.diag = RowLog(self.dir / "diagnostics.csv", DIAG_HEADER, keep("states"))
+        self.fields = RowLog(self.dir / "fields.csv",
+                             FIELD_HEADER + [o.field for o in self.extra], keep("fields_rows"))
+        self.jumps = RowLog(self.dir / "jumps.csv", JUMP_HEADER, keep("jumps"))
+        self.eq_curve = None
+        self.count = r.get("states", 0)
+        self._pvd = {}
+
+    def write_state(self, branch, state):
+        """Write one state to every file (curve.csv last); returns its state number."""
+        k = self.count
+        p = self.problem
+        self.fields.append(self._field_rows(k, branch, state))
+        self.diag.append([self._diag_row(k, branch, state)])
+        if self.vtk:
+            self._write_vtk(k, branch, state)
+        self.curve.append([[k, branch] + state_row(p, state, self.extra)])
+        self.count += 1
+        return k
+
+    def write_jump(self, row):
+        """One jump (the dict the run records: see JUMP_HEADER)."""
+        self.jumps.append([[row["branch"]] + [_g(row[k]) for k in JUMP_HEADER[1:]]])
+
+    def _field_rows(self, k, branch, state):
+        p = self.problem
+        n = state.w.size
+        p_lj = state.p_effects.get("lj", np.zeros(n))
+        cols = [p.grid.nodes, state.w, state.h, p_lj, state.p_contact] + [
+            state.p_effects[o.name] for o in self.extra]
+        return [[k, branch, _g(state.d)] + [_g(c[i]) for c in cols] for i in range(n)]
+
+    def _diag_row(self, k, branch, state):
+        p = self.problem
+        sigma = p.sigma
+        return [k, branch, _g(state.d), int(state.active.sum()),
+                _g(float(np.min(state.h) - sigma)) if sigma is not None else "",
+                _g(float(np.min(state.p_contact[state.active]))) if state.active.any() else "",
+                _g(state.diagnostics.get("eq10_violation_inside_m", 0.0)),
+                _g(p.node_softening_ratio(state.h))]
+
+    def _write_vtk(self, k, branch, state):
+        from .vtk import write_pvd, write_state
+
+        entries = self._pvd.setdefault(branch, [])
+        vol, surf = write_state(self.dir, branch, k, state, self.problem)
+        # the collection's time is the state number: ParaView plays the sweep in the order it
+        # ran (d is a field of every file; keyed by d the approach would play backwards)
+        entries += [(k, vol, 0), (k, surf, 1)]
+        write_pvd(self.dir / f"{branch}.pvd", entries)
+
+    def write_curve_point(self, i, point, state):
+        """One point of an arclength curve to equilibrium_curve.csv (streamed)."""
+        if self.eq_curve is None:
+            self.eq_curve = RowLog(self.dir / "equilibrium_curve.csv", EQ_CURVE_HEADER)
+        self.eq_curve.append([[i, _g(state.d), _g(state.h0),
+                               _g(state_forces(self.problem, state)[2]), point.stable,
+                               _g(point.t_d), _g(state.residual)]])
+
+    def close(self):
+        for log in (self.curve, self.diag, self.fields, self.jumps, self.eq_curve):
+            if log is not None:
+                log.close()
 
 
 def read_curve(path):
-    """Read curve.csv into a dict of numpy arrays (and the branch labels)."""
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
+    """Read curve.csv into a dict of numpy arrays (and the branch labels); a torn last line
+    (from a killed writer) is ignored."""
+    with open(path, newline="") as f:
+        text = f.read()
+    lines = text.split("\n")
+    if not text.endswith("\n"):
+        lines = lines[:-1]             # a torn last line is not a row
+    rows = list(csv.DictReader(lines))
     out = {"branch": np.array([r["branch"] for r in rows])}
-    for k in CURVE_HEADER[1:]:
-        if k == "converged":
+    header = rows[0].keys() if rows else CURVE_HEADER
+    for k in header:
+        if k == "branch":
+            continue
+        if k in ("converged", "stable"):
             out[k] = np.array([r[k] == "True" for r in rows])
+        elif k == "state":
+            out[k] = np.array([int(r[k]) for r in rows], int)
         else:
             out[k] = np.array([float(r[k]) for r in rows])
     return out
+
+
+def committed_counts(folder):
+    """What a resumed run keeps of a previous run's files: its committed states (the complete
+    rows of curve.csv), their fields rows, and the jumps that happened before its last state
+    on each branch (a jump written just before a kill whose next state was not committed is
+    found again by the resumed run)."""
+    folder = Path(folder)
+    c = read_curve(folder / "curve.csv")
+    n = len(c["d_m"])
+    last = {}
+    for b, d in zip(c["branch"], c["d_m"]):
+        last[str(b)] = float(d)
+    fields_rows = 0
+    with open(folder / "fields.csv", newline="") as f:
+        next(f, None)
+        for line in f:
+            if not line.endswith("\n") or int(line.split(",", 1)[0]) >= n:
+                break
+            fields_rows += 1
+    jumps = 0
+    path = folder / "jumps.csv"
+    if path.exists():
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                b, d_land = r["branch"], float(r["d_land_m"])
+                if b not in last:
+                    break
+                reached = d_land >= last[b] if b == "approach" else d_land <= last[b]
+                if not reached:
+                    break
+                jumps += 1
+    return {"states": n, "fields_rows": fields_rows, "jumps": jumps}
+
+
+def read_fields_state(folder, branch):
+    """(d, w) of the last committed state of a branch, from fields.csv (resume)."""
+    folder = Path(folder)
+    c = read_curve(folder / "curve.csv")
+    idx = [int(k) for k, b in zip(c["state"], c["branch"]) if b == branch]
+    k = idx[-1]
+    d, w = None, []
+    with open(folder / "fields.csv", newline="") as f:
+        for r in csv.DictReader(f):
+            if int(r["state"]) == k:
+                d = float(r["d_m"])
+                w.append(float(r["w_m"]))
+            elif w:
+                break
+    return d, np.array(w)

@@ -10,6 +10,7 @@ P_LJa): :class:`femadh.contact.constraints.AsperityGap` with ``adhesion``.
 from dataclasses import dataclass
 import math
 
+from ..schema import Key, Table
 from .step import SmoothStepLaw
 
 
@@ -40,3 +41,43 @@ class AsperityAdhesion(SmoothStepLaw):
     @property
     def _center(self):
         return self.sigma + 5 * self.width
+
+
+def _build(values, ctx):
+    """Eq 20 on the sigma-gap contact set: exactly (range-less, carried by the constraint:
+    a contact node holds tension up to P_LJa), or as the smoothed step law."""
+    from .registry import Built
+
+    p = eq20_pressure(values["asperity_radius"], values["surface_energy"], values["density"],
+                      values["contact_probability"])
+    if values["model"] == "contact-set":
+        return Built({}, gap_adhesion=p)
+    return Built({"asperity_adhesion": AsperityAdhesion(p, ctx.sigma,
+                                                        values["smoothing"] * ctx.sigma)})
+
+
+def _registration():
+    from .registry import Output, Registration
+
+    table = Table("effects.asperity_adhesion", "Asperity adhesion over the sigma-gap contact "
+                  "region, paper 1 eq (20): P_LJa = 2 pi R_a dg rho p.", (
+        Key("asperity_radius", "length", "Summit radius R_a (paper 1 sec 6: 0.94 um).",
+            lo=0.0),
+        Key("surface_energy", "surface_energy", "Surface energy dg of a summit contact "
+            "(sec 6: 0.06 J/m^2).", lo=0.0),
+        Key("density", "areal_density", "Summit density rho (Fig 8: 0, 100, 179 um^-2).",
+            lo=0.0, lo_closed=True),
+        Key("contact_probability", "number", "Fraction p of summits in contact (eq 20; sec 6: "
+            "0.5).", default=0.5, lo=0.0, hi=1.0, lo_closed=True, hi_closed=True),
+        Key("model", "choice", "'contact-set': P_LJa acts exactly on the contact set (a node "
+            "holds tension up to P_LJa before it releases; the limit of the smoothed law); "
+            "'smoothed': a logistic step of width smoothing x sigma above sigma.",
+            default="contact-set", choices=("contact-set", "smoothed")),
+        Key("smoothing", "number", "Step width as a fraction of sigma (model = 'smoothed').",
+            default=0.02, lo=0.0, hi=0.2, hi_closed=True),
+    ))
+    return Registration(table, _build, (Output("asperity_adhesion", "F_LJa_N", "P_LJa_Pa", 1.0,
+                                               "asperity adhesion (eq 20)"),))
+
+
+REGISTRATION = _registration()

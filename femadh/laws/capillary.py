@@ -15,6 +15,7 @@ The surface-tension ring force at the meniscus edge (relative size ~ sqrt(|r_K|/
 """
 from dataclasses import dataclass
 
+from ..schema import Key, Table
 from .step import SmoothStepLaw
 
 
@@ -51,3 +52,46 @@ class CapillaryCondensate(SmoothStepLaw):
     @property
     def _center(self):
         return self.fill_gap
+
+
+def _build(values, ctx):
+    """The law from a liquid, p/psat, temperature and isotherm (the built-in liquid's
+    representative isotherm unless one is given; ``model = "none"`` for bare solids)."""
+    from ..meniscus.isotherms import default_isotherm
+    from ..meniscus.kelvin import kelvin_radius
+    from ..meniscus.liquids import LIQUIDS
+    from .registry import Built
+
+    liquid, x = values["liquid"], values["relative_pressure"]
+    iso = values["isotherm"]
+    if iso == "default":
+        iso = default_isotherm(liquid.name) if liquid.name in LIQUIDS else None
+    r_k = kelvin_radius(liquid, x, values["temperature"])
+    film = 0.0 if iso is None else float(iso(x))
+    fill = 2 * abs(r_k) + 2 * film
+    return Built({"capillary": CapillaryCondensate(liquid.surface_tension, r_k, film,
+                                                   values["smoothing"] * fill)})
+
+
+def _registration():
+    from .registry import Output, Registration
+
+    table = Table("effects.capillary", "Capillary condensate filling the gap where a meniscus "
+                  "of Kelvin curvature spans it (paper 2 physics in a contact scene).", (
+        Key("liquid", "liquid", "A built-in liquid (water, ethanol, n-butanol, n-pentanol) or "
+            "a table { name, surface_tension, molar_volume }."),
+        Key("relative_pressure", "number", "Vapour pressure p/psat (paper 2 eq 6).", lo=0.0,
+            hi=1.0),
+        Key("temperature", "temperature", "Temperature (Kelvin equation).",
+            default="298.15 K", lo=0.0),
+        Key("isotherm", "isotherm", "Adsorption isotherm of the film on both surfaces: "
+            "{ model = gab | bet | polynomial | tabulated | none, ... }; default: the "
+            "built-in liquid's representative GAB isotherm.", default="default"),
+        Key("smoothing", "number", "Width of the smoothed meniscus edge as a fraction of the "
+            "filled gap 2|r_K| + 2h.", default=0.02, lo=0.0, hi=0.5, hi_closed=True),
+    ))
+    return Registration(table, _build, (Output("capillary", "F_cap_N", "P_cap_Pa", 1.0,
+                                               "capillary"),))
+
+
+REGISTRATION = _registration()

@@ -16,6 +16,8 @@ import math
 import numpy as np
 from scipy import special
 
+from ..schema import Key, Table
+
 
 #: |t| beyond which scipy's pbdv overflows (t < 0) or returns nan (t > ~2071); there
 #: I_n is 0 in double precision (t > 0: below 1e-300) or its Gaussian-moment series (t < 0)
@@ -124,3 +126,37 @@ class GWAdhesion:
     def energy(self, h):
         s = self.summits
         return -self._c * s.sigma_a * gw_integral(1.0, _t(s, h))
+
+
+def _build(values, ctx):
+    from .registry import Built
+
+    s = Summits(values["rms_height"], values["mean_height"], values["asperity_radius"],
+                values["density"])
+    laws = {"asperity_elastic": GWElastic(s, ctx.e_star)}
+    if values["surface_energy"] > 0:
+        laws["asperity_adhesion"] = GWAdhesion(s, values["surface_energy"])
+    return Built(laws)
+
+
+def _registration():
+    from .registry import Output, Registration
+
+    table = Table("effects.asperity_contact", "Greenwood-Williamson asperity pressures "
+                  "(eqs 23-24) as smooth laws of the mean-plane gap, instead of the hard "
+                  "sigma-gap.", (
+        Key("model", "choice", "The asperity model.", choices=("greenwood-williamson",)),
+        Key("rms_height", "length", "rms summit height sigma_a (Table 2 composite: "
+            "0.344 nm).", lo=0.0),
+        Key("mean_height", "length", "Mean summit height z_m above the mean plane (1.08 nm)."),
+        Key("asperity_radius", "length", "Summit radius R_a (0.94 um).", lo=0.0),
+        Key("density", "areal_density", "Summit density rho.", lo=0.0),
+        Key("surface_energy", "surface_energy", "Surface energy of a summit contact (eq 24); "
+            "0 for no asperity adhesion.", default=0.0, lo=0.0, lo_closed=True),
+    ))
+    return Registration(table, _build, (
+        Output("asperity_elastic", "F_ela_N", "P_ela_Pa", -1.0, "asperity elasticity (eq 23)"),
+        Output("asperity_adhesion", "F_LJa_N", "P_LJa_Pa", 1.0, "asperity adhesion (eq 24)")))
+
+
+REGISTRATION = _registration()

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 
+from ..schema import Key, Table
+
 
 @dataclass(frozen=True)
 class LennardJones:
@@ -50,3 +52,24 @@ class LennardJones:
     def work_of_adhesion(self):
         """Delta gamma = -U(z0) = A/(16 pi z0^2) (J/m^2), eq (19)."""
         return self.hamaker / (16.0 * math.pi * self.z0**2)
+
+
+def _build(values, ctx):
+    from .registry import Built
+
+    return Built({"lj": LennardJones(values["hamaker"], values["equilibrium_distance"])})
+
+
+def _registration():
+    from .registry import Output, Registration
+
+    table = Table("effects.lennard_jones", "Mean-plane Lennard-Jones pressure, paper 1 eq (3).", (
+        Key("hamaker", "energy", "Hamaker constant A (paper 1 Table 1: 1e-19 J).", lo=0.0),
+        Key("equilibrium_distance", "length", "Atomic equilibrium distance z0, where the LJ "
+            "pressure vanishes (Table 1: 0.165 nm).", lo=0.0),
+    ))
+    return Registration(table, _build, (Output("lj", "F_LJ_N", "P_LJ_Pa", 1.0,
+                                               "Lennard-Jones"),))
+
+
+REGISTRATION = _registration()

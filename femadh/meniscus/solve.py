@@ -155,11 +155,12 @@ def meniscus(method, radius, gamma, r_k, film=0.0, separation=None, *, elements=
                                       sol.phi)))
 
 
-def sweep(method, radius, liquid, temperature, isotherm, p_ratios, separation=None, *,
-          elements=16):
-    """Solve along p/psat with continuation; returns a list of MeniscusResult or DomainError
-    (one per p/psat, in order). A point with no meniscus does not stop the sweep."""
-    out, warm = [], None
+def sweep_points(method, radius, liquid, temperature, isotherm, p_ratios, separation=None, *,
+                 elements=16):
+    """Solve along p/psat with continuation, yielding (p/psat, MeniscusResult) or, where no
+    meniscus exists or its solve fails, (p/psat, the DomainError/ConvergenceError saying why):
+    such a point does not stop the sweep (the next one starts afresh)."""
+    warm = None
     for x in p_ratios:
         try:
             r_k = kelvin_radius(liquid, x, temperature)
@@ -167,7 +168,13 @@ def sweep(method, radius, liquid, temperature, isotherm, p_ratios, separation=No
             res = meniscus(method, radius, liquid.surface_tension, r_k, h, separation,
                            elements=elements, warm=warm)
             warm = res
-        except DomainError as exc:
+        except (DomainError, ConvergenceError) as exc:
             res, warm = exc, None
-        out.append(res)
-    return out
+        yield x, res
+
+
+def sweep(method, radius, liquid, temperature, isotherm, p_ratios, separation=None, *,
+          elements=16):
+    """:func:`sweep_points` as a list of results/errors, one per p/psat, in order."""
+    return [r for _, r in sweep_points(method, radius, liquid, temperature, isotherm,
+                                       p_ratios, separation, elements=elements)]

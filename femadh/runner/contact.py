@@ -1,154 +1,349 @@
-"""Run a scene: build the problem, trace its branches, stream results to disk, draw figures."""
-from dataclasses import dataclass, field
+"""Run a contact scene: build its problem, trace its branches, stream every state to disk as
+it is computed, draw its figures, and return a :class:`ContactResult` (data only).
+
+Nothing is lost: the output folder is claimed before anything is computed (one run per
+folder, checked writable), ``summary.json`` says ``running`` from the start and is rewritten
+atomically at the end, every committed state is in every csv, SIGINT/SIGTERM stop after the
+current state with status ``interrupted``, and ``resume=True`` continues an interrupted or
+failed sweep from its last committed state.
+"""
+import hashlib
+import json
+import math
 import sys
 import time
 import warnings
 
 import numpy as np
 
+from .._threads import blas_threads
 from .._version import __version__
-from ..contact import Jump, State, Sweep, trace
+from ..contact import Jump, State, trace
 from ..contact.forces import state_forces
-from ..errors import ConvergenceError, MeshResolutionWarning
-from ..io.writers import SIGN_NOTE, RunWriter, write_json
-from ..scene import Scene, build_problem, load_scene
-
+from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning
+from ..scene import build_problem, load_scene
+from . import interrupt
+from .result import ContactResult
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
+#: surface profiles kept in the result per branch (all of them are in fields.csv)
+PROFILES = 12
 
 
-@dataclass
-class RunResult:
-    """What :func:`run` returns.
-
-    Attributes
-    ----------
-    scene : Scene
-    problem : ContactProblem
-    sweeps : dict[str, Sweep]
-        ``"approach"`` / ``"retract"`` branches, each with its states and jumps.
-    status : str
-        ``"converged"`` or ``"failed"`` (then ``error`` holds the message).
-    wall_time : float
-        Seconds for the whole run, output included.
-    out_dir : str or None
-    """
-
-    scene: Scene
-    problem: object
-    sweeps: dict = field(default_factory=dict)
-    status: str = "converged"
-    error: str | None = None
-    wall_time: float = 0.0
-    out_dir: str | None = None
-    stiffness_ratio: float = 0.0
-
-    def curve(self, branch):
-        """Arrays d, h0, F_LJ, F_el, F_ex, r_c (SI) of one branch."""
-        states = self.sweeps[branch].states
-        f = np.array([state_forces(self.problem, s) for s in states]).reshape(-1, 3)
-        return {"d": np.array([s.d for s in states]), "h0": np.array([s.h0 for s in states]),
-                "F_LJ": f[:, 0], "F_el": f[:, 1], "F_ex": f[:, 2],
-                "r_c": np.array([s.r_c for s in states])}
-
-    @property
-    def jumps(self):
-        return [j for sw in self.sweeps.values() for j in sw.jumps]
+def scene_id(scene):
+    """Content hash of a scene's resolved values (its output folder aside): two runs of the
+    same physics and numerics have the same id."""
+    data = dict(scene.resolved)
+    data.pop("output_dir", None)
+    blob = json.dumps(data, sort_keys=True, default=repr).encode()
+    return hashlib.sha1(blob).hexdigest()[:16]
 
 
-def _progress_bar(total, label, enabled):
-    if not enabled:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=total, desc=label, unit="step", leave=False, file=sys.stderr)
-
-
-def run(scene, out_dir=None, *, write=True, figures=True, progress=None):
-    """Solve a scene's force-separation sweep.
+def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False):
+    """Solve a scene.
 
     Parameters
     ----------
-    scene : Scene or str or Path
-        A loaded scene or the path of its TOML file.
-    out_dir : str, optional
-        Output folder (default: the scene's ``[output] dir``).
-    write : bool
-        Stream curve/diagnostics/fields csv and summary.json to ``out_dir``.
+    scene : Scene, MeniscusScene, str or Path
+        A scene or the path of its TOML file.
+    out_dir : str or Path, optional
+        Folder for the csv/json/VTK outputs and figures. None (the default): nothing is
+        written (the command line passes the scene's ``[output] dir``).
     figures : bool
-        Draw the Fig 3-style panels (PNG) after the sweep.
+        Draw the scene's figures into ``out_dir``.
     progress : bool, optional
         Progress bar on stderr; default: only when stderr is a terminal.
+    overwrite, resume : bool
+        What to do with a folder that holds a previous run: replace it, or continue it
+        (an interrupted or failed run of the same scene). Neither: refuse it.
 
     Returns
     -------
-    RunResult
-        Also when a step fails to converge: then ``status == "failed"``, ``error`` says where,
-        and every state computed before it is in the result and on disk.
+    ContactResult or MeniscusRunResult
+        Also when a step fails (status "failed", ``error`` says where) or the run is
+        interrupted (status "interrupted"): every state computed before is in the result
+        and on disk.
+
+    Raises
+    ------
+    SceneError, OutputError, DependencyError
+        Before anything is computed.
     """
-    if not isinstance(scene, Scene) and not hasattr(scene, "p_ratios"):
+    if not hasattr(scene, "kind"):
         scene = load_scene(scene)
-    if hasattr(scene, "p_ratios"):  # a [meniscus] scene (paper 2)
+    if scene.kind == "meniscus":
         from .meniscus import run_meniscus
 
-        return run_meniscus(scene, out_dir, write=write, figures=figures)
-    t0 = time.perf_counter()
+        return run_meniscus(scene, out_dir, figures=figures, progress=progress,
+                            overwrite=overwrite)
     if progress is None:
         progress = sys.stderr.isatty()
+    with blas_threads():
+        if out_dir is None:
+            return _run(scene, None, progress=progress)
+        from ..io.run_folder import RunFolder
+
+        mode = "resume" if resume else "overwrite" if overwrite else "new"
+        with RunFolder(out_dir, scene_id(scene), scene.name, mode) as folder:
+            res = _run(scene, folder, progress=progress)
+            if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
+                from ..io.plots import contact_figures
+
+                res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
+                folder.write_summary(summary(res))
+            return res
+
+
+def solve_sweeps(scene, problem=None):
+    """The solver-level trace of a stepping scene, for scripts that need the states themselves
+    (their fields, the problem's operator), not only the result's curves.
+
+    Returns (problem, {branch: Sweep}, error message or None); on failure the sweeps hold the
+    states computed before it. Writes nothing.
+    """
+    if scene.continuation == "arclength":
+        raise ValueError("solve_sweeps traces stepping scenes; use contact.arclength.trace_curve")
+    with blas_threads():
+        problem = problem or build_problem(scene)
+        sweeps, start = {}, None
+        for branch, d_vals in _plan(scene):
+            try:
+                sw = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
+                           max_iter=scene.max_iter)
+            except ConvergenceError as exc:
+                if getattr(exc, "sweep", None) is not None and exc.sweep.states:
+                    sweeps[branch] = exc.sweep
+                return problem, sweeps, str(exc)
+            sweeps[branch], start = sw, sw.states[-1]
+    return problem, sweeps, None
+
+
+def _timed(fn):
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def _run(scene, folder, *, progress):
+    t0 = time.perf_counter()
+    res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
-    problem = build_problem(scene, progress=say)
+    resume = _resume_point(folder) if folder is not None and folder.previous else None
+    writer = None
+    with interrupt.interruptible():
+        try:
+            if folder is not None:
+                folder.write_summary(summary(res, status="running"))
+            t1 = time.perf_counter()
+            problem = build_problem(scene, progress=say)
+            res.timings["operator_s"] = time.perf_counter() - t1
+            res.nodes = problem.grid.nodes.copy()
+            res.warnings += _stiffness_warning(scene, problem)
+            interrupt.check()
+            if folder is not None:
+                from ..io.writers import ContactWriter
+
+                writer = ContactWriter(folder, problem, vtk=scene.vtk, resume=resume)
+            sink = Sink(problem, res, writer, progress)
+            if resume:
+                sink.load(folder.path)
+            t1 = time.perf_counter()
+            if scene.continuation == "arclength":
+                _trace_arclength(scene, problem, sink)
+            else:
+                _trace_steps(scene, problem, sink, resume)
+            res.timings["solve_s"] = time.perf_counter() - t1
+        except ConvergenceError as exc:
+            res.status, res.error = "failed", str(exc)
+        except Interrupted as exc:
+            res.status, res.error = "interrupted", str(exc)
+            res.exit_code = exc.exit_code
+        finally:
+            if writer is not None:
+                writer.close()
+            res.timings["total_s"] = time.perf_counter() - t0
+            if res.status == "converged":
+                from .headline import headline
+
+                res.headline = headline(res, problem if "problem" in locals() else None)
+            if folder is not None:
+                folder.write_summary(summary(res))
+    return res
+
+
+class Sink:
+    """Where each state goes as soon as it exists: the result's arrays, the csv files, the
+    progress bar; then the interrupt check (a safe point: the state is complete on disk)."""
+
+    def __init__(self, problem, result, writer, progress):
+        from ..io.writers import extra_outputs, state_row
+
+        self.problem, self.result, self.writer = problem, result, writer
+        self.progress = progress
+        self._row = lambda st: state_row(problem, st, self._extra)
+        self._extra = extra_outputs(problem)
+        self.columns = (["d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
+                         "residual_m", "converged", "stable"] + [o.force for o in self._extra])
+        self.rows = {}
+        self.profile_picks = {}
+        self.bar = None
+
+    def plan(self, branch, n):
+        """A branch of n states begins: which of them keep their surface profile."""
+        self.profile_picks[branch] = set(np.linspace(0, n - 1, min(n, PROFILES)).round()
+                                         .astype(int))
+        if self.progress:
+            from ..io.progress import bar
+
+            if self.bar is not None:
+                self.bar.close()
+            self.bar = bar(n, f"{self.result.name} {branch}")
+
+    def state(self, branch, st):
+        rows = self.rows.setdefault(branch, [])
+        if branch in self.profile_picks and len(rows) in self.profile_picks[branch]:
+            prof = self.result.profiles.setdefault(
+                branch, {"d_m": [], "w_m": [], "P_LJ_Pa": [], "P_el_Pa": []})
+            prof["d_m"].append(st.d)
+            prof["w_m"].append(st.w.copy())
+            prof["P_LJ_Pa"].append(st.p_effects.get("lj", 0 * st.w).copy())
+            prof["P_el_Pa"].append(st.p_contact.copy())
+        rows.append([float(v) if not isinstance(v, bool) else v for v in self._row(st)])
+        if self.writer:
+            self.writer.write_state(branch, st)
+        if self.bar is not None:
+            self.bar.update(1)
+        self._publish(branch)
+        interrupt.check()
+
+    def jump(self, jump):
+        p = self.problem
+        # hysteresis: the energy released by the snap, both states at the landing separation
+        # (the closure has no energy: nan)
+        released = (math.nan if p.contact_model == "hertz-closure" else
+                    float(p.energy(jump.before.w, jump.d_land)
+                          - p.energy(jump.after.w, jump.d_land)))
+        self.result.jumps.append({
+            "branch": jump.branch, "d_fold_m": jump.d_fold, "d_land_m": jump.d_land,
+            "resolution_m": jump.resolution,
+            "F_ex_before_N": state_forces(p, jump.before)[2],
+            "F_ex_after_N": state_forces(p, jump.after)[2],
+            "h0_before_m": jump.before.h0, "h0_after_m": jump.after.h0,
+            "energy_released_J": released})
+        if self.writer:
+            self.writer.write_jump(self.result.jumps[-1])
+
+    def _publish(self, branch):
+        rows = self.rows[branch]
+        cols = list(zip(*rows))
+        self.result.branches[branch] = {
+            c: np.array(v, dtype=bool if c in ("converged", "stable") else
+                        int if c == "n_iter" else float) for c, v in zip(self.columns, cols)}
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+        for prof in self.result.profiles.values():
+            for k in list(prof):
+                prof[k] = np.array(prof[k])
+
+    def load(self, folder):
+        """Resume: the committed states and jumps of the previous run, into the result."""
+        from ..io.writers import read_curve
+
+        c = read_curve(folder / "curve.csv")
+        for i, b in enumerate(c["branch"]):
+            row = [c[k][i] for k in self.columns]
+            self.rows.setdefault(str(b), []).append(
+                [bool(v) if isinstance(v, np.bool_) else float(v) for v in row])
+        for b in self.rows:
+            self._publish(b)
+        import csv
+
+        with open(folder / "jumps.csv", newline="") as f:
+            for r in csv.DictReader(f):
+                self.result.jumps.append({k: (v if k == "branch" else float(v))
+                                          for k, v in r.items()})
+
+
+def _stiffness_warning(scene, problem):
     ratio, h_at, soft, k_node = problem.surface_force_stiffness()
-    if ratio > STIFFNESS_WARNING:
-        warnings.warn(
-            f"{scene.path or scene.name}: the surface forces' stiffness -dP/dh = {soft:.3g} Pa/m "
-            f"at h = {h_at * 1e9:.3g} nm is {ratio:.2f} x the stiffness of one surface node "
-            f"({k_node:.3g} Pa/m): single nodes can snap on their own and the result depends on "
-            f"the mesh. Use [solver] nodes >= {int(scene.nodes * ratio / STIFFNESS_WARNING) + 1}.",
-            MeshResolutionWarning, stacklevel=2)
-    result = RunResult(scene, problem, out_dir=(out_dir or scene.output_dir) if write else None)
-    result.stiffness_ratio = ratio
-    writer = RunWriter(result.out_dir, problem, vtk=scene.vtk) if write else None
+    if ratio <= STIFFNESS_WARNING:
+        return []
+    msg = (f"{scene.path or scene.name}: the surface forces' stiffness -dP/dh = {soft:.3g} Pa/m "
+           f"at h = {h_at * 1e9:.3g} nm is {ratio:.2f} x the stiffness of one surface node "
+           f"({k_node:.3g} Pa/m): single nodes can snap on their own and the result depends on "
+           f"the mesh. Use [solver] nodes >= {int(scene.nodes * ratio / STIFFNESS_WARNING) + 1}.")
+    warnings.warn(msg, MeshResolutionWarning, stacklevel=4)
+    return [msg]
+
+
+def _plan(scene):
     d = scene.d_values
-    plan = []
     if "approach" in scene.directions:
-        plan.append(("approach", d))
+        plan = [("approach", d)]
         if "retract" in scene.directions:
             plan.append(("retract", d[::-1]))
-    else:
-        plan.append(("retract", d))
-    if scene.continuation == "arclength":
-        _run_arclength(scene, problem, result, writer, progress)
-        plan = []
-    start = None
-    try:
-        for branch, d_vals in plan:
-            bar = _progress_bar(len(d_vals) - 1, f"{scene.name} {branch}", progress)
-            on_state = (lambda s, b=branch: writer.write_state(b, s)) if writer else None
-            try:
-                sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
-                              max_iter=scene.max_iter, on_state=on_state,
-                              progress=(lambda k, bar=bar: bar.update(1)) if bar else None)
-            finally:
-                if bar:
-                    bar.close()
-            result.sweeps[branch] = sweep
-            start = sweep.states[-1]
-    except ConvergenceError as exc:
-        result.status, result.error = "failed", str(exc)
-        partial = getattr(exc, "sweep", None)
-        if partial is not None and partial.states:
-            result.sweeps[partial.branch] = partial
-    result.wall_time = time.perf_counter() - t0
-    if writer:
-        writer.close()
-        write_json(f"{result.out_dir}/summary.json", _summary(result))
-        if figures and result.sweeps:
-            from ..io.plots import paper1_panels
-            paper1_panels(result, f"{result.out_dir}/fig3_panels.png")
-    return result
+        return plan
+    return [("retract", d)]
+
+
+def _trace_steps(scene, problem, sink, resume):
+    """Stepping continuation of every branch of the scene's plan, from the resume point."""
+    start, prev = None, None
+    for branch, d_vals in _plan(scene):
+        done = len(sink.rows.get(branch, []))
+        skip_first = False
+        if done >= len(d_vals):
+            start, prev = None, branch
+            continue
+        if done:                      # resume inside this branch
+            start = _restart_state(problem, scene, sink, branch)
+            d_vals, skip_first = d_vals[done - 1:], True
+        elif start is None and prev is not None:    # resume at the start of this branch
+            start = _restart_state(problem, scene, sink, prev)
+        sink.plan(branch, len(d_vals) - skip_first)
+        first = [skip_first]
+
+        def on_state(st, branch=branch):
+            if first[0]:              # the resumed start state is already on disk
+                first[0] = False
+                return
+            sink.state(branch, st)
+        sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
+                      max_iter=scene.max_iter, on_state=on_state, on_jump=sink.jump)
+        start, prev = sweep.states[-1], branch
+    sink.close()
+
+
+def _restart_state(problem, scene, sink, branch):
+    """The last committed state of a branch, re-solved from its saved surface (resume):
+    Newton from the saved w converges in an iteration or two to the same state (to the
+    tolerance)."""
+    from ..contact import solve_state
+    from ..io.writers import read_fields_state
+
+    d, w = read_fields_state(sink.result.out_dir, branch)
+    kw = {}
+    if problem.contact_model == "hertz-closure":
+        kw["r_c0"] = float(sink.result.branches[branch]["r_c_m"][-1]) or None
+    elif problem.sigma is not None:
+        kw["active0"] = np.abs(problem.contour(d) - w - problem.sigma) <= 1e-9 * problem.sigma
+    st = solve_state(problem, d, w, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
+    if not (st.converged and st.stable):
+        raise ConvergenceError("resume: the last saved state does not re-converge to a stable "
+                               "state", d=d, residual=st.residual, n_iter=st.n_iter)
+    return st
+
+
+def _resume_point(folder):
+    """How much of a previous run's output to keep: its committed states (curve.csv rows),
+    their field rows, their jumps."""
+    from ..io.writers import committed_counts
+
+    return committed_counts(folder.path)
 
 
 def _curve_state(problem, d, w, stable):
@@ -160,81 +355,63 @@ def _curve_state(problem, d, w, stable):
                  np.zeros(n, bool), 0.0, 0, res, True, stable)
 
 
-def _run_arclength(scene, problem, result, writer, progress):
-    """Trace the scene's equilibrium curve by arclength; write its paths as branches.
-
-    The whole curve (unstable states included) goes to equilibrium_curve.csv; the
-    displacement-controlled approach and retract paths, with their jumps, go to curve.csv as
-    with the stepping solver. On failure the part of the curve traced so far is written.
-    """
+def _trace_arclength(scene, problem, sink):
+    """Trace the scene's equilibrium curve by arclength (every point streamed to
+    equilibrium_curve.csv), then its displacement-controlled paths as branches."""
     from ..contact.arclength import trace_curve
 
     d = scene.d_values
     step = abs(d[1] - d[0])
-    bar = _progress_bar(100, f"{scene.name} arclength", progress)
-    last = [0]
+    curve_rows = []
 
-    def tick(frac):
-        k = int(100 * frac)
-        if bar and k > last[0]:
-            bar.update(k - last[0])
-            last[0] = k
-    curve = None
+    def on_point(i, point):
+        st = _curve_state(problem, point.d, point.w, point.stable)
+        curve_rows.append((i, point, st))
+        if sink.writer:
+            sink.writer.write_curve_point(i, point, st)
+        interrupt.check()
     try:
         curve = trace_curve(problem, d[0], d[-1], tol=scene.tolerance, scale=step, ds=1.0,
-                            ds_max=1.0, progress=tick)
-    except ConvergenceError as exc:
-        result.status, result.error = "failed", str(exc)
-        curve = getattr(exc, "curve", None)
+                            ds_max=1.0, on_point=on_point)
     finally:
-        if bar:
-            bar.close()
-    if curve is None:
-        return
-    if writer:
-        writer.write_equilibrium_curve(curve.points,
-                                       [_curve_state(problem, p.d, p.w, p.stable)
-                                        for p in curve.points])
-    if result.status != "converged":
-        return
+        sink.result.equilibrium_curve = {
+            "d_m": np.array([p.d for _, p, _ in curve_rows]),
+            "h0_m": np.array([s.h0 for _, _, s in curve_rows]),
+            "F_ex_N": np.array([state_forces(problem, s)[2] for _, _, s in curve_rows]),
+            "stable": np.array([p.stable for _, p, _ in curve_rows], bool),
+            "dd_ds": np.array([p.t_d for _, p, _ in curve_rows])}
     for branch in scene.directions:
-        sweep = Sweep(branch, n_solves=curve.n_solves)
+        path = curve.branch(branch)
+        sink.plan(branch, sum(kind != "fold" for kind, _, _ in path))
         before = None
-        for kind, dk, wk in curve.branch(branch):
+        for kind, dk, wk in path:
             st = _curve_state(problem, dk, wk, True)
             if kind == "fold":
                 before = st
                 continue        # the fold state is the jump's 'before', not a grid state
+            sink.state(branch, st)
             if kind == "land":
-                sweep.jumps.append(Jump(branch, dk, dk, 0.0, before, st))
-            sweep.states.append(st)
-            if writer:
-                writer.write_state(branch, st)
-        sweep.wall_time = curve.wall_time
-        result.sweeps[branch] = sweep
+                sink.jump(Jump(branch, dk, dk, 0.0, before, st))
+    sink.close()
 
 
-def _summary(result):
-    scene = result.scene
-    jumps = [{"branch": j.branch, "d_fold_m": j.d_fold, "d_land_m": j.d_land,
-              "resolution_m": j.resolution,
-              "F_ex_before_N": state_forces(result.problem, j.before)[2],
-              "F_ex_after_N": state_forces(result.problem, j.after)[2],
-              "h0_before_m": j.before.h0, "h0_after_m": j.after.h0} for j in result.jumps]
+def summary(res, status=None):
+    """summary.json of a run."""
+    scene = res.scene
+    from ..io.writers import SIGN_NOTE
+
     branches = {}
-    for b, sw in result.sweeps.items():
-        c = result.curve(b)
-        k = int(np.argmax(c["F_ex"]))
-        branches[b] = {"n_states": len(sw.states), "n_solves": sw.n_solves,
-                       "wall_time_s": sw.wall_time, "max_F_ex_N": float(c["F_ex"][k]),
-                       "d_at_max_F_ex_m": float(c["d"][k]),
-                       "all_converged": all(s.converged for s in sw.states),
-                       "all_stable": all(s.stable for s in sw.states)}
+    for b, cols in res.branches.items():
+        n = len(cols["d_m"])
+        if not n:
+            continue
+        k = int(np.argmax(cols["F_ex_N"]))
+        branches[b] = {"n_states": n, "max_F_ex_N": float(cols["F_ex_N"][k]),
+                       "d_at_max_F_ex_m": float(cols["d_m"][k]),
+                       "all_converged": bool(np.all(cols["converged"])),
+                       "all_stable": bool(np.all(cols["stable"]))}
     return {"femadh_version": __version__, "scene_file": scene.path,
-            "status": result.status, "error": result.error, "sign_convention": SIGN_NOTE,
-            "scene": scene.resolved, "branches": branches, "jumps": jumps,
-            "surface_force_stiffness_over_node_stiffness": result.stiffness_ratio,
-            "operator": {"name": result.problem.operator.name,
-                         "timings_s": getattr(result.problem.operator, "timings", {}),
-                         "n_dofs": getattr(result.problem.operator, "n_dofs", None)},
-            "wall_time_s": result.wall_time}
+            "status": status or res.status, "error": res.error,
+            "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
+            "jumps": res.jumps, "headline": res.headline, "warnings": res.warnings,
+            "timings_s": res.timings, "wall_time_s": res.wall_time}

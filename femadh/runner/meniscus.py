@@ -1,14 +1,20 @@
-"""Run a ``[meniscus]`` scene: sweeps of every liquid, radius and method; csv, json, figure, VTK."""
-import csv
+"""Run a ``[meniscus]`` scene (paper 2): a p/psat sweep for every liquid, tip radius and method;
+``meniscus.csv``, ``profiles.csv`` (meridians), ``summary.json``, the force figure and VTK
+surfaces of revolution. Same guarantees as a contact run: the folder is claimed first, rows
+are written in whole chunks, SIGINT/SIGTERM stop after the current point."""
 import math
 from pathlib import Path
+import sys
 import time
 
 import numpy as np
 
+from .._threads import blas_threads
 from .._version import __version__
-from ..io.writers import write_json
-from ..meniscus.solve import sweep
+from ..errors import Interrupted
+from ..meniscus.solve import sweep_points
+from . import interrupt
+from .result import MeniscusRunResult
 
 HEADER = ["method", "p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",
           "neck_radius_m", "liquid", "tip_radius_m"]
@@ -17,71 +23,121 @@ NOTE = ("Capillary force on the sphere, attractive positive, normalised by 4 pi 
         "and flat, the film-covered sphere has radius R + h and, in contact, D = -2h "
         "(paper 2 Fig 2b); zero contact angle on the films. 'no-film' is the exact meniscus on "
         "bare solids (h = 0).")
+COLUMNS = ("p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",
+           "neck_radius_m")
 
 
-def run_meniscus(scene, out_dir=None, *, write=True, figures=True):
+def run_meniscus(scene, out_dir=None, *, figures=True, progress=None, overwrite=False):
+    """Solve a meniscus scene; writes nothing unless ``out_dir`` is given. Returns a
+    MeniscusRunResult (status "failed" when no point of the scene has a meniscus)."""
+    from .contact import scene_id
+
+    if progress is None:
+        progress = sys.stderr.isatty()
+    with blas_threads():
+        if out_dir is None:
+            return _run(scene, None, progress)
+        from ..io.run_folder import RunFolder
+
+        with RunFolder(out_dir, scene_id(scene), scene.name,
+                       "overwrite" if overwrite else "new") as folder:
+            res = _run(scene, folder, progress)
+            if figures and any(np.any(np.isfinite(c["force_N"])) for c in res.curves.values()):
+                from ..io.plots import meniscus_forces
+
+                t0 = time.perf_counter()
+                meniscus_forces(res, folder.path / "meniscus_force.png")
+                res.timings["figures_s"] = time.perf_counter() - t0
+                folder.write_summary(summary(res))
+            return res
+
+
+def _run(scene, folder, progress):
+    from ..io.atomic import RowLog
+
     t0 = time.perf_counter()
-    out = Path(out_dir or scene.output_dir)
-    results = {}
-    errors = []
-    if write:
-        out.mkdir(parents=True, exist_ok=True)
-        fcsv = open(out / "meniscus.csv", "w", newline="")
-        w = csv.writer(fcsv)
-        w.writerow(HEADER)
-        fprof = open(out / "profiles.csv", "w", newline="")
-        wp = csv.writer(fprof)
-        wp.writerow(["liquid", "tip_radius_m", "method", "p_ratio", "r_m", "z_m"])
-    timings = {}
-    for lq in scene.liquids:
-        iso = scene.isotherms[lq.name]
-        for R in scene.radii:
-            for meth in scene.methods:
-                t1 = time.perf_counter()
-                res = sweep(meth, R, lq, scene.temperature, iso, scene.p_ratios,
-                            scene.separation, elements=scene.elements)
-                timings[f"{lq.name}/{R:g}/{meth}"] = time.perf_counter() - t1
-                results[lq.name, R, meth] = res
-                for x, r in zip(scene.p_ratios, res):
-                    if isinstance(r, Exception):
-                        errors.append({"liquid": lq.name, "tip_radius_m": R, "method": meth,
-                                       "p_ratio": x, "error": str(r)})
-                        row = [meth, x, "", "", "nan", "nan", "nan", lq.name, R]
-                    else:
-                        row = [meth, x, r.film, r.kelvin_radius, r.force,
-                               r.force_over_4piRgamma, r.neck_radius, lq.name, R]
-                        if write:
-                            for rr, zz in zip(r.r, r.z):
-                                wp.writerow([lq.name, R, meth, x, repr(float(rr)),
-                                             repr(float(zz))])
-                    if write:
-                        w.writerow([repr(v) if isinstance(v, float) else v for v in row])
-                if write:
-                    fcsv.flush()
-                    if scene.vtk and meth == "fe":
-                        _write_vtk(out, lq.name, R, scene.p_ratios, res)
-    wall = time.perf_counter() - t0
-    if write:
-        fcsv.close()
-        fprof.close()
-        write_json(out / "summary.json", {
-            "femadh_version": __version__, "scene_file": scene.path, "note": NOTE,
-            "scene": scene.resolved, "domain_errors": errors, "timings_s": timings,
-            "wall_time_s": wall})
-        if figures:
-            from ..io.plots import meniscus_forces
+    res = MeniscusRunResult(scene.name, scene, out_dir=None if folder is None
+                            else str(folder.path))
+    logs = None
+    combos = [(lq, R, m) for lq in scene.liquids for R in scene.radii for m in scene.methods]
+    bar = None
+    if progress:
+        from ..io.progress import bar as make_bar
 
-            meniscus_forces(scene, results, out / "meniscus_force.png")
-    return results, errors, wall
+        bar = make_bar(len(combos) * len(scene.p_ratios), scene.name)
+    with interrupt.interruptible():
+        try:
+            if folder is not None:
+                folder.write_summary(summary(res, status="running"))
+                logs = (RowLog(folder.path / "meniscus.csv", HEADER),
+                        RowLog(folder.path / "profiles.csv",
+                               ["liquid", "tip_radius_m", "method", "p_ratio", "r_m", "z_m"]))
+            for lq, R, meth in combos:
+                iso = scene.isotherms[lq.name]
+                cur = {k: [] for k in COLUMNS}
+                res.curves[lq.name, R, meth] = cur
+                t1 = time.perf_counter()
+                points = []
+                for x, r in sweep_points(meth, R, lq, scene.temperature, iso, scene.p_ratios,
+                                         scene.separation, elements=scene.elements):
+                    points.append(r)
+                    _record(res, cur, lq, R, meth, x, r, logs)
+                    if bar is not None:
+                        bar.update(1)
+                    interrupt.check()
+                res.timings[f"{lq.name}/{R:g}/{meth}_s"] = time.perf_counter() - t1
+                if folder is not None and scene.vtk and meth == "fe":
+                    _write_vtk(folder.path, lq.name, R, scene.p_ratios, points)
+        except Interrupted as exc:
+            res.status, res.error = "interrupted", str(exc)
+            res.exit_code = exc.exit_code
+        finally:
+            if bar is not None:
+                bar.close()
+            for log in logs or ():
+                log.close()
+            for cur in res.curves.values():
+                for k in cur:
+                    cur[k] = np.array(cur[k], float)
+            n_ok = sum(int(np.sum(np.isfinite(c["force_N"]))) for c in res.curves.values())
+            if res.status == "converged" and n_ok == 0:
+                res.status = "failed"
+                res.error = (f"no point of the scene has a meniscus ({len(res.errors)} points "
+                             f"failed; first: {res.errors[0]['error'] if res.errors else '-'})")
+            res.timings["total_s"] = time.perf_counter() - t0
+            if folder is not None:
+                folder.write_summary(summary(res))
+    return res
+
+
+def _record(res, cur, lq, R, meth, x, r, logs):
+    """One p/psat point (a MeniscusResult or the DomainError/ConvergenceError of a point
+    without a meniscus) into the result and the csv files."""
+    if isinstance(r, Exception):
+        res.errors.append({"liquid": lq.name, "tip_radius_m": R, "method": meth, "p_ratio": x,
+                           "error": str(r)})
+        vals = [x] + [math.nan] * 5
+        row = [meth, repr(x), "", "", "nan", "nan", "nan", lq.name, repr(R)]
+    else:
+        vals = [x, r.film, r.kelvin_radius, r.force, r.force_over_4piRgamma, r.neck_radius]
+        row = [meth] + [repr(float(v)) for v in vals] + [lq.name, repr(R)]
+    for k, v in zip(COLUMNS, vals):
+        cur[k].append(v)
+    if logs:
+        if not isinstance(r, Exception):
+            logs[1].append([[lq.name, repr(R), meth, repr(x), repr(float(rr)), repr(float(zz))]
+                            for rr, zz in zip(r.r, r.z)])
+        logs[0].append([row])
 
 
 def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
     """Meniscus surface of revolution per p/psat (quads) and a .pvd keyed by p/psat."""
     import meshio
 
+    from ..io.atomic import save_atomic
     from ..io.vtk import write_pvd
 
-    vdir = out / "vtk"
+    vdir = Path(out) / "vtk"
     vdir.mkdir(exist_ok=True)
     tag = f"{liquid}_R{R * 1e9:g}nm"
     entries = []
@@ -98,7 +154,14 @@ def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
         jn = (j + 1) % n_theta
         quads = np.stack([i + j, i + jn, i + n_theta + jn, i + n_theta + j], -1).reshape(-1, 4)
         name = f"meniscus_{tag}_{k:03d}.vtu"
-        meshio.write(vdir / name, meshio.Mesh(pts, [("quad", quads)],
-                                              point_data={"z": pts[:, 2]}))
+        mesh = meshio.Mesh(pts, [("quad", quads)], point_data={"z": pts[:, 2]})
+        save_atomic(vdir / name, lambda p, mesh=mesh: meshio.write(p, mesh, file_format="vtu"))
         entries.append((x, f"vtk/{name}", 0))
-    write_pvd(out / f"meniscus_{tag}.pvd", entries)
+    write_pvd(Path(out) / f"meniscus_{tag}.pvd", entries)
+
+
+def summary(res, status=None):
+    return {"femadh_version": __version__, "scene_file": res.scene.path,
+            "status": status or res.status, "error": res.error, "note": NOTE,
+            "scene": res.scene.resolved, "domain_errors": res.errors,
+            "timings_s": res.timings, "wall_time_s": res.wall_time}

@@ -1,10 +1,15 @@
 """Scene files (TOML) -> validated scenes: the user-facing contract.
 
-Quantities are strings with units ("2 mm") or plain numbers in SI. Unknown keys, missing keys,
-wrong units and unphysical values raise :class:`~femadh.errors.SceneError` naming the file,
-the key, the value and what was expected. A scene with a ``[meniscus]`` table is a capillary
+Quantities are strings with units ("2 mm", "25 degC"); in scene *files* a bare number for a
+dimensional key is an error (``radius = 2`` would silently mean 2 m), in scenes built in code
+(:meth:`Scene.from_dict`, :meth:`Scene.replace`) it is taken as SI. Every problem of a scene -
+unknown keys (with a "did you mean"), missing keys, wrong units, values out of range - is
+reported at once, each naming the file, the key, the value and what was expected
+(:class:`~femadh.errors.SceneError`). A scene with a ``[meniscus]`` table is a capillary
 (paper 2) scene (:class:`MeniscusScene`); otherwise a contact scene (:class:`Scene`).
+``femadh keys`` prints every key (:func:`reference_page`).
 """
+import copy
 from pathlib import Path
 
 try:
@@ -18,8 +23,8 @@ from .contact import Scene, parse_contact
 from .meniscus import MeniscusScene, parse_meniscus
 from .reader import Reader
 
-__all__ = ["Scene", "MeniscusScene", "load_scene", "scene_from_dict", "build_operator",
-           "build_problem"]
+__all__ = ["Scene", "MeniscusScene", "load_scene", "scene_from_dict", "apply_overrides",
+           "build_operator", "build_problem", "reference_page"]
 
 
 def load_scene(path):
@@ -32,12 +37,13 @@ def load_scene(path):
 
     Returns
     -------
-    Scene
+    Scene or MeniscusScene
 
     Raises
     ------
     SceneError
-        On any malformed, missing, unknown or unphysical entry.
+        Naming every malformed, missing, unknown or unphysical entry (SceneErrors when
+        there are several).
     """
     path = Path(path)
     try:
@@ -45,16 +51,68 @@ def load_scene(path):
     except OSError as exc:
         raise SceneError(str(path), "(file)", str(path), f"a readable file ({exc.strerror})") \
             from None
+    except UnicodeDecodeError:
+        raise SceneError(str(path), "(file)", str(path), "a UTF-8 text (TOML) file") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(str(path), "(file)", "(TOML text)", f"valid TOML ({exc})") from None
-    return scene_from_dict(data, str(path))
+    return scene_from_dict(data, str(path), bare_numbers=False)
 
 
-def scene_from_dict(data, file=None):
-    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`."""
-    top = Reader(file, data, "")
-    if "meniscus" in data:
-        return parse_meniscus(top, file)
-    return parse_contact(top, file)
+def scene_from_dict(data, file=None, *, bare_numbers=True):
+    """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`.
+    ``bare_numbers``: whether plain numbers are SI for dimensional keys (code) or errors
+    (files)."""
+    reader = Reader(file, bare_numbers=bare_numbers)
+    if not isinstance(data, dict):
+        reader.fail("(top level)", data, "a table of tables")
+        reader.finish()
+    parse = parse_meniscus if "meniscus" in data else parse_contact
+    scene = parse(reader, data, file)
+    reader.finish()
+    return scene
+
+
+def apply_overrides(raw, changes):
+    """A deep copy of a scene dict with dotted keys set (``"effects.asperity_gap.sigma"``);
+    intermediate tables are created. The result is a dict, to be validated."""
+    data = copy.deepcopy(raw)
+    for dotted, value in changes.items():
+        parts = dotted.split(".")
+        node = data
+        for p in parts[:-1]:
+            if not isinstance(node.get(p), dict):
+                node[p] = {}
+            node = node[p]
+        node[parts[-1]] = value
+    return data
+
+
+def reference_page():
+    """Markdown page of every scene key, generated from the declarative tables."""
+    from ..laws.registry import registry
+    from ..schema import REQUIRED
+    from . import contact, liquids, meniscus
+    from .reader import _words
+
+    tables = (list(contact.TABLES[:4]) + [r.table for r in registry().values()]
+              + list(contact.TABLES[4:]) + list(meniscus.TABLES) + [liquids.LIQUID_TABLE]
+              + list(liquids.ISOTHERM_TABLES.values()))
+    lines = ["# Scene keys", "", "Generated from femadh's scene schema (`femadh keys`). "
+             "Quantities are strings with units (\"2 mm\", \"0.165 nm\", \"25 degC\"); in "
+             "scene files a bare number for a dimensional key is an error.", ""]
+    seen = set()
+    for t in tables:
+        tag = (t.path, t.doc)
+        if tag in seen:
+            continue
+        seen.add(tag)
+        lines += [f"## [{t.path}]" if t.path else "## (top level)", "", t.doc, "",
+                  "| key | expected | default | meaning |", "|---|---|---|---|"]
+        for k in t.keys:
+            default = "required" if k.default is REQUIRED else (
+                "-" if k.default is None else f"`{k.default!r}`".replace("'", '"'))
+            lines.append(f"| `{k.name}` | {k.expected(_words(k))} | {default} | {k.doc} |")
+        lines.append("")
+    return "\n".join(lines)

@@ -1,29 +1,153 @@
-"""Contact scenes (paper 1): the sphere, the materials, the effects (gap laws and the
-sigma-gap), the solver and the sweep, validated into a :class:`Scene` in SI units."""
+"""Contact scenes (paper 1): the sphere, the materials, the effects (gap laws and the sigma-gap),
+the solver and the sweep, validated into a :class:`Scene` in SI units.
+
+Every key is described once in the tables below (and, for the laws, in their registrations in
+:mod:`femadh.laws.registry`); ``femadh keys`` prints them all.
+"""
+import copy
 from dataclasses import asdict, dataclass, field
 import math
 
 from ..contact.constraints import CONTACT_MODELS, AsperityGap
-from ..errors import SceneError
 from ..indenter import PROFILES, Sphere
-from ..laws import LennardJones
+from ..laws.registry import BuildContext, registry
 from ..materials import IsotropicMaterial, composite_modulus
-from .reader import Reader, scene_name
+from ..schema import Key, Table
+from .reader import BAD, any_bad
 
 METHODS = ("green", "fe")
 DIRECTIONS = ("approach", "retract")
+#: the largest number of separations a sweep may list
+MAX_SEPARATIONS = 100000
 
-_TOP = {"scene", "sphere", "materials", "effects", "solver", "sweep", "output"}
-_EFFECTS = {"lennard_jones", "asperity_gap", "capillary", "asperity_adhesion",
-            "asperity_contact"}
+
+def _directions(reader, raw, path):
+    if (not isinstance(raw, list) or not raw or any(x not in DIRECTIONS for x in raw)
+            or len(set(raw)) != len(raw)):
+        return reader.fail(path, raw, "a list drawn from ['approach', 'retract']")
+    return tuple(raw)
+
+
+def _analysis_radius(reader, raw, path):
+    """A length, or { delta = length } with delta = a^2 / 2R (paper 1 sec 4): returned as
+    ("radius", a) or ("delta", delta); the sphere turns delta into a radius."""
+    if isinstance(raw, dict):
+        v = reader.read(DELTA, raw, path)
+        return BAD if v["delta"] is BAD else ("delta", v["delta"])
+    v = reader.value(Key("analysis_radius", "length", "", lo=0.0), raw, path)
+    return BAD if v is BAD else ("radius", v)
+
+
+DELTA = Table("solver.analysis_radius", "The analysis radius by its gap a^2/2R.", (
+    Key("delta", "length", "Gap of the undeformed sphere at the analysis radius, a^2/(2R) "
+        "(paper 1 sec 4 uses 10 nm).", lo=0.0),))
+
+SCENE = Table("scene", "The scene's identity.", (
+    Key("name", "string", "Name of the scene (output folder default out/<name>)."),))
+
+SPHERE = Table("sphere", "The rigid sphere (slider, tip, asperity), paper 1 eq (4).", (
+    Key("radius", "length", "Sphere radius R (paper 1: 2 mm slider, 1 um in Fig 6).", lo=0.0),
+    Key("profile", "choice", "'paraboloid': b = d + r^2/2R (eq 4); 'sphere': the exact cap.",
+        default="paraboloid", choices=PROFILES),
+))
+
+MATERIAL = Table("materials.disk", "An isotropic elastic solid.", (
+    Key("youngs_modulus", "pressure", "Young's modulus E.", lo=0.0),
+    Key("poisson_ratio", "number", "Poisson ratio nu.", lo=-1.0, hi=0.5),
+))
+
+MATERIALS = Table("materials", "Elastic constants: disk and slider (composite modulus E* of "
+                  "eq 2) or E* itself.", (
+    Key("disk", "custom", "{ youngs_modulus, poisson_ratio } of the disk (flat).",
+        default=None, parse=lambda r, raw, path: _material(r, raw, path),
+        expect="a table { youngs_modulus, poisson_ratio }"),
+    Key("slider", "custom", "{ youngs_modulus, poisson_ratio } of the sphere; omitted: rigid.",
+        default=None, parse=lambda r, raw, path: _material(r, raw, path),
+        expect="a table { youngs_modulus, poisson_ratio }"),
+    Key("composite_modulus", "pressure", "E* directly, instead of disk/slider.", default=None,
+        lo=0.0),
+))
+
+GAP = Table("effects.asperity_gap", "The minimum gap sigma set by compressed asperities, "
+            "paper 1 eq (8): h >= sigma.", (
+    Key("sigma", "length", "Spacing of the mean planes in contact (Figs 3/4: 1 and 0.5 nm).",
+        lo=0.0),
+    Key("contact_model", "choice", "'complementarity': h >= sigma, p_c >= 0, p_c (h - sigma) "
+        "= 0, exact; 'hertz-closure': the paper's Hertz-shaped contact pressure (eq 9) with "
+        "the contact radius a continuous unknown.", default="complementarity",
+        choices=CONTACT_MODELS),
+))
+
+MESH = Table("solver.mesh", "FE mesh of the half-space (method = 'fe').", (
+    Key("outer_factor", "number", "Far boundary radius over the analysis radius.",
+        default=1e4, lo=1.0, hi=1e7, hi_closed=True),
+    Key("growth", "number", "Element size growth with distance from the loaded surface.",
+        default=0.25, lo=0.0, hi=2.0, hi_closed=True),
+    Key("surface_fraction", "number", "Surface element size over the node spacing.",
+        default=0.5, lo=0.0, hi=1.0, hi_closed=True),
+    Key("far_field", "choice", "Data on the far arc: the Boussinesq field (error O(a^2/L^2)) "
+        "or 'fixed' (O(a/L)).", default="boussinesq", choices=("boussinesq", "fixed")),
+    Key("poisson_ratio", "number", "Poisson ratio of the FE body (default: the disk's, else "
+        "0.3).", default=None, lo=-1.0, hi=0.5),
+))
+
+SOLVER = Table("solver", "Discretisation and solver.", (
+    Key("method", "choice", "Elastic half-space: exact Green function or condensed finite "
+        "elements.", default="green", choices=METHODS),
+    Key("nodes", "integer", "Radial nodes N on the analysis disk.", default=200, lo=8,
+        lo_closed=True, hi=20000, hi_closed=True),
+    Key("analysis_radius", "custom", "The analysed disk: a length, or { delta = length } "
+        "with delta = a^2/2R.", default={"delta": "10 nm"}, parse=_analysis_radius,
+        expect="a length, or a table { delta = length }"),
+    Key("tolerance", "length", "Residual of eq 6/10 every state meets.",
+        default="1e-10 nm", lo=0.0),
+    Key("max_iter", "integer", "Newton iterations per solve.", default=40, lo=1,
+        lo_closed=True, hi=10000, hi_closed=True),
+    Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
+        "laws only).", default="steps", choices=("steps", "arclength")),
+    Key("mesh", "custom", "FE mesh settings (method = 'fe'), see [solver.mesh].",
+        default=None, parse=lambda r, raw, path: None if raw is None else r.read(MESH, raw, path),
+        expect="a table (see [solver.mesh])"),
+))
+
+SWEEP = Table("sweep", "The separations d of the sphere tip above the undeformed mean plane.", (
+    Key("start", "length", "First separation."),
+    Key("stop", "length", "Last separation."),
+    Key("step", "length", "Step between separations.", lo=0.0),
+    Key("directions", "custom", "Branches to trace: approach (start -> stop) and/or retract.",
+        default=["approach", "retract"], parse=_directions,
+        expect="a list drawn from ['approach', 'retract']"),
+))
+
+OUTPUT = Table("output", "Outputs.", (
+    Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
+    Key("vtk", "bool", "VTK volume and surface files per state (FE only; default: true for "
+        "FE).", default=None),
+))
+
+#: the tables of a contact scene file
+TOP = ("scene", "sphere", "materials", "effects", "solver", "sweep", "output")
+#: every table description, for the reference page (femadh keys)
+TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, GAP, SOLVER, DELTA, MESH, SWEEP, OUTPUT)
+
+
+def _material(reader, raw, path):
+    if raw is None:
+        return None
+    v = reader.read(MATERIAL, raw, path)
+    if any_bad(v):
+        return BAD
+    return IsotropicMaterial(v["youngs_modulus"], v["poisson_ratio"])
 
 
 @dataclass
 class Scene:
-    """A validated scene, all quantities in SI units.
+    """A validated contact scene, all quantities in SI units.
 
-    Attributes mirror the TOML sections; ``raw`` keeps the file's own text values and
-    ``resolved`` the SI values written to summary.json.
+    Build one from a file (:func:`femadh.load_scene`), from a dict (:meth:`from_dict`), or
+    from another with changes (:meth:`replace`): each goes through the same validation, and
+    derived values (analysis radius, E*, the laws) are recomputed. ``raw`` keeps the scene's
+    own values; ``resolved`` the SI values written to summary.json.
     """
 
     name: str
@@ -44,7 +168,32 @@ class Scene:
     fe_poisson_ratio: float = 0.3
     vtk: bool = False
     continuation: str = "steps"
+    disk: IsotropicMaterial | None = None
+    slider: IsotropicMaterial | None = None
     raw: dict = field(repr=False, default_factory=dict)
+
+    kind = "contact"
+
+    @classmethod
+    def from_dict(cls, data, file=None):
+        """Validate a contact scene given as a dict (keys as in the TOML file; numbers for
+        dimensional keys are SI in code-built scenes)."""
+        from . import scene_from_dict
+
+        sc = scene_from_dict(data, file, bare_numbers=True)
+        if not isinstance(sc, cls):
+            raise TypeError("the dict describes a meniscus scene, not a contact scene")
+        return sc
+
+    def replace(self, changes=None, **kw):
+        """A new scene with keys changed, validated like a file: ``changes`` maps dotted keys
+        to values (``{"sphere.radius": "1 um", "effects.asperity_gap.sigma": "0.5 nm"}``);
+        keywords use ``__`` for the dots (``sphere__radius="1 um"``)."""
+        from . import apply_overrides, scene_from_dict
+
+        data = apply_overrides(self.raw, {**(changes or {}),
+                                          **{k.replace("__", "."): v for k, v in kw.items()}})
+        return scene_from_dict(data, self.path, bare_numbers=True)
 
     @property
     def resolved(self):
@@ -53,266 +202,221 @@ class Scene:
             "name": self.name,
             "sphere": {"radius_m": self.sphere.radius, "profile": self.sphere.profile},
             "composite_modulus_Pa": self.e_star,
-            "effects": {name: asdict(e) for name, e in self.effects.items()},
+            "effects": {name: _law_dict(e) for name, e in self.effects.items()},
             "asperity_gap": None if self.gap is None else
-            {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model},
+            {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model,
+             "adhesion_Pa": self.gap.adhesion},
             "solver": {"method": self.method, "nodes": self.nodes,
                        "analysis_radius_m": self.analysis_radius,
                        "tolerance_m": self.tolerance, "max_iter": self.max_iter,
                        "continuation": self.continuation,
                        "mesh": None if self.fe_settings is None else {
-                           "outer_factor": self.fe_settings.outer_factor,
-                           "growth": self.fe_settings.growth,
-                           "surface_fraction": self.fe_settings.surface_fraction,
-                           "far_field": self.fe_settings.far_field,
-                           "poisson_ratio": self.fe_poisson_ratio}},
+                           **asdict(self.fe_settings), "poisson_ratio": self.fe_poisson_ratio}},
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
             "output_dir": self.output_dir,
         }
 
 
-def _capillary(file, table):
-    """[effects.capillary]: liquid, temperature, relative_pressure, isotherm, smoothing."""
-    from ..laws import CapillaryCondensate
-    from ..meniscus.isotherms import default_isotherm
-    from ..meniscus.kelvin import kelvin_radius
-    from ..meniscus.liquids import LIQUIDS
-    from .liquids import read_isotherm, read_liquid
-
-    c = Reader(file, table, "effects.capillary")
-    liquid = read_liquid(c, c.raw("liquid"))
-    temperature = c.quantity("temperature", "temperature", default="298.15 K")
-    x = c.raw("relative_pressure")
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 < x < 1:
-        raise c.error("relative_pressure", x, "a number in (0, 1)")
-    iso_raw = c.raw("isotherm", None)
-    if iso_raw is None:
-        iso = default_isotherm(liquid.name) if liquid.name in LIQUIDS else None
-    else:
-        iso = read_isotherm(c, iso_raw)
-    smoothing = c.raw("smoothing", 0.02)
-    if isinstance(smoothing, bool) or not isinstance(smoothing, (int, float)) \
-            or not 0 < smoothing <= 0.5:
-        raise c.error("smoothing", smoothing, "a fraction in (0, 0.5] of the filled gap")
-    c.done()
-    r_k = kelvin_radius(liquid, float(x), temperature)
-    film = 0.0 if iso is None else float(iso(float(x)))
-    fill = 2 * abs(r_k) + 2 * film
-    return CapillaryCondensate(liquid.surface_tension, r_k, film, float(smoothing) * fill)
-
-
-def _asperity_adhesion(file, table, sigma):
-    """[effects.asperity_adhesion]: eq 20 over the contact region."""
-    from ..laws import AsperityAdhesion
-
-    t = Reader(file, table, "effects.asperity_adhesion")
-    Ra = t.quantity("asperity_radius", "length")
-    dg = t.quantity("surface_energy", "surface_energy")
-    rho = t.quantity("density", "areal_density", positive=False)
-    if rho < 0:
-        raise t.error("density", table["density"], "a density >= 0")
-    p = t.raw("contact_probability", 0.5)
-    if isinstance(p, bool) or not isinstance(p, (int, float)) or not 0 <= p <= 1:
-        raise t.error("contact_probability", p, "a number in [0, 1]")
-    sm = t.raw("smoothing", 0.02)
-    if isinstance(sm, bool) or not isinstance(sm, (int, float)) or not 0 < sm <= 0.2:
-        raise t.error("smoothing", sm, "a fraction in (0, 0.2] of sigma")
-    t.done()
-    return AsperityAdhesion.from_asperities(Ra, dg, rho, float(p), sigma, float(sm))
-
-
-def _asperity_contact(file, table, e_star):
-    """[effects.asperity_contact] model = "greenwood-williamson": eqs 23-24 as gap laws."""
-    from ..laws import GWAdhesion, GWElastic, Summits
-
-    t = Reader(file, table, "effects.asperity_contact")
-    t.choice("model", ("greenwood-williamson",))
-    rough = Summits(t.quantity("rms_height", "length"),
-                      t.quantity("mean_height", "length", positive=False),
-                      t.quantity("asperity_radius", "length"),
-                      t.quantity("density", "areal_density"))
-    dg = t.quantity("surface_energy", "surface_energy", default=0.0, positive=False)
-    t.done()
-    out = {"asperity_elastic": GWElastic(rough, e_star)}
-    if dg > 0:
-        out["asperity_adhesion"] = GWAdhesion(rough, dg)
+def _law_dict(law):
+    out = {}
+    for k, v in asdict(law).items():
+        out[k] = v if isinstance(v, (int, float, str, type(None))) else repr(v)
     return out
 
 
-def _material(r, k):
-    t = r.table_at(k)
-    m = Reader(r.file, t, r.key(k))
-    E = m.quantity("youngs_modulus", "pressure")
-    nu = m.raw("poisson_ratio")
-    if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
-        raise m.error("poisson_ratio", nu, "a number in (-1, 0.5)")
-    m.done()
-    return IsotropicMaterial(E, float(nu))
+def parse_contact(reader, data, file):
+    """Build a contact :class:`Scene` from the parsed TOML ``data``; every error is recorded
+    in ``reader`` and raised together by the caller."""
+    for name in data:
+        if name not in TOP:
+            reader.unknown("", name, data[name], list(TOP))
+    sc = reader.read(SCENE, data.get("scene"), "scene")
+    sp = reader.read(SPHERE, data.get("sphere"), "sphere")
+    if "sphere" not in data:
+        reader.fail("sphere", None, "a [sphere] table (it is required)")
+    sphere = None if any_bad(sp) else Sphere(sp["radius"], sp["profile"])
+
+    e_star, disk, slider = _read_materials(reader, data)
+    gap, effects = _read_effects(reader, data.get("effects"), e_star)
+
+    so = reader.read(SOLVER, data.get("solver"), "solver")
+    a = _analysis_radius_m(reader, so, sphere)
+    sw = reader.read(SWEEP, data.get("sweep"), "sweep")
+    if "sweep" not in data:
+        reader.fail("sweep", None, "a [sweep] table (it is required)")
+    d_values = _separations(reader, sw, data.get("sweep") or {})
+    ou = reader.read(OUTPUT, data.get("output"), "output")
+
+    method = so["method"]
+    fe_settings, fe_nu = None, (disk.poisson_ratio if isinstance(disk, IsotropicMaterial)
+                                else 0.3)
+    if so["mesh"] is not None and so["mesh"] is not BAD:
+        if method != "fe":
+            reader.fail("solver.mesh", data["solver"]["mesh"], "no [solver] mesh table unless "
+                        "method = \"fe\"")
+        elif not any_bad(so["mesh"]):
+            fe_settings, fe_nu = _fe_settings(so["mesh"], fe_nu)
+    elif method == "fe":
+        fe_settings, fe_nu = _fe_settings(reader.read(MESH, None, "solver.mesh"), fe_nu)
+    vtk = ou["vtk"] if ou["vtk"] is not None else method == "fe"
+    if vtk is True and method != "fe":
+        reader.fail("output.vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
+                    "operator has no interior field to write)")
+    _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a)
+    if reader.errors:
+        return None
+    name = sc["name"]
+    return Scene(name=name, path=file, sphere=sphere, e_star=e_star, effects=effects, gap=gap,
+                 method=method, nodes=so["nodes"], analysis_radius=a,
+                 tolerance=so["tolerance"], max_iter=so["max_iter"], fe_settings=fe_settings,
+                 d_values=d_values, directions=sw["directions"],
+                 output_dir=ou["dir"] or f"out/{name}", fe_poisson_ratio=fe_nu, vtk=vtk,
+                 continuation=so["continuation"], disk=disk, slider=slider,
+                 raw=copy.deepcopy(data))
 
 
-def parse_contact(top, file):
-    """Build a contact :class:`Scene` from the top-level Reader of a scene file."""
-    data = top.table
-    top.used |= _TOP
-    top.done(_TOP)
+def _read_materials(reader, data):
+    mt = reader.read(MATERIALS, data.get("materials"), "materials")
+    if "materials" not in data:
+        reader.fail("materials", None, "a [materials] table (it is required)")
+        return BAD, None, None
+    if any_bad(mt):
+        return BAD, None, None
+    if mt["composite_modulus"] is not None:
+        if mt["disk"] is not None or mt["slider"] is not None:
+            reader.fail("materials.composite_modulus", data["materials"]["composite_modulus"],
+                        "either composite_modulus or disk/slider, not both")
+            return BAD, None, None
+        return mt["composite_modulus"], None, None
+    if mt["disk"] is None:
+        reader.fail("materials.disk", None, "a table { youngs_modulus, poisson_ratio } (or "
+                    "materials.composite_modulus)")
+        return BAD, None, None
+    return composite_modulus(mt["disk"], mt["slider"]), mt["disk"], mt["slider"]
 
-    name = scene_name(top, file)
 
-    sp = Reader(file, top.table_at("sphere"), "sphere")
-    sphere = Sphere(sp.quantity("radius", "length"),
-                    sp.choice("profile", PROFILES, "paraboloid"))
-    sp.done()
+def _read_effects(reader, table, e_star):
+    """The sigma-gap and the laws the [effects.*] tables name (through the law registry)."""
+    if table is None or not isinstance(table, dict) or not table:
+        reader.fail("effects", table, "at least one surface force effect, e.g. "
+                    "[effects.lennard_jones]")
+        return None, {}
+    reg = registry()
+    allowed = ["asperity_gap"] + list(reg)
+    for name in table:
+        if name not in allowed:
+            reader.unknown("effects", name, table[name], allowed)
+    gap = None
+    if "asperity_gap" in table:
+        g = reader.read(GAP, table["asperity_gap"], "effects.asperity_gap")
+        if not any_bad(g):
+            gap = AsperityGap(g["sigma"], g["contact_model"])
+    if "asperity_adhesion" in table and "asperity_gap" not in table:
+        reader.fail("effects.asperity_adhesion", table["asperity_adhesion"], "an "
+                    "[effects.asperity_gap] as well: eq 20 acts over the sigma-gap contact "
+                    "region")
+        return gap, {}
+    if "asperity_contact" in table and "asperity_gap" in table:
+        reader.fail("effects.asperity_contact", table["asperity_contact"], "no "
+                    "[effects.asperity_gap]: the Greenwood-Williamson model replaces the hard "
+                    "sigma-gap")
+    effects, adhesion = {}, 0.0
+    ctx = BuildContext(e_star if e_star is not BAD else math.nan,
+                       None if gap is None else gap.sigma)
+    for name, entry in reg.items():
+        if name not in table:
+            continue
+        values = reader.read(entry.table, table[name], f"effects.{name}")
+        if any_bad(values) or e_star is BAD:
+            continue
+        built = entry.build(values, ctx)
+        effects.update(built.laws)
+        adhesion += built.gap_adhesion
+    if gap is not None and adhesion:
+        gap = AsperityGap(gap.sigma, gap.contact_model, adhesion)
+    if gap is not None and gap.contact_model == "hertz-closure":
+        if "asperity_adhesion" in effects:
+            reader.fail("effects.asperity_adhesion.model", "smoothed", "'contact-set' with "
+                        "contact_model = 'hertz-closure' (the closure applies eq 20 over "
+                        "r < r_c exactly)")
+        if "lj" not in effects:
+            reader.fail("effects.asperity_gap.contact_model", gap.contact_model,
+                        "'complementarity' unless [effects.lennard_jones] is present")
+    # (a bare sigma-gap without laws is Hertz contact, A = 0: a valid limit)
+    if not effects and gap is None and not reader.errors:
+        reader.fail("effects", sorted(table), "at least one surface force effect, e.g. "
+                    "[effects.lennard_jones]")
+    return gap, effects
 
-    mt = Reader(file, top.table_at("materials"), "materials")
-    disk = None
-    if "composite_modulus" in mt.table:
-        if "disk" in mt.table or "slider" in mt.table:
-            raise mt.error("composite_modulus", mt.table["composite_modulus"],
-                           "either composite_modulus or disk/slider, not both")
-        e_star = mt.quantity("composite_modulus", "pressure")
-    else:
-        disk = _material(mt, "disk")
-        slider = _material(mt, "slider") if "slider" in mt.table else None
-        e_star = composite_modulus(disk, slider)
-    mt.done()
 
-    ef = Reader(file, top.table_at("effects", {}), "effects")
-    effects, gap = {}, None
-    lj_t = ef.table_at("lennard_jones", None)
-    if lj_t is not None:
-        lj = Reader(file, lj_t, "effects.lennard_jones")
-        effects["lj"] = LennardJones(lj.quantity("hamaker", "energy"),
-                                     lj.quantity("equilibrium_distance", "length"))
-        lj.done()
-    gap_t = ef.table_at("asperity_gap", None)
-    if gap_t is not None:
-        g = Reader(file, gap_t, "effects.asperity_gap")
-        gap = AsperityGap(g.quantity("sigma", "length"),
-                          g.choice("contact_model", CONTACT_MODELS, "complementarity"))
-        g.done()
-    cap_t = ef.table_at("capillary", None)
-    if cap_t is not None:
-        effects["capillary"] = _capillary(file, cap_t)
-    ad_t = ef.table_at("asperity_adhesion", None)
-    if ad_t is not None:
-        if gap is None:
-            raise SceneError(file, "effects.asperity_adhesion", ad_t, "an [effects.asperity_gap]"
-                             " as well: eq 20 acts over the sigma-gap contact region")
-        effects["asperity_adhesion"] = _asperity_adhesion(file, ad_t, gap.sigma)
-    gw_t = ef.table_at("asperity_contact", None)
-    if gw_t is not None:
-        if gap is not None:
-            raise SceneError(file, "effects.asperity_contact", gw_t, "no [effects.asperity_gap]"
-                             ": the Greenwood-Williamson model replaces the hard sigma-gap")
-        effects.update(_asperity_contact(file, gw_t, e_star))
-    ef.done(_EFFECTS)
-    if not effects:
-        raise SceneError(file, "effects", sorted(ef.table), "at least one surface force "
-                         "effect, e.g. [effects.lennard_jones]")
-    if gap is not None and gap.contact_model == "hertz-closure" and "lj" not in effects:
-        raise SceneError(file, "effects.asperity_gap.contact_model", gap.contact_model,
-                         "'complementarity' unless [effects.lennard_jones] is present")
-
-    so = Reader(file, top.table_at("solver", {}), "solver")
-    method = so.choice("method", METHODS, "green")
-    nodes = so.integer("nodes", 8, 200)
-    ar = so.raw("analysis_radius", {"delta": "10 nm"})
-    if isinstance(ar, dict):
-        arr = Reader(file, ar, "solver.analysis_radius")
-        delta = arr.quantity("delta", "length")
-        arr.done()
-        a = math.sqrt(2.0 * sphere.radius * delta)  # paper 1 sec 4: delta = a^2 / 2R
-    else:
-        a = so.quantity("analysis_radius", "length")
+def _analysis_radius_m(reader, so, sphere):
+    ar = so["analysis_radius"]
+    if ar is BAD or sphere is None:
+        return BAD
+    kind, v = ar
+    a = math.sqrt(2.0 * sphere.radius * v) if kind == "delta" else v
     if sphere.profile == "sphere" and a >= sphere.radius:
-        raise so.error("analysis_radius", ar, f"less than the sphere radius {sphere.radius} m")
-    tol = so.quantity("tolerance", "length", default="1e-10 nm")
-    max_iter = so.integer("max_iter", 1, 40)
-    continuation = so.choice("continuation", ("steps", "arclength"), "steps")
-    if continuation == "arclength" and gap is not None:
-        raise so.error("continuation", continuation, "'steps' with [effects.asperity_gap]: "
-                       "arclength continuation traces smooth laws only (the hard sigma-gap "
-                       "is not smooth)")
-    fe_settings, fe_nu = None, (disk.poisson_ratio if disk is not None else 0.3)
-    mesh_t = so.table_at("mesh", None)
-    if method == "fe":
-        from ..elastic.fe import FESettings
+        reader.fail("solver.analysis_radius", v, f"an analysis radius below the sphere "
+                    f"radius {sphere.radius} m")
+        return BAD
+    return a
 
-        ms = Reader(file, mesh_t or {}, "solver.mesh")
-        d0 = FESettings()
-        outer = ms.raw("outer_factor", d0.outer_factor)
-        growth = ms.raw("growth", d0.growth)
-        surf = ms.raw("surface_fraction", d0.surface_fraction)
-        for k, v, lo, hi in (("outer_factor", outer, 1.0, 1e7), ("growth", growth, 0.0, 2.0),
-                             ("surface_fraction", surf, 0.0, 1.0)):
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
-                raise ms.error(k, v, f"a number in ({lo:g}, {hi:g}]")
-        far = ms.choice("far_field", ("boussinesq", "fixed"), d0.far_field)
-        nu = ms.raw("poisson_ratio", fe_nu)
-        if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1 < nu < 0.5:
-            raise ms.error("poisson_ratio", nu, "a number in (-1, 0.5)")
-        ms.done()
-        fe_settings, fe_nu = FESettings(float(outer), float(growth), float(surf), far), float(nu)
-    elif mesh_t is not None:
-        raise so.error("mesh", mesh_t, "no [solver] mesh table unless method = \"fe\"")
-    so.done()
 
-    cap = effects.get("capillary")
-    delta_a = a * a / (2 * sphere.radius)
-    if cap is not None and cap.fill_gap >= delta_a:
-        raise SceneError(file, "solver.analysis_radius", ar, f"an analysis radius whose gap "
-                         f"a^2/2R = {delta_a * 1e9:.4g} nm exceeds the condensate's filled gap "
-                         f"2|r_K| + 2h = {cap.fill_gap * 1e9:.4g} nm, so that the meniscus lies "
-                         f"inside it (e.g. analysis_radius = {{ delta = "
-                         f"\"{2 * cap.fill_gap * 1e9:.3g} nm\" }})")
-    sw = Reader(file, top.table_at("sweep"), "sweep")
-    start = sw.quantity("start", "length", positive=False)
-    stop = sw.quantity("stop", "length", positive=False)
-    step = sw.quantity("step", "length")
-    dirs = sw.raw("directions", ["approach", "retract"])
-    if (not isinstance(dirs, list) or not dirs or any(x not in DIRECTIONS for x in dirs)
-            or len(set(dirs)) != len(dirs)):
-        raise sw.error("directions", dirs, "a list drawn from ['approach', 'retract']")
+def _separations(reader, sw, raw):
+    if any_bad(sw):
+        return BAD
+    start, stop, step, dirs = sw["start"], sw["stop"], sw["step"], sw["directions"]
     if "approach" in dirs and not stop < start:
-        raise sw.error("stop", sw.table["stop"], f"a separation below start "
-                       f"({sw.table['start']}) for an approach")
-    if dirs == ["retract"] and not stop > start:
-        raise sw.error("stop", sw.table["stop"], f"a separation above start "
-                       f"({sw.table['start']}) for a retract-only sweep")
+        reader.fail("sweep.stop", raw.get("stop"), f"a separation below start "
+                    f"({raw.get('start')}) for an approach")
+        return BAD
+    if dirs == ("retract",) and not stop > start:
+        reader.fail("sweep.stop", raw.get("stop"), f"a separation above start "
+                    f"({raw.get('start')}) for a retract-only sweep")
+        return BAD
     n_steps = abs(stop - start) / step
-    if n_steps > 100000:
-        raise sw.error("step", sw.table["step"], "a step giving at most 100000 separations")
+    if n_steps > MAX_SEPARATIONS:
+        reader.fail("sweep.step", raw.get("step"), f"a step giving at most "
+                    f"{MAX_SEPARATIONS} separations (this one gives {n_steps:.3g})")
+        return BAD
     k = round(n_steps)
     if abs(n_steps - k) > 1e-6:
-        raise sw.error("step", sw.table["step"], f"a step that divides |stop - start| = "
-                       f"{abs(stop - start):.6g} m into whole steps")
-    if continuation == "arclength" and "approach" not in dirs:
-        raise sw.error("directions", dirs, "a list with 'approach' for [solver] continuation "
-                       "= 'arclength' (the curve is traced from start to stop)")
+        reader.fail("sweep.step", raw.get("step"), f"a step that divides |stop - start| = "
+                    f"{abs(stop - start):.6g} m into whole steps")
+        return BAD
     sign = -1.0 if stop < start else 1.0
-    d_values = [start + sign * i * step for i in range(k + 1)]
-    sw.done()
-    if gap is None and d_values[0] <= 0:
-        raise SceneError(file, "sweep.start", sw.table["start"], "a positive separation for a "
-                         "smooth sphere (no [effects.asperity_gap]): the sweep starts from the "
-                         "undeformed surface, which the tip must not touch")
-
-    ou = Reader(file, top.table_at("output", {}), "output")
-    out_dir = ou.raw("dir", f"out/{name}")
-    if not isinstance(out_dir, str) or not out_dir:
-        raise ou.error("dir", out_dir, "a folder path")
-    vtk = ou.raw("vtk", method == "fe")
-    if not isinstance(vtk, bool):
-        raise ou.error("vtk", vtk, "true or false")
-    if vtk and method != "fe":
-        raise ou.error("vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
-                       "operator has no interior field to write)")
-    ou.done()
-
-    return Scene(name=name, path=file, sphere=sphere, e_star=e_star, effects=effects, gap=gap,
-                 method=method, nodes=nodes, analysis_radius=a, tolerance=tol,
-                 max_iter=max_iter, fe_settings=fe_settings, d_values=d_values,
-                 directions=tuple(dirs), output_dir=out_dir, fe_poisson_ratio=fe_nu, vtk=vtk,
-                 continuation=continuation, raw=data)
+    return [start + sign * i * step for i in range(k + 1)]
 
 
+def _fe_settings(mesh, nu_default):
+    from ..elastic.fe.operator import FESettings
+
+    nu = mesh["poisson_ratio"] if mesh["poisson_ratio"] is not None else nu_default
+    return FESettings(mesh["outer_factor"], mesh["growth"], mesh["surface_fraction"],
+                      mesh["far_field"]), float(nu)
+
+
+def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
+    """Rules that tie tables together."""
+    if so["continuation"] == "arclength":
+        if gap is not None:
+            reader.fail("solver.continuation", "arclength", "'steps' with "
+                        "[effects.asperity_gap]: arclength continuation traces smooth laws "
+                        "only (the hard sigma-gap is not smooth)")
+        if not any_bad(sw) and "approach" not in sw["directions"]:
+            reader.fail("sweep.directions", list(sw["directions"]), "a list with 'approach' "
+                        "for [solver] continuation = 'arclength' (the curve is traced from "
+                        "start to stop)")
+    if gap is None and d_values is not BAD and d_values and d_values[0] <= 0:
+        reader.fail("sweep.start", data["sweep"].get("start"), "a positive separation for a "
+                    "smooth sphere (no [effects.asperity_gap]): the sweep starts from the "
+                    "undeformed surface, which the tip must not touch")
+    cap = effects.get("capillary")
+    if cap is not None and a is not BAD and sphere is not None:
+        delta_a = a * a / (2 * sphere.radius)
+        if cap.fill_gap >= delta_a:
+            reader.fail("solver.analysis_radius", (data.get("solver") or {}).get(
+                "analysis_radius", {"delta": "10 nm"}), f"an analysis radius whose gap "
+                f"a^2/2R = {delta_a * 1e9:.4g} nm exceeds the condensate's filled gap "
+                f"2|r_K| + 2h = {cap.fill_gap * 1e9:.4g} nm, so that the meniscus lies inside "
+                f"it (e.g. analysis_radius = {{ delta = \"{2 * cap.fill_gap * 1e9:.3g} nm\" }})")

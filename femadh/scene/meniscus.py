@@ -10,6 +10,7 @@
     methods = ["fe", "shooting", "circular", "no-film"]
     elements = 16                    # FE elements of the meridian
 """
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,8 +18,101 @@ import numpy as np
 from ..meniscus.isotherms import default_isotherm
 from ..meniscus.liquids import LIQUIDS
 from ..meniscus.solve import METHODS
-from .liquids import read_isotherm, read_liquid
-from .reader import Reader, scene_name
+from ..schema import Key, Table
+from .liquids import read_liquid
+from .reader import BAD, any_bad, quantity
+
+#: the most p/psat points a scene may ask for (each is a meniscus solve per liquid, radius and
+#: method; 1e5 already takes minutes)
+MAX_POINTS = 100000
+
+
+def _radii(reader, raw, path):
+    items = raw if isinstance(raw, list) else [raw]
+    if not items:
+        return reader.fail(path, raw, "a length or a non-empty list of lengths")
+    out = [quantity(reader, v, f"{path}[{i}]" if isinstance(raw, list) else path, "length")
+           for i, v in enumerate(items)]
+    if any(x is BAD for x in out):
+        return BAD
+    for i, x in enumerate(out):
+        if not 1e-10 <= x <= 1.0:   # a meniscus needs a tip larger than its molecules
+            return reader.fail(f"{path}[{i}]" if isinstance(raw, list) else path, items[i],
+                               "a tip radius between 0.1 nm and 1 m")
+    return out
+
+
+def _separation(reader, raw, path):
+    if raw == "contact":
+        return None
+    x = quantity(reader, raw, path, "length", positive=False)
+    if x is not BAD and x < 0:
+        return reader.fail(path, raw, "'contact' or a solid-solid gap >= 0")
+    return x
+
+
+def _liquids(reader, raw, path):
+    items = raw if isinstance(raw, list) else [raw]
+    out = [read_liquid(reader, v, path) for v in items]
+    return BAD if any(x is BAD for x in out) or not out else out
+
+
+RANGE = Table("meniscus.relative_pressure", "Evenly spaced p/psat.", (
+    Key("start", "number", "First p/psat.", lo=0.0, hi=1.0),
+    Key("stop", "number", "Last p/psat.", lo=0.0, hi=1.0),
+    Key("num", "integer", "Number of points.", lo=2, lo_closed=True, hi=MAX_POINTS,
+        hi_closed=True),
+))
+
+
+def _p_ratios(reader, raw, path):
+    if isinstance(raw, dict):
+        v = reader.read(RANGE, raw, path)
+        return BAD if any_bad(v) else [float(x) for x in np.linspace(v["start"], v["stop"],
+                                                                      v["num"])]
+    if (not isinstance(raw, list) or not raw or len(raw) > MAX_POINTS
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 < x < 1
+                   for x in raw)):
+        return reader.fail(path, raw, "a list of numbers in (0, 1), or { start, stop, num } "
+                           f"inside (0, 1) with num <= {MAX_POINTS}")
+    return [float(x) for x in raw]
+
+
+def _methods(reader, raw, path):
+    if not isinstance(raw, list) or not raw or any(x not in METHODS for x in raw):
+        return reader.fail(path, raw, f"a list drawn from {list(METHODS)}")
+    return tuple(raw)
+
+
+MENISCUS = Table("meniscus", "Capillary meniscus with an adsorbed film between a sphere and a "
+                 "flat (paper 2), swept in p/psat.", (
+    Key("tip_radius", "custom", "Solid sphere radius R, or a list of them.", parse=_radii,
+        expect="a length or a list of lengths"),
+    Key("separation", "custom", "'contact' (D = -2h, paper 2 Fig 2b) or a solid-solid gap.",
+        default="contact", parse=_separation, expect="'contact' or a length >= 0"),
+    Key("liquid", "custom", "A built-in liquid (water, ethanol, n-butanol, n-pentanol), a "
+        "table { name, surface_tension, molar_volume }, or a list of them.", parse=_liquids,
+        expect="a liquid name, a liquid table, or a list of them"),
+    Key("temperature", "temperature", "Temperature (Kelvin equation, paper 2 eq 6).",
+        default="298.15 K", lo=0.0),
+    Key("isotherm", "isotherm", "Adsorption isotherm { model = gab | bet | polynomial | "
+        "tabulated | none, ... }; default: each built-in liquid's representative GAB "
+        "isotherm.", default="default"),
+    Key("relative_pressure", "custom", "p/psat values: a list, or { start, stop, num }.",
+        parse=_p_ratios, expect="a list of numbers in (0, 1), or { start, stop, num }"),
+    Key("methods", "custom", "Solvers: fe (1D finite elements), shooting (ODE), circular "
+        "(toroidal approximation), no-film (exact, bare solids).", default=list(METHODS),
+        parse=_methods, expect=f"a list drawn from {list(METHODS)}"),
+    Key("elements", "integer", "FE elements of the meridian.", default=16, lo=2,
+        lo_closed=True, hi=4096, hi_closed=True),
+))
+
+OUTPUT = Table("output", "Outputs.", (
+    Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
+    Key("vtk", "bool", "VTK surfaces of revolution of the FE menisci.", default=True),
+))
+
+TABLES = (MENISCUS, RANGE, OUTPUT)
 
 
 @dataclass
@@ -37,6 +131,17 @@ class MeniscusScene:
     vtk: bool = True
     raw: dict = field(repr=False, default_factory=dict)
 
+    kind = "meniscus"
+
+    def replace(self, changes=None, **kw):
+        """A new scene with dotted keys changed, validated like a file (see
+        :meth:`femadh.scene.Scene.replace`)."""
+        from . import apply_overrides, scene_from_dict
+
+        data = apply_overrides(self.raw, {**(changes or {}),
+                                          **{k.replace("__", "."): v for k, v in kw.items()}})
+        return scene_from_dict(data, self.path, bare_numbers=True)
+
     @property
     def resolved(self):
         return {"name": self.name, "tip_radii_m": self.radii,
@@ -51,60 +156,31 @@ class MeniscusScene:
                 "elements": self.elements, "output_dir": self.output_dir}
 
 
-def parse_meniscus(top, file):
-    """Build a MeniscusScene from the top-level _Reader of a scene file."""
-    top.used |= {"scene", "meniscus", "output"}
-    top.done({"scene", "meniscus", "output"})
-    name = scene_name(top, file)
-    m = Reader(file, top.table_at("meniscus"), "meniscus")
-    radii_raw = m.raw("tip_radius")
-    radii_list = radii_raw if isinstance(radii_raw, list) else [radii_raw]
-    radii = []
-    for i, v in enumerate(radii_list):
-        sub = Reader(file, {"tip_radius": v}, "meniscus")
-        radii.append(sub.quantity("tip_radius", "length"))
-    sep_raw = m.raw("separation", "contact")
-    separation = None if sep_raw == "contact" else m.quantity("separation", "length",
-                                                              positive=False)
-    if separation is not None and separation < 0:
-        raise m.error("separation", sep_raw, "'contact' or a solid-solid gap >= 0")
-    liq_raw = m.raw("liquid")
-    liquids = [read_liquid(m, v) for v in (liq_raw if isinstance(liq_raw, list) else [liq_raw])]
-    temperature = m.quantity("temperature", "temperature", default="298.15 K")
-    iso_raw = m.raw("isotherm", None)
+def parse_meniscus(reader, data, file):
+    """Build a MeniscusScene from the parsed TOML ``data`` (errors recorded in ``reader``)."""
+    from .contact import SCENE
+
+    for name in data:
+        if name not in ("scene", "meniscus", "output"):
+            reader.unknown("", name, data[name], ["meniscus", "output", "scene"])
+    sc = reader.read(SCENE, data.get("scene"), "scene")
+    m = reader.read(MENISCUS, data.get("meniscus"), "meniscus")
+    ou = reader.read(OUTPUT, data.get("output"), "output")
     isotherms = {}
-    for lq in liquids:
-        if iso_raw is None:
-            if lq.name not in LIQUIDS:
-                raise m.error("isotherm", None, f"an isotherm table for the user liquid "
-                              f"{lq.name!r} (or model = 'none')")
-            isotherms[lq.name] = default_isotherm(lq.name)
-        else:
-            isotherms[lq.name] = read_isotherm(m, iso_raw)
-    pr = m.raw("relative_pressure")
-    if isinstance(pr, dict):
-        r = Reader(file, pr, "meniscus.relative_pressure")
-        start, stop, num = r.raw("start"), r.raw("stop"), r.integer("num", 2)
-        r.done()
-        p_ratios = list(np.linspace(start, stop, num)) if all(
-            isinstance(v, (int, float)) for v in (start, stop)) else None
-    else:
-        p_ratios = pr if isinstance(pr, list) else None
-    if not p_ratios or any(isinstance(x, bool) or not isinstance(x, (int, float))
-                           or not 0 < x < 1 for x in p_ratios):
-        raise m.error("relative_pressure", pr, "a list of numbers in (0, 1), or "
-                      "{ start, stop, num } inside (0, 1)")
-    methods = m.raw("methods", list(METHODS))
-    if not isinstance(methods, list) or not methods or any(x not in METHODS for x in methods):
-        raise m.error("methods", methods, f"a list drawn from {list(METHODS)}")
-    elements = m.integer("elements", 2, 16)
-    m.done()
-    ou = Reader(file, top.table_at("output", {}), "output")
-    out_dir = ou.raw("dir", f"out/{name}")
-    vtk = ou.raw("vtk", True)
-    if not isinstance(vtk, bool):
-        raise ou.error("vtk", vtk, "true or false")
-    ou.done()
-    return MeniscusScene(name, file, radii, separation, liquids, temperature, isotherms,
-                         [float(x) for x in p_ratios], tuple(methods), elements, out_dir, vtk,
-                         top.table)
+    if m["liquid"] is not BAD and m["isotherm"] is not BAD:
+        for lq in m["liquid"]:
+            if m["isotherm"] == "default":
+                if lq.name not in LIQUIDS:
+                    reader.fail("meniscus.isotherm", None, f"an isotherm table for the user "
+                                f"liquid {lq.name!r} (or model = 'none')")
+                    continue
+                isotherms[lq.name] = default_isotherm(lq.name)
+            else:
+                isotherms[lq.name] = m["isotherm"]
+    if reader.errors:
+        return None
+    name = sc["name"]
+    return MeniscusScene(name, file, m["tip_radius"], m["separation"], m["liquid"],
+                         m["temperature"], isotherms, m["relative_pressure"], m["methods"],
+                         m["elements"], ou["dir"] or f"out/{name}", ou["vtk"],
+                         copy.deepcopy(data))

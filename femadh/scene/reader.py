@@ -1,72 +1,148 @@
-"""Reading one table of a scene file with key-by-key checks; every error names the file, the
-key, the value and what was expected."""
+"""Reading scene tables against their declarative descriptions (:mod:`femadh.schema`).
+
+Every problem is collected - unknown keys (with a "did you mean"), missing keys, wrong units or
+types, values out of range - and reported together: each names the file, the key, the value and
+what was expected.
+"""
+import difflib
 import math
 
-from ..errors import SceneError, _MISSING
-from ..units import to_si
+from ..errors import SceneError, SceneErrors, _MISSING
+from ..units import DIMENSIONS, to_si
+
+
+class _Bad:
+    def __repr__(self):
+        return "(invalid)"
+
+
+#: the value of a key that failed its check (its error is recorded)
+BAD = _Bad()
 
 
 class Reader:
-    """Reads one table with key-by-key checks; remembers the file for error messages."""
+    """Reads the tables of one scene, collecting errors.
 
-    def __init__(self, file, table, prefix):
-        self.file, self.table, self.prefix = file, table, prefix
-        self.used = set()
+    Parameters
+    ----------
+    file : str or None
+        The scene file (for messages).
+    bare_numbers : bool
+        Whether a plain number is SI for a dimensional key (scenes built in code) or an error
+        (scene files: ``radius = 2`` would silently mean 2 m).
+    """
 
-    def key(self, k):
-        return f"{self.prefix}.{k}" if self.prefix else k
+    def __init__(self, file, *, bare_numbers=False):
+        self.file, self.bare_numbers = file, bare_numbers
+        self.errors = []
 
-    def error(self, k, value, expected):
-        return SceneError(self.file, self.key(k), value, expected)
+    def fail(self, path, value, expected):
+        """Record an error; returns BAD."""
+        self.errors.append(SceneError(self.file, path, value, expected))
+        return BAD
 
-    def raw(self, k, default=_MISSING):
-        self.used.add(k)
-        if k in self.table:
-            return self.table[k]
-        if default is _MISSING:
-            raise self.error(k, _MISSING, "this key (it is required)")
-        return default
+    def finish(self):
+        """Raise every recorded error at once."""
+        if len(self.errors) == 1:
+            raise self.errors[0]
+        if self.errors:
+            raise SceneErrors(self.errors)
 
-    def quantity(self, k, dim, *, default=_MISSING, positive=True):
-        v = self.raw(k, default)
-        x = to_si(v, dim, file=self.file, key=self.key(k))
-        if not math.isfinite(x):
-            raise self.error(k, v, "a finite value")
-        if positive and not x > 0:
-            raise self.error(k, v, f"a positive {dim.replace('_', ' ')}")
-        return x
+    def read(self, table, data, path=None):
+        """Values (SI) of the keys of ``table`` from the dict ``data`` (None: all defaults).
 
-    def choice(self, k, options, default=_MISSING):
-        v = self.raw(k, default)
-        if v not in options:
-            raise self.error(k, v, "one of " + ", ".join(repr(o) for o in options))
-        return v
+        Unknown keys are errors; missing required keys are errors; a key that fails is BAD.
+        """
+        path = table.path if path is None else path
+        if data is None:
+            data = {}
+        if not isinstance(data, dict):
+            self.fail(path or "(top level)", data, "a table")
+            return {k.name: BAD for k in table.keys}
+        names = table.names
+        for name in data:
+            if name not in names:
+                self.unknown(path, name, data[name], names)
+        out = {}
+        for key in table.keys:
+            full = f"{path}.{key.name}" if path else key.name
+            if key.name in data:
+                out[key.name] = self.value(key, data[key.name], full)
+            elif key.required:
+                out[key.name] = self.fail(full, _MISSING, f"{key.expected(_words(key))} "
+                                          "(this key is required)")
+            else:
+                out[key.name] = self.value(key, key.default, full, default=True)
+        return out
 
-    def integer(self, k, lo, default=_MISSING):
-        v = self.raw(k, default)
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise self.error(k, v, f"an integer >= {lo}")
-        return v
+    def unknown(self, path, name, value, allowed):
+        close = difflib.get_close_matches(str(name), allowed, n=1, cutoff=0.6)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        full = f"{path}.{name}" if path else str(name)
+        self.fail(full, value, f"no such key here; {hint}allowed keys are "
+                  + ", ".join(sorted(allowed)))
 
-    def table_at(self, k, default=_MISSING):
-        v = self.raw(k, default)
-        if v is not None and not isinstance(v, dict):
-            raise self.error(k, v, "a table")
-        return v
+    def value(self, key, raw, path, default=False):
+        """One key's value in SI (or BAD, with its error recorded)."""
+        if key.kind == "custom":
+            return key.parse(self, raw, path)
+        if key.kind in ("liquid", "isotherm"):
+            from .liquids import read_isotherm, read_liquid
 
-    def done(self, allowed=None):
-        allowed = set(allowed or []) | self.used
-        for k in self.table:
-            if k not in allowed:
-                raise self.error(k, self.table[k], "no such key here; allowed keys are "
-                                 + ", ".join(sorted(allowed)))
+            return (read_liquid if key.kind == "liquid" else read_isotherm)(self, raw, path)
+        if raw is None and default:
+            return None
+        if key.kind == "choice":
+            return raw if raw in key.choices else self.fail(path, raw, key.expected())
+        if key.kind == "bool":
+            return raw if isinstance(raw, bool) else self.fail(path, raw, key.expected())
+        if key.kind == "string":
+            return raw if isinstance(raw, str) and raw else self.fail(path, raw,
+                                                                      key.expected())
+        if key.kind == "integer":
+            if isinstance(raw, bool) or not isinstance(raw, int) or not key.in_range(raw):
+                return self.fail(path, raw, key.expected())
+            return raw
+        if key.kind == "number":
+            if isinstance(raw, bool) or not isinstance(raw, (int, float)) \
+                    or not math.isfinite(raw) or not key.in_range(raw):
+                return self.fail(path, raw, key.expected())
+            return float(raw)
+        if key.kind in DIMENSIONS:
+            try:
+                x = to_si(raw, key.kind, file=self.file, key=path,
+                          bare_numbers=self.bare_numbers or default)
+            except SceneError as exc:
+                self.errors.append(exc)
+                return BAD
+            if not math.isfinite(x) or not key.in_range(x):
+                return self.fail(path, raw, key.expected(_words(key)))
+            return x
+        raise ValueError(f"unknown key kind {key.kind!r} of {path}")
 
 
-def scene_name(top, file):
-    """The [scene] table's name, validated (shared by contact and meniscus scenes)."""
-    s = Reader(file, top.table_at("scene"), "scene")
-    name = s.raw("name")
-    if not isinstance(name, str) or not name:
-        raise s.error("name", name, "a non-empty string")
-    s.done()
-    return name
+def _words(key):
+    """'a length', 'a pressure', ... for a dimensional key (from units.DIMENSIONS)."""
+    if key.kind in DIMENSIONS:
+        return "a " + key.kind.replace("_", " ")
+    return None
+
+
+def quantity(reader, raw, path, dimension, *, positive=True):
+    """A one-off quantity outside a Table (list items, sub-tables of custom keys)."""
+    try:
+        x = to_si(raw, dimension, file=reader.file, key=path, bare_numbers=reader.bare_numbers)
+    except SceneError as exc:
+        reader.errors.append(exc)
+        return BAD
+    if not math.isfinite(x) or (positive and not x > 0):
+        return reader.fail(path, raw, f"a positive {dimension.replace('_', ' ')}")
+    return x
+
+
+def any_bad(*values):
+    """Whether any value (or any item of a dict of values) failed its check."""
+    for v in values:
+        if v is BAD or (isinstance(v, dict) and any(x is BAD for x in v.values())):
+            return True
+    return False

@@ -7,7 +7,6 @@ from scipy import linalg
 
 from ..state import State
 from ..stability import is_positive_definite
-from ...laws.asperity import AsperityAdhesion
 from . import hertz
 from .newton import _lu_sign, _newton_contact, _newton_free
 from .system import ClosureSystem
@@ -28,12 +27,11 @@ def _contact_state(cs, res, tol):
     frac = _annulus_fraction_inside(g.edges, r_c)
     h = ev.h.copy()
     p_eff = {}
-    for name, eff in problem.effects.items():
-        if isinstance(eff, AsperityAdhesion):       # eq (20): constant over r < r_c
-            p_eff[name] = eff.pressure_value * frac
-        else:                                        # law at sigma inside, at h_k outside
-            p_k = eff.pressure(h)
-            p_eff[name] = frac * eff.pressure(np.array([cs.sigma]))[0] + (1 - frac) * p_k
+    for name, eff in problem.effects.items():        # law at sigma inside, at h_k outside
+        p_k = eff.pressure(h)
+        p_eff[name] = frac * eff.pressure(np.array([cs.sigma]))[0] + (1 - frac) * p_k
+    if cs.p_asperity:                                # eq (20): constant over r < r_c
+        p_eff["asperity_adhesion"] = cs.p_asperity * frac
     p_c = hertz.annulus_force(g.edges, r_c, problem.sphere.radius,
                               problem.operator.e_star if hasattr(problem.operator, "e_star")
                               else cs.infl.e_star) / g.areas
@@ -89,8 +87,9 @@ def _free_state(cs, res):
     d, w = res.d, res.w
     h, P, F = res.ev
     n = cs.n
-    p_eff = {name: (np.zeros(n) if isinstance(e, AsperityAdhesion) else e.pressure(h))
-             for name, e in problem.effects.items()}
+    p_eff = {name: e.pressure(h) for name, e in problem.effects.items()}
+    if cs.p_asperity:
+        p_eff["asperity_adhesion"] = np.zeros(n)
     resid = float(np.max(np.abs(F)))
     st = State(d, w, h, p_eff, np.zeros(n), np.zeros(n, bool), 0.0, res.n_iter, resid,
                res.ok, False)
@@ -137,7 +136,7 @@ def solve_closure_state(problem, d, w0, *, tol, max_iter=40, r_c0=None, system=N
     ----------
     problem : ContactProblem
         With an asperity gap sigma (eq 8); gap laws (eq 3 LJ, ...) in ``effects``; an
-        ``AsperityAdhesion`` effect (eq 20) acts as a constant pressure over r < r_c.
+        sigma-gap's ``adhesion`` (eq 20) acts as a constant pressure over r < r_c.
     d : float
         Separation of the sphere tip from the undeformed mean plane (m).
     w0 : ndarray

@@ -6,7 +6,6 @@ import math
 import numpy as np
 
 from ...errors import ConvergenceError
-from ...laws.asperity import AsperityAdhesion
 from .influence import influence_for
 
 #: below this fraction of the first node spacing the contact has closed (r_c -> 0)
@@ -89,11 +88,9 @@ class ClosureSystem:
         self.shape = problem.shape
         self.sphere = problem.sphere
         self.infl = influence or influence_for(problem)
-        # eq (20) acts as a constant pressure over r < r_c: taken out of the gap laws
-        self.laws = {k: e for k, e in problem.effects.items()
-                     if not isinstance(e, AsperityAdhesion)}
-        self.p_asperity = sum(e.pressure_value for e in problem.effects.values()
-                              if isinstance(e, AsperityAdhesion))
+        # eq (20) acts as a constant pressure over r < r_c, carried by the sigma-gap
+        self.laws = dict(problem.effects)
+        self.p_asperity = float(problem.gap.adhesion)
         self.p_sigma = self.law(np.array([self.sigma]))[0]
         _finite_or_raise(self.p_sigma, "gap-law pressure P(sigma) (Pa) of the clamped contact",
                          None, lambda k: f"h = sigma = {self.sigma * 1e9:.4g} nm")

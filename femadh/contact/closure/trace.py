@@ -189,7 +189,8 @@ def _first_state(cs, problem, d, tol, max_iter):
     return st
 
 
-def trace_closure(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None):
+def trace_closure(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
+                  on_jump=None):
     """Follow the closure's stable branch through the separations ``d_values`` (m).
 
     Continuation in d: tangent predictor (w, r_c), Newton corrector, step halving down to
@@ -212,6 +213,8 @@ def trace_closure(problem, d_values, *, branch, tol, start=None, max_iter=40, on
         A converged state at d_values[0] (e.g. the approach's last); else solved from w = 0.
     on_state : callable(State), optional
         Called with every state at a requested separation.
+    on_jump : callable(Jump), optional
+        Called with each fold and its landing as soon as it is found.
 
     Returns
     -------
@@ -238,7 +241,8 @@ def trace_closure(problem, d_values, *, branch, tol, start=None, max_iter=40, on
         if on_state:
             on_state(state)
         for d_next in d_values[1:]:
-            state = _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter)
+            state = _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter,
+                             on_jump)
             sweep.states.append(state)
             if on_state:
                 on_state(state)
@@ -274,7 +278,7 @@ def _continuous_transition(cs, old, new, tol, max_iter):
     return _onset_is_stable(cs, old if old.r_c == 0 else new, tol, max_iter)
 
 
-def _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter):
+def _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter, on_jump=None):
     """Step from state to d_next with halving; folds -> land_closure."""
     grid_step = d_next - state.d
     step = grid_step
@@ -307,5 +311,7 @@ def _advance(cs, problem, state, d_next, sweep, branch, tol, max_iter):
                               system=cs)
         sweep.n_solves += 1
         sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
+        if on_jump:
+            on_jump(sweep.jumps[-1])
         state = landed
     return state

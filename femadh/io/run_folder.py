@@ -1,0 +1,164 @@
+"""One folder, one run: an output folder is claimed before anything is computed.
+
+- It must be (or become) a writable folder - not an existing file - checked by creating its
+  lock file; a lock (``fcntl.flock`` on ``.femadh.lock``) stops a second run writing into it.
+- A folder that holds another run's outputs is refused, unless the run is asked to replace
+  them (``overwrite``: femadh's own output files are removed first, nothing else) or to
+  continue them (``resume``: only a run of the same scene that did not finish).
+- ``summary.json`` exists from the start with ``status = "running"`` and is rewritten
+  atomically as the run ends: converged / failed / interrupted.
+"""
+import fcntl
+import json
+import os
+from pathlib import Path
+import shutil
+
+from ..errors import OutputError
+from .atomic import write_atomic
+
+LOCK = ".femadh.lock"
+#: what femadh writes into a run folder (files and folders), removed by ``overwrite``
+OUTPUTS = ("summary.json", "curve.csv", "diagnostics.csv", "fields.csv", "jumps.csv",
+           "equilibrium_curve.csv", "checkpoint.npz", "meniscus.csv", "profiles.csv",
+           "vtk", "approach.pvd", "retract.pvd", "force_curve.png", "fig3_panels.png",
+           "meniscus_force.png", "render.png")
+
+
+def previous_run(path):
+    """The summary of the run a folder holds (dict), or None; a folder with femadh outputs but
+    no readable summary counts as a run of unknown status."""
+    path = Path(path)
+    s = path / "summary.json"
+    if s.exists():
+        try:
+            return json.loads(s.read_text())
+        except (OSError, ValueError):
+            return {"status": "unknown (unreadable summary.json)"}
+    if any((path / name).exists() for name in OUTPUTS[1:]) or any(path.glob("meniscus_*.pvd")):
+        return {"status": "unknown (no summary.json)"}
+    return None
+
+
+class RunFolder:
+    """Claim ``path`` for a run.
+
+    Parameters
+    ----------
+    path : str or Path
+    scene_id : str
+        Content hash of the resolved scene (a resumed run must be of the same scene).
+    scene_name : str
+    mode : {"new", "overwrite", "resume"}
+
+    Raises
+    ------
+    OutputError
+        The path is a file, not writable, locked by another run, or holds another run's
+        outputs that ``mode`` does not allow to touch.
+    """
+
+    def __init__(self, path, scene_id, scene_name, mode="new"):
+        self.path = Path(path)
+        self.scene_id, self.scene_name, self.mode = scene_id, scene_name, mode
+        if self.path.exists() and not self.path.is_dir():
+            raise OutputError(f"output folder {self.path} is an existing file; give a folder "
+                              "(--out DIR)")
+        try:
+            self.path.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"cannot create the output folder {self.path}: "
+                              f"{exc.strerror or exc}") from None
+        self._lock()
+        try:
+            self.previous = self._check_previous()
+        except OutputError:
+            self.release()
+            raise
+
+    def _lock(self):
+        lock = self.path / LOCK
+        try:
+            self.lock_fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise OutputError(f"output folder {self.path} is not writable: "
+                              f"{exc.strerror or exc}") from None
+        try:
+            fcntl.flock(self.lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            other = os.read(self.lock_fd, 64).decode(errors="replace").strip() or "?"
+            os.close(self.lock_fd)
+            self.lock_fd = None
+            raise OutputError(f"output folder {self.path} is in use by another femadh run "
+                              f"(pid {other}); wait for it or give another --out") from None
+        os.ftruncate(self.lock_fd, 0)
+        os.write(self.lock_fd, str(os.getpid()).encode())
+
+    def _check_previous(self):
+        prev = previous_run(self.path)
+        if prev is None:
+            if self.mode == "resume":
+                raise OutputError(f"nothing to resume in {self.path}: it holds no femadh run")
+            return None
+        what = (f"{self.path} holds the results of a previous run (scene "
+                f"{prev.get('scene', {}).get('name', '?')!r}, status {prev.get('status')})")
+        if self.mode == "overwrite":
+            self.clean()
+            return None
+        if self.mode == "resume":
+            if prev.get("scene_id") != self.scene_id:
+                raise OutputError(f"{what} of another scene (or of this scene changed): it "
+                                  "cannot be resumed; use --overwrite to replace it")
+            if prev.get("status") == "converged":
+                raise OutputError(f"{what}: it has finished, there is nothing to resume")
+            return prev
+        raise OutputError(f"{what}; use --resume to continue it or --overwrite to replace it "
+                          "(or give another --out)")
+
+    def clean(self):
+        """Remove femadh's own outputs (and nothing else) from the folder."""
+        for name in OUTPUTS:
+            p = self.path / name
+            try:
+                if p.is_dir():
+                    shutil.rmtree(p)
+                elif p.exists():
+                    p.unlink()
+            except OSError as exc:
+                raise OutputError(f"cannot remove {p}: {exc.strerror or exc}") from None
+        for p in self.path.glob("meniscus_*.pvd"):
+            p.unlink()
+
+    def write_summary(self, data):
+        """summary.json, atomically; ``data`` gets the scene id."""
+        write_atomic(self.path / "summary.json",
+                     json.dumps({"scene_id": self.scene_id, **data}, indent=2,
+                                default=_json_default) + "\n")
+
+    def release(self):
+        if getattr(self, "lock_fd", None) is not None:
+            try:
+                os.unlink(self.path / LOCK)
+            except OSError:
+                pass
+            os.close(self.lock_fd)
+            self.lock_fd = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+        return False
+
+
+def _json_default(o):
+    import numpy as np
+
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    raise TypeError(type(o))

@@ -1,0 +1,39 @@
+"""The lines a run prints: per branch its states and largest adhesion, the headline numbers
+with their estimated errors, the jumps. Forces in the unit that fits their size."""
+import numpy as np
+
+
+def _force(x, err=None):
+    from ..io.plots import force_unit
+
+    s, unit = force_unit([x])
+    if err is not None and np.isfinite(err):
+        return f"{x * s:.5g} ± {err * s:.1g} {unit}"
+    return f"{x * s:.5g} {unit}"
+
+
+def headline_lines(res):
+    """Human-readable summary lines of a ContactResult."""
+    out = []
+    hl = res.headline
+    for b, c in res.branches.items():
+        if not len(c["d_m"]):
+            continue
+        k = int(np.argmax(c["F_ex_N"]))
+        out.append(f"{b}: {len(c['d_m'])} states, max adhesion F_ex = {_force(c['F_ex_N'][k])} "
+                   f"at d = {c['d_m'][k] * 1e9:.4g} nm, F_LJ(d = {c['d_m'][-1] * 1e9:.4g} nm) "
+                   f"= {_force(c['F_LJ_N'][-1])}")
+    if "max_adhesion_N" in hl:
+        out.append(f"max adhesion {_force(hl['max_adhesion_N'], hl.get('max_adhesion_error_N'))}"
+                   f" at d = {hl['d_at_max_adhesion_m'] * 1e9:.4g} nm"
+                   + (f" (DMT 2πRW = {_force(hl['dmt_pull_off_N'])}, JKR 1.5πRW = "
+                      f"{_force(hl['jkr_pull_off_N'])})" if "dmt_pull_off_N" in hl else ""))
+    for j in res.jumps:
+        where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else
+                 "traced fold, dd/ds = 0")
+        out.append(f"jump ({j['branch']}): branch folds at d = {j['d_fold_m'] * 1e9:.4f} nm "
+                   f"({where}), h0 {j['h0_before_m'] * 1e9:.3f} -> {j['h0_after_m'] * 1e9:.3f} "
+                   "nm")
+    for w in res.warnings:
+        out.append(f"warning: {w}")
+    return out
