@@ -355,10 +355,12 @@ def _analysis_radius_m(reader, so, sphere):
         return BAD
     kind, v = ar
     a = math.sqrt(2.0 * sphere.radius * v) if kind == "delta" else v
-    if sphere.profile == "sphere" and a >= sphere.radius:
-        reader.fail("solver.analysis_radius", v, f"an analysis radius below the sphere "
-                    f"radius {sphere.radius} m")
-        return BAD
+    # the surface laws act where the sphere is near the flat: the paraboloid (eq 4) is the
+    # sphere only for r << R, the exact cap ends at r = R
+    if not a < sphere.radius:
+        return reader.fail("solver.analysis_radius", v if kind == "radius" else {"delta": v},
+                           f"an analysis radius below the sphere radius {sphere.radius:g} m "
+                           f"(this one is {a:.3g} m)")
     return a
 
 

@@ -64,7 +64,7 @@ def read_isotherm(reader, raw, path):
     if not isinstance(raw, dict):
         return reader.fail(path, raw, "a table with model = " + " | ".join(ISOTHERM_MODELS))
     model = raw.get("model")
-    if model not in ISOTHERM_TABLES:
+    if not isinstance(model, str) or model not in ISOTHERM_TABLES:
         return reader.fail(f"{path}.model", model, "one of " + ", ".join(
             repr(m) for m in ISOTHERM_MODELS))
     v = reader.read(ISOTHERM_TABLES[model], raw, path)

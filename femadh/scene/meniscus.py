@@ -53,8 +53,10 @@ def _separation(reader, raw, path):
 
 def _liquids(reader, raw, path):
     items = raw if isinstance(raw, list) else [raw]
+    if not items:
+        return reader.fail(path, raw, "a liquid name, a liquid table, or a non-empty list")
     out = [read_liquid(reader, v, path) for v in items]
-    return BAD if any(x is BAD for x in out) or not out else out
+    return BAD if any(x is BAD for x in out) else out
 
 
 RANGE = Table("meniscus.relative_pressure", "Evenly spaced p/psat.", (

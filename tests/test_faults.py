@@ -1,0 +1,219 @@
+"""Faults: signals, resume, a full disk, read-only and occupied folders, concurrent runs, an
+existing file as the output folder. Every fault ends in one clear line and loses no completed
+state; a resumed run gives the states an uninterrupted one gives."""
+import json
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import femadh
+from femadh.cli import main
+from femadh.io.writers import read_curve
+
+from conftest import check_curve_against_fields
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
+ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+
+
+def long_scene(tmp_path, step="0.02 nm", nodes=200, extra=""):
+    """The Fig 3 scene with many small steps (350 per branch): long enough to interrupt."""
+    text = FIG3.read_text().replace('step = "0.2 nm"', f'step = "{step}"').replace(
+        "nodes = 200", f"nodes = {nodes}") + extra
+    p = tmp_path / "long.toml"
+    p.write_text(text)
+    return p
+
+
+def start(scene, out, *flags):
+    return subprocess.Popen([sys.executable, "-m", "femadh", "run", str(scene), "--out",
+                             str(out), "--quiet", *flags], cwd=ROOT, env=ENV,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def wait_rows(out, n, proc, timeout=60):
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        path = out / "curve.csv"
+        if path.exists() and path.read_text().count("\n") > n:
+            return
+        if proc.poll() is not None:
+            raise AssertionError(f"the run ended before {n} rows: {proc.stderr.read()}")
+        time.sleep(0.05)
+    raise AssertionError("no rows appeared")
+
+
+def assert_same_as_uninterrupted(scene_path, out):
+    """The resumed run's curve equals an uninterrupted in-memory run's: the same states, forces
+    within the Newton tolerance's effect (measured <= 2e-12 relative of the peak force)."""
+    ref = femadh.run(femadh.load_scene(scene_path), progress=False)
+    c = read_curve(out / "curve.csv")
+    for b, cols in ref.branches.items():
+        sel = c["branch"] == b
+        assert sel.sum() == len(cols["d_m"])
+        assert np.array_equal(c["d_m"][sel], cols["d_m"])
+        peak = np.max(np.abs(cols["F_ex_N"]))
+        assert np.max(np.abs(c["F_ex_N"][sel] - cols["F_ex_N"])) <= 1e-10 * peak
+    jumps = list(csvrows(out / "jumps.csv"))
+    assert len(jumps) == len(ref.jumps)
+
+
+def csvrows(path):
+    import csv
+
+    with open(path, newline="") as f:
+        yield from csv.DictReader(f)
+
+
+@pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_stops_cleanly_and_resume_completes(tmp_path, sig, code):
+    scene = long_scene(tmp_path)
+    out = tmp_path / "out"
+    p = start(scene, out)
+    wait_rows(out, 20, p)
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == code
+    lines = err.strip().splitlines()
+    assert lines and all(line.startswith("femadh: error:") for line in lines)
+    assert "--resume" in err and "Traceback" not in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted"
+    n = check_curve_against_fields(out)           # every committed state in every file
+    assert 20 <= n < 700
+    p = start(scene, out, "--resume")
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    assert json.loads((out / "summary.json").read_text())["status"] == "converged"
+    assert check_curve_against_fields(out) == 702
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_kill_9_loses_no_committed_state_and_resumes(tmp_path):
+    scene = long_scene(tmp_path)
+    out = tmp_path / "out"
+    p = start(scene, out)
+    wait_rows(out, 40, p)
+    p.kill()
+    p.communicate(timeout=30)
+    assert json.loads((out / "summary.json").read_text())["status"] == "running"
+    c = read_curve(out / "curve.csv")             # no torn row (a torn last line is dropped)
+    assert len(c["d_m"]) >= 40
+    p = start(scene, out, "--resume")
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    assert check_curve_against_fields(out) == 702
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_previous_run_refused_overwrite_cleans_it(tmp_path, capsys):
+    out = tmp_path / "out"
+    fe = ROOT / "validation" / "scenes" / "paper1_fig3_fe.toml"
+    text = fe.read_text().replace("nodes = 200", "nodes = 40")
+    text = text.replace('stop = "-5 nm"', 'stop = "0 nm"').replace('step = "0.2 nm"',
+                                                                    'step = "1 nm"')
+    (tmp_path / "fe.toml").write_text(text)
+    assert main(["run", str(tmp_path / "fe.toml"), "--out", str(out), "--quiet",
+                 "--no-figures"]) == 0
+    assert list((out / "vtk").glob("*.vtu"))
+    capsys.readouterr()
+    assert main(["run", str(FIG3), "--out", str(out), "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert err.count("femadh: error:") == 1 and "--overwrite" in err and "--resume" in err
+    assert main(["run", str(FIG3), "--out", str(out), "--quiet", "--overwrite"]) == 0
+    assert not (out / "vtk").exists() and not (out / "approach.pvd").exists()
+    assert main(["run", str(FIG3), "--out", str(out), "--quiet", "--resume"]) == 4
+    assert "nothing to resume" in capsys.readouterr().err
+
+
+def test_existing_file_and_uncreatable_folder_as_out(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["run", str(FIG3), "--out", str(f), "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert "is an existing file" in err and err.count("\n") == 1
+    assert main(["run", str(FIG3), "--out", "/proc/femadh-cannot-be-here", "--quiet"]) == 4
+    assert "cannot create the output folder" in capsys.readouterr().err
+
+
+def test_concurrent_runs_into_one_folder(tmp_path, capsys):
+    scene = long_scene(tmp_path)
+    out = tmp_path / "out"
+    p = start(scene, out)
+    try:
+        wait_rows(out, 5, p)
+        assert main(["run", str(FIG3), "--out", str(out), "--quiet", "--overwrite"]) == 4
+        err = capsys.readouterr().err
+        assert "in use by another femadh run" in err and f"pid {p.pid}" in err
+    finally:
+        p.kill()
+        p.communicate()
+
+
+def _mount_tmpfs(path, opts):
+    path.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", opts, "tmpfs", str(path)],
+                       capture_output=True)
+    if r.returncode:
+        pytest.skip(f"cannot mount a tmpfs here ({r.stderr.decode().strip()})")
+    return path
+
+
+def test_full_disk_is_a_clear_error_and_keeps_earlier_rows(tmp_path, capsys):
+    mnt = _mount_tmpfs(tmp_path / "small", "size=256k")
+    try:
+        out = mnt / "out"
+        code = main(["run", str(long_scene(tmp_path)), "--out", str(out), "--quiet",
+                     "--no-figures"])
+        assert code == 4
+        err = capsys.readouterr().err
+        assert "No space left on device" in err and "cannot write" in err
+        assert "Traceback" not in err and err.count("femadh: error:") == 1
+        # every complete row is parseable and every committed state complete in all files
+        c = read_curve(out / "curve.csv")
+        assert len(c["d_m"]) > 0
+        for name in ("curve.csv", "fields.csv", "diagnostics.csv"):
+            assert (out / name).read_bytes().endswith(b"\n")
+    finally:
+        subprocess.run(["umount", str(mnt)])
+
+
+def test_read_only_folder(tmp_path, capsys):
+    mnt = _mount_tmpfs(tmp_path / "ro", "ro,size=64k")
+    try:
+        t0 = time.perf_counter()
+        assert main(["run", str(FIG3), "--out", str(mnt), "--quiet"]) == 4
+        err = capsys.readouterr().err
+        assert "not writable" in err and "Read-only file system" in err
+        assert time.perf_counter() - t0 < 5          # refused before anything is computed
+    finally:
+        subprocess.run(["umount", str(mnt)])
+
+
+def test_every_meniscus_point_failing_exits_non_zero(tmp_path, capsys):
+    text = (ROOT / "validation" / "scenes" / "paper2_ethanol_100nm.toml").read_text()
+    text = text.replace('tip_radius = "100 nm"', 'tip_radius = "1 nm"').replace(
+        "relative_pressure = [0.05, 0.1, 0.15, 0.2, 0.4, 0.6, 0.8, 0.95]",
+        "relative_pressure = [0.999]").replace('methods = ["fe", "shooting", "circular", '
+                                               '"no-film"]', 'methods = ["fe"]')
+    (tmp_path / "m.toml").write_text(text)
+    assert main(["run", str(tmp_path / "m.toml"), "--out", str(tmp_path / "o"), "--quiet"]) == 3
+    err = capsys.readouterr().err
+    assert "no point of the scene has a meniscus" in err
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["status"] == "failed"
+
+
+@pytest.mark.parametrize("cmd", ["mesh", "study"])
+def test_contact_commands_on_a_meniscus_scene(tmp_path, capsys, cmd):
+    scene = ROOT / "validation" / "scenes" / "paper2_ethanol_100nm.toml"
+    argv = [cmd, str(scene)] if cmd == "mesh" else [cmd, "convergence", str(scene)]
+    assert main(argv + ["--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("femadh: error:") == 1 and "a contact scene" in err
