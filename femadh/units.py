@@ -4,6 +4,7 @@ Inside femadh every quantity is a float in SI units. This module is the only pla
 knows about pint, and pint is imported lazily so that the numerical core never pays for it.
 """
 from functools import lru_cache
+import numbers
 
 from .errors import SceneError
 
@@ -67,7 +68,7 @@ def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     dim, si, words = DIMENSIONS[dimension]
     if isinstance(value, bool):
         raise SceneError(file, key, value, words)
-    if isinstance(value, (int, float)):
+    if isinstance(value, numbers.Real):
         if not bare_numbers and dimension != "dimensionless":
             raise SceneError(file, key, value, f"{words}: a bare number has no unit (write it "
                              f"with its unit, e.g. '{value:g} {si.replace('^', '')}' if SI is "

@@ -6,6 +6,7 @@ what was expected.
 """
 import difflib
 import math
+import numbers
 
 from ..errors import SceneError, SceneErrors, _MISSING
 from ..units import DIMENSIONS, to_si
@@ -100,11 +101,13 @@ class Reader:
             return raw if isinstance(raw, str) and raw else self.fail(path, raw,
                                                                       key.expected())
         if key.kind == "integer":
-            if isinstance(raw, bool) or not isinstance(raw, int) or not key.in_range(raw):
+            # numbers.Integral: numpy integers from code-built scenes count too
+            if isinstance(raw, bool) or not isinstance(raw, numbers.Integral) \
+                    or not key.in_range(raw):
                 return self.fail(path, raw, key.expected())
-            return raw
+            return int(raw)
         if key.kind == "number":
-            if isinstance(raw, bool) or not isinstance(raw, (int, float)) \
+            if isinstance(raw, bool) or not isinstance(raw, numbers.Real) \
                     or not math.isfinite(raw) or not key.in_range(raw):
                 return self.fail(path, raw, key.expected())
             return float(raw)
