@@ -63,14 +63,39 @@ def _parser():
     rd.add_argument("--field", default="von_mises", help="field to colour by "
                     "(default von_mises; e.g. sigma_zz, displacement)")
     rd.add_argument("--png", help="output PNG (default RUN_DIR/render.png)")
-    s = sub.add_parser("study", help="convergence and accuracy-vs-time studies",
-                       description="convergence: the FE mesh ladder against the Green function "
-                                   "on the scene's nodes, and the Green function in N; writes "
+    s = sub.add_parser("study", help="parameter studies (sweep) and convergence studies",
+                       description="sweep: many variants of a scene in parallel (local "
+                                   "processes or a Dask cluster), resumable; convergence: the "
+                                   "FE mesh ladder against the Green function and the Green "
+                                   "function in N.")
+    ss = s.add_subparsers(dest="kind", required=True, metavar="KIND")
+    sw = ss.add_parser("sweep", help="vary scene keys over values, one run per point",
+                       description="Run every combination of the --vary values (or the "
+                                   "scene's [study] table) and write study.csv, study.png and "
+                                   "points/<id>/ (one run folder and record per point). "
+                                   "Running it again computes only the missing points.",
+                       epilog="VALUES: '0.5 nm,1 nm,2 nm' | 'lo..hi:n' | 'lo..hi:n:log', "
+                              "e.g. --vary effects.asperity_gap.sigma='0.3 nm..2 nm:10'")
+    sw.add_argument("scene", help="scene file (TOML)")
+    sw.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
+                    help="a dotted scene key and its values (repeatable)")
+    sw.add_argument("--zip", action="store_true", help="pair the lists instead of their "
+                    "product")
+    sw.add_argument("--out", help="study folder (default: <scene output dir>/study)")
+    g2 = sw.add_mutually_exclusive_group()
+    g2.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
+    g2.add_argument("--scheduler", help="a dask.distributed scheduler address "
+                    "(tcp://host:8786) or local:N for a LocalCluster of N workers")
+    sw.add_argument("--quantity", default="max_adhesion_N",
+                    help="the number the figure shows (default max_adhesion_N)")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    cv = ss.add_parser("convergence", help="FE mesh ladder vs Green, Green in N",
+                       description="The FE mesh ladder against the Green function on the "
+                                   "scene's nodes, and the Green function in N; writes "
                                    "convergence.csv/.md/.png.")
-    s.add_argument("kind", choices=["convergence"])
-    s.add_argument("scene", help="scene file (TOML)")
-    s.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
-    s.add_argument("--out", help="output folder (default: <scene output dir>/study)")
+    cv.add_argument("scene", help="scene file (TOML)")
+    cv.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
+    cv.add_argument("--out", help="output folder (default: <scene output dir>/study)")
     rg = sub.add_parser(
         "regime", help="smooth-sphere LJ adhesion map vs the Tabor parameter",
         description="Trace the force-separation curve of a smooth elastic sphere with LJ "
@@ -152,6 +177,8 @@ def _dispatch(args):
     if args.command == "mesh":
         _require_contact(scene, "mesh")
         return _mesh(scene, args.out)
+    if args.command == "study" and args.kind == "sweep":
+        return _sweep(scene, args)
     if args.command == "study":
         _require_contact(scene, "study convergence")
         return _study(scene, args)
@@ -230,6 +257,35 @@ def _study(scene, args):
     rows = convergence(scene, levels=args.levels, progress=default_progress())
     path = write_convergence(rows, args.out or f"{scene.output_dir}/study", scene.name)
     print(path.read_text())
+    return 0
+
+
+def _sweep(scene, args):
+    from .studies.sweep import run_study
+
+    vary = {}
+    for item in args.vary:
+        if "=" not in item:
+            raise SceneError("command line", "--vary", item, "KEY=VALUES, e.g. "
+                             "effects.asperity_gap.sigma='0.5 nm,1 nm'")
+        k, v = item.split("=", 1)
+        vary[k.strip()] = v
+    zip_ = args.zip
+    if not vary and scene.study:
+        vary, zip_ = scene.study["vary"], scene.study["zip"] or args.zip
+    if args.workers is not None and args.workers < 1:
+        raise SceneError("command line", "--workers", args.workers, "an integer >= 1")
+    out = args.out or f"{scene.output_dir}/study"
+    points, records = run_study(scene, vary, out, zip_=zip_, workers=args.workers,
+                                scheduler=args.scheduler,
+                                progress=not args.quiet and sys.stderr.isatty(),
+                                quantity=args.quantity)
+    failed = [r for r in records.values() if r["status"] != "converged"]
+    print(f"{len(points)} points ({len(points) - len(failed)} converged, {len(failed)} "
+          f"failed) in {out}: study.csv, study.png, points/<id>/")
+    for r in failed[:5]:
+        print(f"femadh: note: point {r['index']} ({r['changes']}): {r['error']}",
+              file=sys.stderr)
     return 0
 
 

@@ -40,7 +40,8 @@ def scene_id(scene):
     return hashlib.sha1(blob).hexdigest()[:16]
 
 
-def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False):
+def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
+        operator=None):
     """Solve a scene.
 
     Parameters
@@ -57,6 +58,8 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     overwrite, resume : bool
         What to do with a folder that holds a previous run: replace it, or continue it
         (an interrupted or failed run of the same scene). Neither: refuse it.
+    operator : SurfaceOperator, optional
+        Reuse an operator built for this scene's grid (studies keep one per worker).
 
     Returns
     -------
@@ -81,12 +84,12 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         progress = sys.stderr.isatty()
     with blas_threads():
         if out_dir is None:
-            return _run(scene, None, progress=progress)
+            return _run(scene, None, progress=progress, operator=operator)
         from ..io.run_folder import RunFolder
 
         mode = "resume" if resume else "overwrite" if overwrite else "new"
         with RunFolder(out_dir, scene_id(scene), scene.name, mode) as folder:
-            res = _run(scene, folder, progress=progress)
+            res = _run(scene, folder, progress=progress, operator=operator)
             if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
                 from ..io.plots import contact_figures
 
@@ -125,7 +128,7 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress):
+def _run(scene, folder, *, progress, operator=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
@@ -136,7 +139,7 @@ def _run(scene, folder, *, progress):
             if folder is not None:
                 folder.write_summary(summary(res, status="running"))
             t1 = time.perf_counter()
-            problem = build_problem(scene, progress=say)
+            problem = build_problem(scene, operator=operator, progress=say)
             res.timings["operator_s"] = time.perf_counter() - t1
             res.nodes = problem.grid.nodes.copy()
             res.warnings += _stiffness_warning(scene, problem)

@@ -125,10 +125,25 @@ OUTPUT = Table("output", "Outputs.", (
         "FE).", default=None),
 ))
 
+def _vary(reader, raw, path):
+    if not isinstance(raw, dict) or not raw or not all(
+            isinstance(v, (str, list)) for v in raw.values()):
+        return reader.fail(path, raw, "a table { \"dotted.key\" = \"values\" }, e.g. "
+                           "{ \"effects.asperity_gap.sigma\" = \"0.3 nm..2 nm:10\" }")
+    return dict(raw)
+
+
+STUDY = Table("study", "A parameter study over this scene (femadh study sweep SCENE).", (
+    Key("vary", "custom", "Dotted scene keys and their values: a comma list with units, "
+        "'lo..hi:n' or 'lo..hi:n:log'.", parse=_vary, expect="a table of key = values"),
+    Key("zip", "bool", "Pair the lists instead of their product.", default=False),
+))
+
 #: the tables of a contact scene file
-TOP = ("scene", "sphere", "materials", "effects", "solver", "sweep", "output")
+TOP = ("scene", "sphere", "materials", "effects", "solver", "sweep", "output", "study")
 #: every table description, for the reference page (femadh keys)
-TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, GAP, SOLVER, DELTA, MESH, SWEEP, OUTPUT)
+TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, GAP, SOLVER, DELTA, MESH, SWEEP, OUTPUT,
+          STUDY)
 
 
 def _material(reader, raw, path):
@@ -170,6 +185,7 @@ class Scene:
     continuation: str = "steps"
     disk: IsotropicMaterial | None = None
     slider: IsotropicMaterial | None = None
+    study: dict | None = None
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "contact"
@@ -246,6 +262,7 @@ def parse_contact(reader, data, file):
         reader.fail("sweep", None, "a [sweep] table (it is required)")
     d_values = _separations(reader, sw, data.get("sweep") or {})
     ou = reader.read(OUTPUT, data.get("output"), "output")
+    study = reader.read(STUDY, data["study"], "study") if "study" in data else None
 
     method = so["method"]
     fe_settings, fe_nu = None, (disk.poisson_ratio if isinstance(disk, IsotropicMaterial)
@@ -271,7 +288,7 @@ def parse_contact(reader, data, file):
                  tolerance=so["tolerance"], max_iter=so["max_iter"], fe_settings=fe_settings,
                  d_values=d_values, directions=sw["directions"],
                  output_dir=ou["dir"] or f"out/{name}", fe_poisson_ratio=fe_nu, vtk=vtk,
-                 continuation=so["continuation"], disk=disk, slider=slider,
+                 continuation=so["continuation"], disk=disk, slider=slider, study=study,
                  raw=copy.deepcopy(data))
 
 

@@ -131,6 +131,7 @@ class MeniscusScene:
     elements: int
     output_dir: str
     vtk: bool = True
+    study: dict | None = None
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "meniscus"
@@ -162,12 +163,15 @@ def parse_meniscus(reader, data, file):
     """Build a MeniscusScene from the parsed TOML ``data`` (errors recorded in ``reader``)."""
     from .contact import SCENE
 
+    from .contact import STUDY
+
     for name in data:
-        if name not in ("scene", "meniscus", "output"):
-            reader.unknown("", name, data[name], ["meniscus", "output", "scene"])
+        if name not in ("scene", "meniscus", "output", "study"):
+            reader.unknown("", name, data[name], ["meniscus", "output", "scene", "study"])
     sc = reader.read(SCENE, data.get("scene"), "scene")
     m = reader.read(MENISCUS, data.get("meniscus"), "meniscus")
     ou = reader.read(OUTPUT, data.get("output"), "output")
+    study = reader.read(STUDY, data["study"], "study") if "study" in data else None
     isotherms = {}
     if m["liquid"] is not BAD and m["isotherm"] is not BAD:
         for lq in m["liquid"]:
@@ -184,5 +188,5 @@ def parse_meniscus(reader, data, file):
     name = sc["name"]
     return MeniscusScene(name, file, m["tip_radius"], m["separation"], m["liquid"],
                          m["temperature"], isotherms, m["relative_pressure"], m["methods"],
-                         m["elements"], ou["dir"] or f"out/{name}", ou["vtk"],
+                         m["elements"], ou["dir"] or f"out/{name}", ou["vtk"], study,
                          copy.deepcopy(data))
