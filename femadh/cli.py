@@ -42,6 +42,9 @@ def _parser():
     g.add_argument("--resume", action="store_true",
                    help="continue an interrupted or failed run in the output folder")
     r.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    r.add_argument("--no-estimate", action="store_true",
+                   help="skip the error estimates of the headline numbers (they solve the "
+                        "scene again on two coarser grids)")
     r.add_argument("--quiet", action="store_true", help="no progress bar or summary lines")
     c = sub.add_parser("check", help="validate a scene without solving it",
                        description="Validate every key, the optional dependencies the scene "
@@ -212,7 +215,7 @@ def _run(scene, args):
     out = args.out or scene.output_dir
     res = run(scene, out, figures=not args.no_figures,
               progress=False if args.quiet else None, overwrite=args.overwrite,
-              resume=args.resume)
+              resume=args.resume, estimate="peak" if args.no_estimate else True)
     if not args.quiet:
         _report(res)
     if res.status == "interrupted":

@@ -127,8 +127,9 @@ def test_scene_with_arclength_continuation_matches_stepping(tmp_path):
     raw = copy.deepcopy(arc.raw)
     raw["solver"]["continuation"] = "steps"
     steps = scene_from_dict(raw, str(path))
-    ra = femadh.run(arc, str(tmp_path / "arc"), figures=False, progress=False)
-    rs = femadh.run(steps, str(tmp_path / "steps"), figures=False, progress=False)
+    ra = femadh.run(arc, str(tmp_path / "arc"), figures=False, progress=False, estimate=False)
+    rs = femadh.run(steps, str(tmp_path / "steps"), figures=False, progress=False,
+                    estimate=False)
     assert ra.status == rs.status == "converged"
     res = 0.1e-9 * 2.0**-10 * 1.01
     for b in ("approach", "retract"):

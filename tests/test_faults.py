@@ -34,7 +34,7 @@ def long_scene(tmp_path, step="0.02 nm", nodes=200, extra=""):
 
 def start(scene, out, *flags):
     return subprocess.Popen([sys.executable, "-m", "femadh", "run", str(scene), "--out",
-                             str(out), "--quiet", *flags], cwd=ROOT, env=ENV,
+                             str(out), "--quiet", "--no-estimate", *flags], cwd=ROOT, env=ENV,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -53,7 +53,7 @@ def wait_rows(out, n, proc, timeout=60):
 def assert_same_as_uninterrupted(scene_path, out):
     """The resumed run's curve equals an uninterrupted in-memory run's: the same states, forces
     within the Newton tolerance's effect (measured <= 2e-12 relative of the peak force)."""
-    ref = femadh.run(femadh.load_scene(scene_path), progress=False)
+    ref = femadh.run(femadh.load_scene(scene_path), progress=False, estimate=False)
     c = read_curve(out / "curve.csv")
     for b, cols in ref.branches.items():
         sel = c["branch"] == b

@@ -183,7 +183,7 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
     def pull_off(sc):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # narrow steps are stiffer than a node
-            return run(sc, progress=False).headline["max_adhesion_N"]
+            return run(sc, progress=False, estimate=False).headline["max_adhesion_N"]
 
     n100 = {"solver.nodes": 100}
     lim = pull_off(_slider(rho=179).replace(n100))

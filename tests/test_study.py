@@ -47,14 +47,14 @@ def test_dask_local_cluster_matches_the_process_pool_and_resumes(tmp_path):
     numbers to the last digit (same solver, same inputs); a rerun computes nothing."""
     sc, vary = small(), {"effects.asperity_gap.sigma": "0.5 nm,1 nm",
                          "sphere.radius": "1 mm,2 mm"}
-    _, pool = run_study(sc, vary, tmp_path / "pool", workers=2)
-    _, dask = run_study(sc, vary, tmp_path / "dask", scheduler="local:2")
+    _, pool = run_study(sc, vary, tmp_path / "pool", workers=2, estimate=False)
+    _, dask = run_study(sc, vary, tmp_path / "dask", scheduler="local:2", estimate=False)
     assert set(pool) == set(dask) and len(pool) == 4
     for k, r in pool.items():
         assert r["status"] == dask[k]["status"] == "converged"
         assert r["max_adhesion_N"] == dask[k]["max_adhesion_N"]
     t0 = time.perf_counter()
-    run_study(sc, vary, tmp_path / "pool", workers=2)
+    run_study(sc, vary, tmp_path / "pool", workers=2, estimate=False)
     assert json.loads((tmp_path / "pool" / "timing.json").read_text())["computed"] == 0
     assert time.perf_counter() - t0 < 5
     rows = (tmp_path / "pool" / "study.csv").read_text().splitlines()

@@ -18,7 +18,7 @@ from ..laws.registry import outputs
 from .atomic import RowLog
 
 CURVE_HEADER = ["state", "branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m",
-                "n_iter", "residual_m", "converged", "stable"]
+                "n_iter", "residual_m", "converged", "stable", "F_tail_N"]
 DIAG_HEADER = ["state", "branch", "d_m", "n_active", "min_gap_minus_sigma_m",
                "min_contact_pressure_Pa", "eq10_violation_inside_m", "node_softening_ratio"]
 FIELD_HEADER = ["state", "branch", "d_m", "r_m", "w_m", "h_m", "P_LJ_Pa", "P_el_Pa"]
@@ -30,8 +30,9 @@ SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ 
              "(attractive positive), F_el = sigma-gap contact force, repulsive positive; "
              "optional F_cap (capillary), F_LJa (asperity adhesion) attractive positive and "
              "F_ela (Greenwood-Williamson asperity elasticity) repulsive positive; "
-             "F_ex = F_LJ + F_cap + F_LJa - F_ela - F_el. The force on the sphere is -F_ex; "
-             "adhesion shows as F_ex > 0.")
+             "F_ex = F_LJ + F_cap + F_LJa - F_ela - F_el over the analysis disk. The force on "
+             "the sphere is -F_ex; adhesion shows as F_ex > 0. F_tail: the laws' force beyond "
+             "the analysis radius on the undeformed sphere (the truncation, not in F_ex).")
 
 
 def extra_outputs(problem):
@@ -49,11 +50,15 @@ def _g(x):
 
 
 def state_row(problem, state, extra):
-    """The curve.csv values of a state after ``state`` and ``branch`` (forces in N)."""
+    """The curve.csv values of a state after ``state`` and ``branch`` (forces in N).
+    F_tail is the laws' force beyond the analysis radius (not in F_ex: the truncation)."""
+    from ..runner.estimates import tail_force
+
     f_lj, f_el, f_ex = state_forces(problem, state)
     g = problem.grid
     return ([_g(state.d), _g(state.h0), _g(f_lj), _g(f_el), _g(f_ex), _g(state.r_c),
-             state.n_iter, _g(state.residual), state.converged, state.stable]
+             state.n_iter, _g(state.residual), state.converged, state.stable,
+             _g(tail_force(problem, state.d))]
             + [_g(o.sign * g.force(state.p_effects[o.name])) for o in extra])
 
 

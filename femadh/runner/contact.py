@@ -23,6 +23,7 @@ from ..contact.forces import state_forces
 from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning
 from ..scene import build_problem, load_scene
 from . import interrupt
+from .estimates import GuardError
 from .result import ContactResult
 
 #: surface-force stiffness over single-node stiffness above which a run warns
@@ -41,7 +42,7 @@ def scene_id(scene):
 
 
 def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
-        operator=None):
+        operator=None, estimate=True):
     """Solve a scene.
 
     Parameters
@@ -60,6 +61,10 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         (an interrupted or failed run of the same scene). Neither: refuse it.
     operator : SurfaceOperator, optional
         Reuse an operator built for this scene's grid (studies keep one per worker).
+    estimate : bool or "peak"
+        Estimate the error of the headline numbers (a coarser grid's run, the tail beyond the
+        analysis radius, the peak between the grid separations; see
+        :mod:`femadh.runner.estimates`); "peak": only locate the peak.
 
     Returns
     -------
@@ -83,13 +88,18 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     if progress is None:
         progress = sys.stderr.isatty()
     with blas_threads():
+        if getattr(scene, "accuracy", None) and estimate is True:
+            from .accuracy import run_to_accuracy
+
+            return run_to_accuracy(scene, out_dir, figures=figures, progress=progress,
+                                   overwrite=overwrite, resume=resume)
         if out_dir is None:
-            return _run(scene, None, progress=progress, operator=operator)
+            return _run(scene, None, progress=progress, operator=operator, estimate=estimate)
         from ..io.run_folder import RunFolder
 
         mode = "resume" if resume else "overwrite" if overwrite else "new"
         with RunFolder(out_dir, scene_id(scene), scene.name, mode) as folder:
-            res = _run(scene, folder, progress=progress, operator=operator)
+            res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate)
             if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
                 from ..io.plots import contact_figures
 
@@ -128,7 +138,7 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress, operator=None):
+def _run(scene, folder, *, progress, operator=None, estimate=True):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
@@ -157,7 +167,9 @@ def _run(scene, folder, *, progress, operator=None):
             else:
                 _trace_steps(scene, problem, sink, resume)
             res.timings["solve_s"] = time.perf_counter() - t1
-        except ConvergenceError as exc:
+            if res.status == "converged":
+                _finish(scene, res, problem, sink, estimate)
+        except (ConvergenceError, GuardError) as exc:
             res.status, res.error = "failed", str(exc)
         except Interrupted as exc:
             res.status, res.error = "interrupted", str(exc)
@@ -166,13 +178,24 @@ def _run(scene, folder, *, progress, operator=None):
             if writer is not None:
                 writer.close()
             res.timings["total_s"] = time.perf_counter() - t0
-            if res.status == "converged":
-                from .headline import headline
-
-                res.headline = headline(res, problem if "problem" in locals() else None)
             if folder is not None:
                 folder.write_summary(summary(res))
     return res
+
+
+def _finish(scene, res, problem, sink, estimate):
+    """Headline numbers, their error estimates and the bound guard of a finished sweep."""
+    from .estimates import estimate_errors, guard_bounds, refine_peak
+    from .headline import headline
+
+    t1 = time.perf_counter()
+    res.headline = headline(res, problem)
+    if estimate:
+        half = refine_peak(scene, res, problem, sink)
+        if estimate is True:
+            res.estimates = estimate_errors(scene, res, problem, sink, half)
+        guard_bounds(res, problem)
+    res.timings["estimate_s"] = time.perf_counter() - t1
 
 
 class Sink:
@@ -187,10 +210,14 @@ class Sink:
         self._row = lambda st: state_row(problem, st, self._extra)
         self._extra = extra_outputs(problem)
         self.columns = (["d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
-                         "residual_m", "converged", "stable"] + [o.force for o in self._extra])
+                         "residual_m", "converged", "stable", "F_tail_N"]
+                        + [o.force for o in self._extra])
         self.rows = {}
         self.profile_picks = {}
         self.bar = None
+        self.scene = result.scene
+        # the state of largest F_ex and its neighbours (the peak search needs them)
+        self.peak, self._prev, self._need_next = None, None, False
 
     def plan(self, branch, n):
         """A branch of n states begins: which of them keep their surface profile."""
@@ -204,6 +231,10 @@ class Sink:
             self.bar = bar(n, f"{self.result.name} {branch}")
 
     def state(self, branch, st):
+        from .estimates import check_state
+
+        check_state(self.problem, st, self.scene)
+        self._track_peak(branch, st)
         rows = self.rows.setdefault(branch, [])
         if branch in self.profile_picks and len(rows) in self.profile_picks[branch]:
             prof = self.result.profiles.setdefault(
@@ -219,6 +250,17 @@ class Sink:
             self.bar.update(1)
         self._publish(branch)
         interrupt.check()
+
+    def _track_peak(self, branch, st):
+        f = state_forces(self.problem, st)[2]
+        prev = self._prev if self._prev is not None and self._prev[0] == branch else None
+        if self._need_next and self.peak is not None and self.peak[0] == branch:
+            self.peak[4] = st
+        self._need_next = False
+        if self.peak is None or f > self.peak[1]:
+            self.peak = [branch, f, prev[1] if prev else None, st, None]
+            self._need_next = True
+        self._prev = (branch, st)
 
     def jump(self, jump):
         p = self.problem
@@ -416,5 +458,6 @@ def summary(res, status=None):
     return {"femadh_version": __version__, "scene_file": scene.path,
             "status": status or res.status, "error": res.error,
             "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
-            "jumps": res.jumps, "headline": res.headline, "warnings": res.warnings,
+            "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
+            "accuracy": res.accuracy, "warnings": res.warnings,
             "timings_s": res.timings, "wall_time_s": res.wall_time}

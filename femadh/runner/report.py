@@ -24,10 +24,19 @@ def headline_lines(res):
                    f"at d = {c['d_m'][k] * 1e9:.4g} nm, F_LJ(d = {c['d_m'][-1] * 1e9:.4g} nm) "
                    f"= {_force(c['F_LJ_N'][-1])}")
     if "max_adhesion_N" in hl:
-        out.append(f"max adhesion {_force(hl['max_adhesion_N'], hl.get('max_adhesion_error_N'))}"
+        out.append(f"max adhesion {_force(hl['max_adhesion_N'], hl.get('max_adhesion_N_error'))}"
                    f" at d = {hl['d_at_max_adhesion_m'] * 1e9:.4g} nm"
                    + (f" (DMT 2πRW = {_force(hl['dmt_pull_off_N'])}, JKR 1.5πRW = "
                       f"{_force(hl['jkr_pull_off_N'])})" if "dmt_pull_off_N" in hl else ""))
+    if "F_ex_deepest_N" in hl:
+        out.append(f"F_ex(d = {hl['d_deepest_m'] * 1e9:.4g} nm) = "
+                   f"{_force(hl['F_ex_deepest_N'], hl.get('F_ex_deepest_N_error'))}, F_LJ = "
+                   f"{_force(hl['F_LJ_deepest_N'], hl.get('F_LJ_deepest_N_error'))}")
+    if res.accuracy:
+        a = res.accuracy
+        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: N = "
+                   f"{a['nodes']}, analysis radius {a['analysis_radius_m'] * 1e6:.4g} um after "
+                   f"{len(a['steps'])} run(s)")
     for j in res.jumps:
         where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else
                  "traced fold, dd/ds = 0")

@@ -44,8 +44,12 @@ class ContactResult:
     nodes : ndarray
         The radial nodes (m).
     headline : dict
-        The headline numbers (e.g. max adhesion) with their estimated errors (see
-        :mod:`femadh.runner.headline`).
+        The headline numbers (e.g. max adhesion) and, as ``<name>_error``, their estimated
+        errors (see :mod:`femadh.runner.headline`, :mod:`femadh.runner.estimates`).
+    estimates : dict
+        The error breakdown: quantity -> {grid, fe_mesh, resolution, tail, tolerance, total}.
+    accuracy : dict
+        Accuracy mode: the target, what was chosen (nodes, analysis radius) and the steps.
     timings : dict
         Seconds per phase.
     warnings : list of str
@@ -62,9 +66,11 @@ class ContactResult:
     profiles: dict = field(default_factory=dict)
     nodes: np.ndarray | None = None
     headline: dict = field(default_factory=dict)
+    estimates: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     out_dir: str | None = None
+    accuracy: dict = field(default_factory=dict)
 
     kind = "contact"
 

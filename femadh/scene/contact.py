@@ -105,6 +105,11 @@ SOLVER = Table("solver", "Discretisation and solver.", (
         lo_closed=True, hi=10000, hi_closed=True),
     Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
         "laws only).", default="steps", choices=("steps", "arclength")),
+    Key("accuracy", "number", "Relative accuracy asked of the headline numbers (largest "
+        "adhesion, forces at the deepest separation): femadh refines N and the analysis "
+        "radius until its error estimate meets it, or says it cannot. Without it the "
+        "explicit settings are used and the estimate is reported.", default=None, lo=0.0,
+        hi=0.1, hi_closed=True),
     Key("mesh", "custom", "FE mesh settings (method = 'fe'), see [solver.mesh].",
         default=None, parse=lambda r, raw, path: None if raw is None else r.read(MESH, raw, path),
         expect="a table (see [solver.mesh])"),
@@ -186,6 +191,7 @@ class Scene:
     disk: IsotropicMaterial | None = None
     slider: IsotropicMaterial | None = None
     study: dict | None = None
+    accuracy: float | None = None
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "contact"
@@ -225,7 +231,7 @@ class Scene:
             "solver": {"method": self.method, "nodes": self.nodes,
                        "analysis_radius_m": self.analysis_radius,
                        "tolerance_m": self.tolerance, "max_iter": self.max_iter,
-                       "continuation": self.continuation,
+                       "continuation": self.continuation, "accuracy": self.accuracy,
                        "mesh": None if self.fe_settings is None else {
                            **asdict(self.fe_settings), "poisson_ratio": self.fe_poisson_ratio}},
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
@@ -289,7 +295,7 @@ def parse_contact(reader, data, file):
                  d_values=d_values, directions=sw["directions"],
                  output_dir=ou["dir"] or f"out/{name}", fe_poisson_ratio=fe_nu, vtk=vtk,
                  continuation=so["continuation"], disk=disk, slider=slider, study=study,
-                 raw=copy.deepcopy(data))
+                 accuracy=so["accuracy"], raw=copy.deepcopy(data))
 
 
 def _read_materials(reader, data):

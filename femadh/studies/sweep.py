@@ -161,7 +161,7 @@ def _operator_key(sc):
     return (sc.method, sc.nodes, round(sc.analysis_radius, 18), round(sc.e_star, 3), fe)
 
 
-def run_point(point, root):
+def run_point(point, root, estimate=True):
     """Run one point into ``root/points/<id>/`` and return its record (a small dict). Runs in
     a worker: the surface operator of each distinct grid/mesh is built once per process and
     reused. Never raises for a failed solve: the record says what happened."""
@@ -184,9 +184,10 @@ def run_point(point, root):
                     _OPERATORS.clear()          # one operator per worker: bounded memory
                     _OPERATORS[key] = build_operator(point.scene)
                 res = run(point.scene, folder, figures=False, progress=False, overwrite=True,
-                          operator=_OPERATORS[key])
+                          operator=_OPERATORS[key], estimate=estimate)
             else:
-                res = run(point.scene, folder, figures=False, progress=False, overwrite=True)
+                res = run(point.scene, folder, figures=False, progress=False, overwrite=True,
+                          estimate=estimate)
         rec["status"], rec["error"] = res.status, res.error
         rec.update(_numbers(res))
     except FemadhError as exc:
@@ -219,7 +220,7 @@ def _jsonable(o):
 # --------------------------------------------------------------------------- the study
 
 def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
-              progress=None, quantity="max_adhesion_N"):
+              progress=None, quantity="max_adhesion_N", estimate=True):
     """Run a study; returns (points, records). Points with a record in ``out_dir`` are not
     computed again. ``workers``: local processes (default: the CPU count); ``scheduler``:
     a dask.distributed address ("tcp://host:port") or "local:N" for a LocalCluster of N
@@ -246,7 +247,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
             bar = make_bar(len(todo), f"study {scene.name}")
         t0 = time.perf_counter()
         try:
-            for rec in _execute(todo, out, workers, scheduler):
+            for rec in _execute(todo, out, workers, scheduler, estimate):
                 records[rec["id"]] = rec
                 if bar is not None:
                     bar.update(1)
@@ -275,17 +276,17 @@ def _load_records(out):
     return recs
 
 
-def _execute(todo, out, workers, scheduler):
+def _execute(todo, out, workers, scheduler, estimate=True):
     """Yield the records of the points as they finish, on the chosen executor."""
     if not todo:
         return
     if scheduler:
-        yield from _execute_dask(todo, out, scheduler)
+        yield from _execute_dask(todo, out, scheduler, estimate)
         return
     workers = workers or os.cpu_count() or 1
     if workers == 1:
         for p in todo:
-            yield run_point(p, out)
+            yield run_point(p, out, estimate)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     import multiprocessing as mp
@@ -294,7 +295,7 @@ def _execute(todo, out, workers, scheduler):
 
     with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
                              initializer=_worker_init) as ex:
-        futures = [ex.submit(run_point, p, out) for p in todo]
+        futures = [ex.submit(run_point, p, out, estimate) for p in todo]
         try:
             for f in as_completed(futures):
                 yield f.result()
@@ -311,7 +312,7 @@ def _worker_init():
     os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 
-def _execute_dask(todo, out, scheduler):
+def _execute_dask(todo, out, scheduler, estimate=True):
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -329,7 +330,7 @@ def _execute_dask(todo, out, scheduler):
         client = Client(scheduler)
     try:
         client.run(_worker_init)
-        futures = [client.submit(run_point, p, str(out), pure=False) for p in todo]
+        futures = [client.submit(run_point, p, str(out), estimate, pure=False) for p in todo]
         for f in as_completed(futures):
             yield f.result()
     finally:

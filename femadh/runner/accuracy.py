@@ -1,0 +1,81 @@
+"""Accuracy on demand: ``[solver] accuracy = 1e-3`` asks the headline numbers (the largest
+adhesion, the forces at the deepest separation) to a relative accuracy. femadh runs the scene,
+estimates the errors (:mod:`femadh.runner.estimates`), and refines - more nodes where the grid
+dominates, a larger analysis radius where the tail beyond it does, more nodes where a node
+would snap alone - until the estimate meets the target, within a budget; the result says what
+was chosen and every step (``result.accuracy``), or fails saying the target was not met."""
+import math
+
+from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
+
+
+def _relative(res):
+    """(grid-like relative error, tail relative error) of the headline forces."""
+    hl, est = res.headline, res.estimates
+    scale = max(abs(hl.get("max_adhesion_N", 0.0)), abs(hl.get("F_ex_deepest_N", 0.0)),
+                abs(hl.get("F_LJ_deepest_N", 0.0)), 1e-300)
+    grid, tail = 0.0, 0.0
+    for q in ("max_adhesion_N", "F_ex_deepest_N", "F_LJ_deepest_N"):
+        comp = est.get(q, {})
+        ref = max(abs(hl.get(q, 0.0)), 1e-3 * scale)
+        grid = max(grid, (comp.get("total", 0.0) - comp.get("tail", 0.0)) / ref)
+        tail = max(tail, comp.get("tail", 0.0) / ref)
+    return grid, tail
+
+
+def run_to_accuracy(scene, out_dir, *, figures=True, progress=None, overwrite=False,
+                    resume=False):
+    from .contact import run
+
+    target = scene.accuracy
+    nodes, delta = scene.nodes, scene.analysis_radius**2 / (2 * scene.sphere.radius)
+    steps = []
+    mode = {"overwrite": overwrite, "resume": resume}
+    res = None
+    for i in range(MAX_REFINEMENTS + 1):
+        trial = variant(scene, nodes=nodes, delta=delta)
+        res = run(trial, out_dir, figures=figures, progress=progress, estimate=True, **mode)
+        mode = {"overwrite": True, "resume": False}       # later trials replace earlier ones
+        grid, tail = _relative(res) if res.status == "converged" else (math.inf, 0.0)
+        steps.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,
+                      "status": res.status, "grid_rel_error": grid, "tail_rel_error": tail,
+                      "wall_time_s": res.wall_time})
+        if res.status == "converged" and grid + tail <= target:
+            break
+        if res.status != "converged":
+            err = res.error or ""
+            if "analysis radius" in err:
+                delta *= 4
+                nodes *= 2
+            elif "snap on their own" in err or "Derjaguin" in err:
+                nodes *= 2
+            else:
+                break                       # a failure refinement does not address
+        else:
+            if tail > target / 3:
+                delta *= 4                  # a doubles; keep the spacing
+                nodes *= 2
+            if grid > 2 * target / 3:
+                nodes = int(min(4 * nodes, math.ceil(nodes * max(2.0, 1.2 * grid
+                                                                     / (2 * target / 3)))))
+        if nodes > MAX_NODES:
+            break
+    met = res.status == "converged" and steps[-1]["grid_rel_error"] + steps[-1][
+        "tail_rel_error"] <= target
+    res.accuracy = {"target": target, "met": met, "nodes": steps[-1]["nodes"],
+                    "analysis_radius_m": steps[-1]["analysis_radius_m"], "steps": steps}
+    if not met and res.status == "converged":
+        res.status = "failed"
+        res.error = (f"accuracy {target:g} not met: estimated relative error "
+                     f"{steps[-1]['grid_rel_error'] + steps[-1]['tail_rel_error']:.2g} with "
+                     f"N = {steps[-1]['nodes']} (the budget: N <= {MAX_NODES}, "
+                     f"{MAX_REFINEMENTS} refinements)")
+    if out_dir is not None:
+        from ..io.run_folder import RunFolder
+        from .contact import scene_id, summary
+
+        with RunFolder(out_dir, scene_id(variant(scene, nodes=steps[-1]["nodes"])),
+                       scene.name, "overwrite") as folder:
+            folder.previous = None
+            folder.write_summary(summary(res))
+    return res

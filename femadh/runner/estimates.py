@@ -1,0 +1,274 @@
+"""Error estimates of a contact run's headline numbers, the guards that refuse silent garbage,
+and accuracy on demand.
+
+Each headline number gets an a-posteriori estimate made of
+- **discretisation**: the same scene on the coarser members of its grid family (N/2 and N/4
+  nodes; FE runs: also the FE body against the exact Green function on the same nodes), the
+  fine grid's error estimated by Richardson with the order observed over the three levels
+  (clamped to [1, 3]);
+- **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
+  the grid separations by a bounded scalar search on fresh states (its bracket is its error);
+  a fold is located to 2^-10 of the grid step (the jump's resolution);
+- **truncation at the analysis radius**: the force the laws exert beyond it on the undeformed
+  far field, -2 pi R U(b(a; d)) per law (exact for the paraboloid), reported as ``F_tail``;
+- **solver tolerance**: the force a change of the displacements by the tolerance makes,
+  sum_k area_k |P'(h_k)| tol.
+The total is the sum of their magnitudes (each is a bound or a conservative estimate of its
+part; the signed parts are kept in the breakdown).
+
+Guards (a state or a result that would be garbage is refused, not reported "converged"):
+- the contact reaches the analysis radius (the disk is too small for the load);
+- a node softens beyond its own stiffness (-P'(h_k) > K_kk: it snaps on its own, lattice
+  trapping - the answer then depends on the mesh);
+- the largest adhesion exceeds the Derjaguin-Bradley bound 2 pi R W of the scene's own work of
+  adhesion W (by more than its estimated error): for smooth laws and the complementarity
+  sigma-gap an elastic sphere's load-controlled pull-off lies between JKR's 1.5 and this bound.
+
+Accuracy on demand (``[solver] accuracy``): the run doubles N (and grows the analysis radius
+when the tail dominates) until the estimated error of the largest adhesion and of the force at
+the deepest separation is below the target, within a budget; it says what it chose, or that
+the target cannot be met.
+"""
+import math
+
+import numpy as np
+from scipy import optimize
+
+from ..errors import FemadhError
+
+#: the largest N accuracy mode may choose
+MAX_NODES = 3200
+#: refinements accuracy mode may make
+MAX_REFINEMENTS = 5
+#: a node whose softening exceeds this multiple of its own stiffness snaps alone
+TRAPPING_LIMIT = 1.0
+#: the contact may reach this fraction of the analysis radius
+EDGE_FRACTION = 0.9
+#: assumed order of the discretisation error in the node spacing (conservative, see above)
+ORDER = 1.0
+
+
+class GuardError(FemadhError):
+    """A state or result outside the model's validity: names the quantity, its value and the
+    setting to change."""
+
+
+def check_state(problem, state, scene):
+    """Refuse a state whose contact reaches the analysis radius or whose nodes snap alone."""
+    a = problem.grid.radius
+    if state.r_c > EDGE_FRACTION * a or (state.active.size and state.active[-1]):
+        raise GuardError(
+            f"the contact reaches the analysis radius at d = {state.d * 1e9:.4g} nm (r_c = "
+            f"{state.r_c * 1e6:.4g} um of a = {a * 1e6:.4g} um): the sphere's load does not "
+            "fit the analysed disk; grow [solver] analysis_radius (e.g. delta) or stop the "
+            "sweep earlier")
+    ratio = problem.node_softening_ratio(state.h)
+    if ratio > TRAPPING_LIMIT:
+        n = problem.grid.n
+        raise GuardError(
+            f"at d = {state.d * 1e9:.4g} nm a node's surface-force softening -P'(h) is "
+            f"{ratio:.2f} x its own stiffness: single nodes snap on their own (lattice "
+            f"trapping) and the result depends on the mesh; use [solver] nodes >= "
+            f"{int(math.ceil(n * ratio / 0.5))}")
+
+
+def tail_force(problem, d):
+    """Force (N, attractive positive) of the laws beyond the analysis radius on the undeformed
+    paraboloid: 2 pi R int_{h_a}^inf P dh = -2 pi R U(h_a), h_a = b(a; d)."""
+    a, R = problem.grid.radius, problem.sphere.radius
+    h_a = np.array([d + problem.sphere.shape(a)])
+    return float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
+                                        for e in problem.effects.values()))
+
+
+def tolerance_force(problem, state, tol):
+    """Force change (N) of a displacement change by the tolerance: sum area |P'(h)| tol."""
+    return float(problem.areas @ np.abs(problem.dpressure(state.h)) * tol)
+
+
+def peak_adhesion(problem, prev, best, nxt, scene):
+    """The largest F_ex of the curve between the grid states around its best grid state
+    ``best``: a bounded search in d on fresh states, each solved from the displacements
+    interpolated between the bracketing grid states and accepted only if it stays on that
+    branch (within a quarter of every gap of the interpolation). Returns (F, d, half-width of
+    the final d bracket)."""
+    from ..contact import solve_state
+    from ..contact.forces import state_forces
+
+    f_best = state_forces(problem, best)[2]
+    lo, hi = sorted((prev.d, nxt.d))
+    found = {}
+
+    def interp(d):
+        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
+        t = (d - a.d) / (b.d - a.d)
+        return (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
+
+    def neg(d):
+        w0, near = interp(d)
+        kw = {}
+        if problem.contact_model == "hertz-closure":
+            kw["r_c0"] = near.r_c or None
+        elif problem.sigma is not None:
+            kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
+        st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
+        h_pred = problem.contour(d) - w0
+        if not (st.converged and st.stable) or np.any(
+                np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+            return -f_best
+        found[d] = state_forces(problem, st)[2]
+        return -found[d]
+    xatol = 1e-4 * (hi - lo)
+    optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                             options={"xatol": xatol, "maxiter": 40})
+    F, d = max([(f_best, best.d)] + [(v, x) for x, v in found.items()])
+    return float(F), float(d), xatol
+
+
+def variant(scene, **changes):
+    """The scene with solver changes, validated: nodes=N, method="green" (drops the FE mesh
+    table), delta=... (analysis radius by its gap)."""
+    from ..scene import apply_overrides, scene_from_dict
+
+    raw = apply_overrides(scene.raw, {})
+    solver = raw.setdefault("solver", {})
+    if "nodes" in changes:
+        solver["nodes"] = int(changes["nodes"])
+    if changes.get("method") == "green":
+        solver["method"] = "green"
+        solver.pop("mesh", None)
+        raw.setdefault("output", {})["vtk"] = False
+    if "delta" in changes:
+        solver["analysis_radius"] = {"delta": f"{changes['delta']!r} m"}
+    solver.pop("accuracy", None)
+    raw.pop("study", None)
+    return scene_from_dict(raw, scene.path, bare_numbers=True)
+
+
+def refine_peak(scene, res, problem, sink):
+    """The largest adhesion between the grid states (see :func:`peak_adhesion`), into the
+    headline; returns the half-width of its d bracket (0 without a bracket)."""
+    hl = res.headline
+    if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
+        return 0.0
+    branch, f_grid, prev, best, nxt = sink.peak
+    F, d, half = peak_adhesion(problem, prev, best, nxt, scene)
+    hl["max_adhesion_grid_N"] = f_grid
+    hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
+    return half
+
+
+def estimate_errors(scene, res, problem, sink, half=0.0):
+    """Fill ``res.headline`` with ``<quantity>_error`` entries and return the breakdown
+    {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
+    bracket (:func:`refine_peak`)."""
+    import warnings
+
+    from ..errors import MeshResolutionWarning
+    from .contact import run as _run_quiet
+
+    def run(*a, **kw):
+        # the coarser members are coarse on purpose: their resolution warnings are noise
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshResolutionWarning)
+            return _run_quiet(*a, **kw)
+
+    hl = res.headline
+    parts = {}
+    if half:
+        parts.setdefault("d_at_max_adhesion_m", {})["resolution"] = half
+    # discretisation: the coarser members of the grid family (and, for FE, the exact Green)
+    fine_hl = dict(hl)
+    green = {"method": "green"} if scene.method == "fe" else {}
+    if scene.method == "fe":
+        g = run(variant(scene, **green), progress=False, estimate="peak")
+        if g.status == "converged":
+            for k, v in g.headline.items():
+                if isinstance(v, float) and isinstance(hl.get(k), float):
+                    parts.setdefault(k, {})["fe_mesh"] = v - hl[k]
+            fine_hl = dict(g.headline)       # the grid part: the Green function's in N
+    levels = []
+    for n in (scene.nodes // 2, scene.nodes // 4):
+        if n < 8:
+            break
+        r = run(variant(scene, nodes=n, **green), progress=False, estimate="peak")
+        if r.status != "converged":
+            res.warnings.append(f"discretisation estimate: the coarse grid (N = {n}) failed: "
+                                f"{r.error}")
+            break
+        levels.append(dict(r.headline))
+    if levels:
+        for k, v in discretisation(fine_hl, levels[0],
+                                   levels[1] if len(levels) > 1 else None).items():
+            parts.setdefault(k, {})["grid"] = v
+    # folds: located to the jump's resolution
+    for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
+        js = [j for j in res.jumps if j["branch"] == branch]
+        if js and name in hl:
+            parts.setdefault(name, {})["resolution"] = float(js[0 if branch == "approach"
+                                                                else -1]["resolution_m"])
+    # truncation at the analysis radius and the solver tolerance, for the forces
+    for name, d_key in (("max_adhesion_N", "d_at_max_adhesion_m"),
+                        ("F_ex_deepest_N", "d_deepest_m"), ("F_LJ_deepest_N", "d_deepest_m")):
+        if name in hl and d_key in hl:
+            # the missing attraction beyond a: the exact value exceeds the truncated one
+            parts.setdefault(name, {})["tail"] = tail_force(problem, hl[d_key])
+            parts[name]["tolerance"] = float(problem.areas.sum() * scene.tolerance
+                                             * np.max(np.abs(problem.dpressure(
+                                                 np.full(1, _contact_gap(problem))))))
+    parts = {k: v for k, v in parts.items() if k in QUANTITIES and k in hl}
+    for k, comp in parts.items():
+        # the parts are signed estimates of Q_exact - Q (grid, fe_mesh, tail) or bounds
+        # (resolution, tolerance); they are added in magnitude: the grid and tail estimates
+        # can cancel where the true errors do not, so the total is an upper estimate
+        comp["total"] = float(sum(abs(v) for v in comp.values()))
+        hl[f"{k}_error"] = comp["total"]
+    return parts
+
+
+def _contact_gap(problem):
+    return problem.sigma if problem.sigma is not None else 0.5e-9
+
+
+def guard_bounds(res, problem):
+    """Refuse a largest adhesion beyond the Derjaguin-Bradley bound 2 pi R W (by more than its
+    estimated error) where that bound holds: smooth laws or the complementarity sigma-gap
+    without eq 20 on the contact set."""
+    hl = res.headline
+    if problem.contact_model == "hertz-closure" or (problem.gap is not None
+                                                    and problem.gap.adhesion):
+        return
+    if "max_adhesion_N" not in hl or "dmt_pull_off_N" not in hl:
+        return
+    F, bound, err = hl["max_adhesion_N"], hl["dmt_pull_off_N"], hl.get("max_adhesion_N_error", 0)
+    if F - err > bound * (1 + 1e-9):
+        raise GuardError(
+            f"the largest adhesion {F:.6g} N (estimated error {err:.2g} N) exceeds the "
+            f"Derjaguin-Bradley bound 2 pi R W = {bound:.6g} N of the scene's work of "
+            f"adhesion W = {hl['work_of_adhesion_J_per_m2']:.4g} J/m^2: the discretisation is "
+            "too coarse for these surface forces; raise [solver] nodes (or set [solver] "
+            "accuracy)")
+
+
+def discretisation(fine, coarse, coarser=None):
+    """Signed estimate of each headline number's discretisation error, Q_exact - Q_fine, from
+    the coarser members of its grid family (N/2 and N/4): (Q_N - Q_N/2) / (2^p - 1) with the
+    order p observed over the three levels (clamped to [ORDER, 3]; ORDER = 1 without the
+    third level)."""
+    out = {}
+    for k, v in fine.items():
+        c = coarse.get(k)
+        if not (isinstance(v, float) and isinstance(c, float) and math.isfinite(v)
+                and math.isfinite(c)):
+            continue
+        p = ORDER
+        cc = (coarser or {}).get(k)
+        if isinstance(cc, float) and math.isfinite(cc) and v != c and cc != c:
+            p = min(3.0, max(ORDER, math.log2(abs(c - cc) / abs(v - c))))
+        out[k] = (v - c) / (2.0**p - 1.0)
+    return out
+
+
+QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",
+              "jump_out_d_m", "hysteresis_J", "r_c_at_zero_force_approach_m",
+              "r_c_at_zero_force_retract_m", "d_at_max_adhesion_m")
