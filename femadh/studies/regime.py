@@ -123,13 +123,13 @@ class Resolution:
     def legacy(self):
         return self.stiffness_target is not None or self.min_nodes is not None
 
-    def coarser(self):
-        """The next coarser member of the same grid family (spacing x 2)."""
+    def coarser(self, factor=2.0):
+        """A coarser member of the same grid family (spacing x factor)."""
         if self.legacy:
-            return replace(self, stiffness_target=2 * (self.stiffness_target or
-                                                       STIFFNESS_TARGET),
-                           min_nodes=max(8, (self.min_nodes or 120) // 2))
-        return replace(self, spacing=2 * self.spacing)
+            return replace(self, stiffness_target=factor * (self.stiffness_target or
+                                                            STIFFNESS_TARGET),
+                           min_nodes=max(8, int((self.min_nodes or 120) / factor)))
+        return replace(self, spacing=factor * self.spacing)
 
     def finer(self, factor=2.0):
         if self.legacy:
@@ -417,8 +417,9 @@ def _unresolved(setup, q):
     return None
 
 
-def _estimate(fine, coarse):
-    """Richardson estimates of the fine result's absolute errors from the coarse member."""
+def _estimate(fine, coarse, ratio=2.0):
+    """Richardson estimates of the fine result's absolute errors from a coarser member whose
+    spacing is ``ratio`` times the fine one."""
     out = {}
     for k in QUANTITIES:
         a, b = fine[k], coarse[k]
@@ -427,7 +428,7 @@ def _estimate(fine, coarse):
         elif b is None:   # the coarse grid missed the feature: its size is the estimate
             out[k] = abs(a)
         else:
-            out[k] = abs(a - b) / (2.0**ORDER - 1.0)
+            out[k] = abs(a - b) / (ratio**ORDER - 1.0)
     return out
 
 
@@ -469,6 +470,19 @@ def _solve(mu, radius, law, res, tol, progress):
     q.update(setup=setup, n_points=len(curve.points), n_solves=curve.n_solves,
              n_folds=len(curve.folds), n_grids=len(curve.tracers))
     return q
+
+
+def _coarse_member(mu, radius, law, res, tol):
+    """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
+    traced). Returns (result, ratio)."""
+    for ratio in (COARSE_RATIO, 2.0):
+        try:
+            return _solve(mu, radius, law, res.coarser(ratio), tol, None), ratio
+        except (ConvergenceError, ValueError):
+            continue
+    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x 1.5, x 2 of "
+                          f"{res.spacing:g} ell) cannot be traced: no error estimate; lower "
+                          f"spacing")
 
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
@@ -520,11 +534,11 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
         if "spacing" not in over and not res.legacy:
             res = replace(res, spacing=initial_spacing(accuracy))
-    coarse = _solve(mu, radius, law, res.coarser(), tol, None)
+    coarse, ratio = _coarse_member(mu, radius, law, res, tol)
     for attempt in range(MAX_REFINEMENTS + 1):
         fine = _solve(mu, radius, law, res, tol, progress)
         why = _unresolved(fine["setup"], fine)
-        errors = _estimate(fine, coarse)
+        errors = _estimate(fine, coarse, ratio)
         name, rel = _worst(fine, errors)
         if accuracy is None or (why is None and rel <= accuracy):
             break
@@ -536,7 +550,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         if fine["edge_ratio"] > EDGE_LIMIT:
             res = replace(res, analysis_radius=1.5 * res.analysis_radius)
         else:
-            coarse, res = fine, res.finer()
+            coarse, ratio, res = fine, 2.0, res.finer()
     if why is not None:
         raise ResolutionError(why)
     _check_bounds(mu, fine, errors)
@@ -560,11 +574,17 @@ def initial_spacing(accuracy):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
     map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error."""
-    return min(0.4, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+    return min(MAX_SPACING, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
 
 
-#: measured error constant of the banded family (rel_err ~ C spacing^2, see initial_spacing)
-C_SPACING = 0.1
+#: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
+#: (hysteresis, mu = 1) and 0.02 (fixed-grip pull-off, mu = 3) for spacing <= 0.1
+C_SPACING = 0.02
+#: largest spacing an accuracy request starts from: beyond ~0.1 ell the fixed-grip jump-out
+#: is not yet in the asymptotic range (mu = 3: 1.2 % off at 0.2, 1.3e-4 at 0.1)
+MAX_SPACING = 0.1
+#: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
+COARSE_RATIO = 1.5
 
 
 def regime_map(mus, progress=None, **kw):
