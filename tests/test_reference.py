@@ -7,7 +7,8 @@ import pytest
 from femadh.reference import (dmt_contact_radius, jkr_contact_radius, jkr_pull_off,
                               surface_energy_from_hamaker, tabor_parameter)
 from femadh.reference.maugis import (dmt_curve, jkr_approach, jkr_curve, jkr_load,
-                                     lj_dugdale_lambda, maugis_curve, maugis_pull_off)
+                                     lj_dugdale_lambda, maugis_curve,
+                                     maugis_fixed_grip_pull_off, maugis_pull_off)
 
 from conftest import observed_order
 
@@ -26,6 +27,33 @@ def test_maugis_tends_to_dmt_and_jkr():
     assert observed_order([1e2, 1e3], jkr) == pytest.approx(-2.0, abs=0.1)
     vals = [maugis_pull_off(x) for x in (0.01, 0.1, 0.5, 1, 2, 5, 10)]
     assert np.all(np.diff(vals) < 0)  # monotone between the limits
+
+
+def test_maugis_fixed_grip_pull_off_limits():
+    """Displacement control: the contact breaks at the vertical tangent of P(D). JKR limit
+    (5/6 at D = 6^(-2/3) - (2/3) 6^(1/3)), approached like lambda^-2 (measured 2.00 between
+    100 and 1000); none below lambda = 0.9379 (bisected to 1e-10); above it, less tension than
+    under load control and a tangent that really is vertical (dD/dm = 0 with dP/dm != 0)."""
+    jkr_d = 6 ** (-2 / 3) - 2 / 3 * 6 ** (1 / 3)
+    errs = []
+    for lam in (1e2, 1e3):
+        p, d = maugis_fixed_grip_pull_off(lam)
+        errs.append(abs(p - 5 / 6))
+        assert d == pytest.approx(jkr_d, rel=2e-5)          # measured 1.5e-5 at lambda = 100
+    assert errs[1] < 5e-7                                      # measured 3.8e-8
+    assert observed_order([1e2, 1e3], errs) == pytest.approx(-2.0, abs=0.1)
+    for lam in (0.5, 0.9, 0.937):
+        assert maugis_fixed_grip_pull_off(lam) is None
+    prev = math.inf
+    for lam in (0.938, 0.95, 1.0, 2.0, 5.0):
+        p, d = maugis_fixed_grip_pull_off(lam)
+        assert 5 / 6 < p < maugis_pull_off(lam) and p < prev
+        prev = p
+        # on the curve: the approach D is a minimum over m at that point
+        m = 1 + np.exp(np.linspace(-25, 12, 20001))
+        assert np.min(maugis_curve(lam, m)[2]) >= d - 1e-9
+    # at the onset it joins the curve's end (A -> 0): D -> -1 ... measured -0.99567
+    assert maugis_fixed_grip_pull_off(0.938)[1] == pytest.approx(-0.9957, abs=1e-3)
 
 
 def test_maugis_curve_approaches_jkr_curve_for_large_lambda():

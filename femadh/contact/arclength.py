@@ -41,8 +41,15 @@ from .stability import is_positive_definite
 MAX_ITER = 15
 #: relative accuracy of a Newton step's linear solve (inexact Newton: ample for convergence)
 NEWTON_RTOL = 1e-4
-#: GMRES iterations before the preconditioning factorisation is refreshed
+#: GMRES iterations before the preconditioning factorisation is refreshed (small grids); on
+#: larger ones an O(N^3) refresh costs ~N/3 O(N^2) mat-vecs, so up to N/GMRES_PER_NODE
+#: iterations are allowed (the Jacobian changes only near the moving contact edge: a
+#: low-rank change that GMRES absorbs in a few iterations per changed node)
 GMRES_MAX = 8
+GMRES_PER_NODE = 25
+#: a grid may be exchanged (regrid) only where |dd/ds| exceeds this: the state is carried
+#: over at fixed d, which is well posed away from folds
+REGRID_MIN_TD = 0.05
 #: the step length is tuned so that the corrector moves no gap by more than about this
 #: fraction of itself away from the prediction (the predictor error grows like step^2)
 TARGET_CORRECTION = 0.05
@@ -77,6 +84,7 @@ class _Bordered:
         self.lu = None
         self.n_factor = 0
         self.n_krylov = 0
+        self.krylov_max = max(GMRES_MAX, self.n // GMRES_PER_NODE)
 
     def matrix(self, D, t):
         n, K = self.n, self.problem.K
@@ -109,7 +117,7 @@ class _Bordered:
             # right preconditioning: GMRES then watches the true residual (Pa), not a
             # preconditioned one in other units
             op = sla.LinearOperator((n + 1, n + 1), matvec=lambda y: mv(pre(y)), dtype=float)
-            y, info = sla.gmres(op, rhs, rtol=rtol, atol=atol, restart=GMRES_MAX, maxiter=1,
+            y, info = sla.gmres(op, rhs, rtol=rtol, atol=atol, restart=self.krylov_max, maxiter=1,
                                 callback=count, callback_type="pr_norm")
             x = pre(y)
             self.n_krylov += its[0]
@@ -128,6 +136,13 @@ class _Tracer:
         self.n = problem.grid.n
         self.omega = 1.0 / self.n
         self.lin = _Bordered(problem, self.omega)
+        self.seg = None
+
+    def register(self):
+        """Make this grid the curve's next segment."""
+        self.seg = len(self.curve.tracers)
+        self.curve.tracers.append(self)
+        return self
 
     def tangent(self, w, d, t_prev):
         """Unit tangent (scaled: w/scale, d/scale) at an equilibrium, oriented along t_prev."""
@@ -181,7 +196,7 @@ def _hessian_stable(problem, w, d):
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
-                max_points=5000, progress=None, on_point=None):
+                max_points=5000, progress=None, regrid=None, stop=None, on_point=None):
     """Follow the equilibrium curve from separation d_start until it passes d_end (m).
 
     Parameters
@@ -200,6 +215,13 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         Largest step length (default: 20 * ds).
     progress : callable(float), optional
         Called with the fraction of |d_end - d_start| covered so far.
+    regrid : callable(problem, w, d) -> ContactProblem or None, optional
+        Asked after each accepted point away from folds (|dd/ds| >= REGRID_MIN_TD) for a grid
+        that suits the state better (e.g. fine around the contact edge, which has moved); the
+        state is interpolated to the new grid, solved again at the same d, and the trace goes
+        on there (a new segment of the curve: :attr:`CurvePoint.seg`). None keeps the grid.
+    stop : callable(EquilibriumCurve) -> bool, optional
+        Asked after each accepted point; True ends the trace there (before d_end).
     on_point : callable(int, CurvePoint), optional
         Called with each point as it is accepted (streams it to disk; may raise to stop).
 
@@ -227,8 +249,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     ds_max = 20 * ds if ds_max is None else ds_max
     direction = math.copysign(1.0, d_end - d_start)
     curve = EquilibriumCurve()
-    tr = _Tracer(problem, scale, tol, curve)
-    curve._tracer = tr
+    tr = _Tracer(problem, scale, tol, curve).register()
     w0 = np.zeros(n) if w_start is None else np.asarray(w_start, float)
     st = solve_complementarity(problem, d_start, w0, tol=tol, max_iter=60)
     curve.n_solves += 1
@@ -253,6 +274,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         return exc
 
     check_next = False
+    stopped = False
     attempts = 0
 
     def shorten(reason, d, res, it):
@@ -315,9 +337,11 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
                 continue
         check_next = folded
         attempts = 0
-        q = CurvePoint(d, w, t, stable, it, res)
+        q = CurvePoint(d, w, t, stable, it, res, tr.seg)
         if folded:
-            curve.folds.append(_locate_fold(tr, p, step, len(curve.points) - 1))
+            fold = _locate_fold(tr, p, step, len(curve.points) - 1)
+            fold.seg = tr.seg
+            curve.folds.append(fold)
         curve.points.append(q)
         step = min(ds_max, step * min(2.0, max(0.5, math.sqrt(TARGET_CORRECTION
                                                              / max(corr, 1e-12)))))
@@ -327,9 +351,27 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             break           # (the last point is recomputed at d_end before it is streamed)
         if on_point:
             on_point(len(curve.points) - 1, q)
+        if stop is not None and stop(curve):
+            stopped = True
+            break
         if len(curve.points) >= max_points:
             raise fail(f"arclength continuation needed more than {max_points} points",
                        d, res, it)
+        if regrid is not None and abs(t[n]) >= REGRID_MIN_TD:
+            new = regrid(problem, w, d)
+            moved = None if new is None else _carry_over(new, q, tr, scale, tol, curve)
+            if moved is not None:
+                tr, problem, n = moved[0], new, new.grid.n
+                weights = np.r_[np.full(n, tr.omega), 1.0]
+                curve.points.append(moved[1])
+                if on_point:
+                    on_point(len(curve.points) - 1, moved[1])
+                check_next = False
+    curve.n_factor = sum(x.lin.n_factor for x in curve.tracers)
+    curve.n_krylov = sum(x.lin.n_krylov for x in curve.tracers)
+    if stopped:
+        curve.wall_time = time.perf_counter() - t0
+        return curve
     # the last point exactly on d_end, recomputed on the curve inside the last step
     b = curve.points[-1]
     if b.d != d_end:
@@ -338,13 +380,32 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         except ConvergenceError as exc:
             raise fail(f"arclength end point: {exc}", d_end, math.nan, 0) from None
         curve.points[-1] = CurvePoint(d_end, w, tr.tangent(w, d_end, b.t), b.stable, b.n_iter,
-                                      _residual(problem, w, d_end))
+                                      _residual(problem, w, d_end), b.seg)
     if on_point and len(curve.points) > 1:
         on_point(len(curve.points) - 1, curve.points[-1])
-    curve.n_factor = tr.lin.n_factor
-    curve.n_krylov = tr.lin.n_krylov
     curve.wall_time = time.perf_counter() - t0
     return curve
+
+
+def _carry_over(problem, q, tr, scale, tol, curve):
+    """Point q (on tracer tr's grid) carried to ``problem``'s grid: w and the tangent
+    interpolated in r, the state solved again at the same d, its stability checked by the
+    Hessian. Returns (new tracer, new CurvePoint), or None (the old grid is kept) if the
+    solve fails or the stability differs (the new grid does not resolve the state)."""
+    r_old, r_new = tr.problem.grid.nodes, problem.grid.nodes
+    n = problem.grid.n
+    w = np.interp(r_new, r_old, q.w)
+    t_w = np.interp(r_new, r_old, q.t[:-1])
+    fixed_d = np.zeros(n + 1)
+    fixed_d[n] = 1.0
+    new = _Tracer(problem, scale, tol, curve)
+    xc, it, res, ok = new.correct(np.r_[w, q.d] / scale, fixed_d)
+    if not ok or _hessian_stable(problem, xc[:n] * scale, q.d) != q.stable:
+        return None
+    w = xc[:n] * scale
+    new.register()
+    t = new.tangent(w, q.d, np.r_[t_w, q.t[-1]])
+    return new, CurvePoint(q.d, w, t, q.stable, it, res, new.seg)
 
 
 def _locate_fold(tr, p, step, index):

@@ -21,6 +21,7 @@ class CurvePoint:
     stable: bool
     n_iter: int
     residual: float
+    seg: int = 0           # the grid segment (index into EquilibriumCurve.tracers) it lives on
 
     @property
     def t_d(self):
@@ -35,11 +36,17 @@ class Fold:
     d: float
     w: np.ndarray
     s_offset: float
+    seg: int = 0
 
 
 @dataclass
 class EquilibriumCurve:
-    """Points in arclength order from d_start to d_end and the folds between them."""
+    """Points in arclength order from d_start to d_end and the folds between them.
+
+    A curve traced on a grid that moves with the contact edge is made of segments, one per
+    grid (``tracers[k].problem``); consecutive points of different segments are the same
+    equilibrium at the same d on two grids (a seam), not an interval of the curve.
+    """
 
     points: list = field(default_factory=list)
     folds: list = field(default_factory=list)
@@ -47,11 +54,23 @@ class EquilibriumCurve:
     n_factor: int = 0
     n_krylov: int = 0
     wall_time: float = 0.0
-    _tracer: object = None
+    tracers: list = field(default_factory=list)
+
+    @property
+    def _tracer(self):
+        return self.tracers[-1]
 
     @property
     def d(self):
         return np.array([p.d for p in self.points])
+
+    def problem_of(self, seg):
+        """The ContactProblem (grid) of segment ``seg``."""
+        return self.tracers[seg].problem
+
+    def _seam(self, i):
+        """True if points i and i+1 lie on different grids (no curve interval between)."""
+        return self.points[i].seg != self.points[i + 1].seg
 
     def walk(self, direction):
         """Segments of the displacement-controlled path in visiting order.
@@ -112,7 +131,8 @@ class EquilibriumCurve:
                     pieces.append((r[0] - 1, f.d, pts[r[0]].d, (f.s_offset, None),
                                    r[0], r[0]))
                 for a in range(r[0], r[1]):
-                    pieces.append((a, pts[a].d, pts[a + 1].d, (0.0, None), a, a + 1))
+                    if not self._seam(a):
+                        pieces.append((a, pts[a].d, pts[a + 1].d, (0.0, None), a, a + 1))
                 if k_out is not None:
                     f = self.folds[k_out]
                     pieces.append((r[1], pts[r[1]].d, f.d, (0.0, f.s_offset), r[1], r[1]))
@@ -135,13 +155,13 @@ class EquilibriumCurve:
                 lo, hi, i = run[0], first, first
 
     def _dist(self, p, q):
-        tr = self._tracer
+        tr = self.tracers[p.seg]
         dx = (np.r_[q.w, q.d] - np.r_[p.w, p.d]) / tr.scale
         return float(np.sqrt(tr.omega * (dx[:-1] @ dx[:-1]) + dx[-1] ** 2))
 
     def _on_curve(self, p, off):
         """(d, w) of the curve point at arclength offset ``off`` from point p, or None."""
-        tr = self._tracer
+        tr = self.tracers[p.seg]
         xc, _, _, ok = tr.correct(np.r_[p.w, p.d] / tr.scale + off * p.t, p.t)
         return (xc[-1] * tr.scale, xc[:-1] * tr.scale) if ok else None
 
@@ -185,16 +205,18 @@ class EquilibriumCurve:
                                  options={"xatol": 1e-7 * (s1 + s2)})
         return tuple(best)
 
-    def branch(self, direction):
+    def branch(self, direction, segments=False):
         """The states along the displacement-controlled path, folds and landings included.
 
         Parameters
         ----------
         direction : {"approach", "retract"}
+        segments : bool
+            Also return each state's grid segment (see :meth:`problem_of`).
 
         Returns
         -------
-        list of (kind, d, w)
+        list of (kind, d, w) or (kind, d, w, seg)
             In visiting order; kind is ``"point"`` (a curve point), ``"fold"`` (the last state
             of a branch) or ``"land"`` (where it jumped to, at the same d, recomputed on the
             curve between the two points that bracket it).
@@ -204,14 +226,14 @@ class EquilibriumCurve:
         for kind, i, j in self.walk(direction):
             if kind == "run":
                 for k in range(i, j + (1 if j >= i else -1), 1 if j >= i else -1):
-                    out.append(("point", pts[k].d, pts[k].w))
+                    out.append(("point", pts[k].d, pts[k].w, pts[k].seg))
             elif kind == "fold":
                 f = self.folds[i]
-                out.append(("fold", f.d, f.w))
+                out.append(("fold", f.d, f.w, f.seg))
             else:
                 d_f = out[-1][1]
-                out.append(("land", d_f, self.point_at(i, d_f, j)))
-        return out
+                out.append(("land", d_f, self.point_at(i, d_f, j), pts[i].seg))
+        return out if segments else [e[:3] for e in out]
 
 
 def bracketed_root(f, lo, hi, *, xtol):

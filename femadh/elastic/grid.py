@@ -79,6 +79,52 @@ class RadialGrid:
         return cls.from_nodes(np.array(nodes), radius)
 
     @classmethod
+    def banded(cls, radius, spacing, band, grading, max_nodes=20000):
+        """A grid family fine in a band and coarsening linearly with the distance from it.
+
+        The node spacing is Delta(r) = spacing * (1 + dist(r, band) / grading): uniform in
+        the band [lo, hi], growing by about 1 + spacing/grading per node away from it
+        (geometrically) on both sides, down to r = 0 and out to the analysis radius. Halving
+        ``spacing`` at fixed ``grading`` halves Delta everywhere: the members of the family
+        are refinements of one mesh density, as a Richardson estimate needs.
+
+        Parameters
+        ----------
+        radius : float
+            Analysis radius a (m).
+        spacing : float
+            Node spacing (m) in the band.
+        band : (float, float)
+            Radii (m) of the band (e.g. around the contact edge); clipped to [0, radius].
+        grading : float
+            Length (m) over which the spacing grows by ``spacing`` (> 0).
+        max_nodes : int
+            Budget: a ValueError beyond it (spacing too fine for the domain).
+        """
+        lo, hi = max(0.0, float(band[0])), min(radius, float(band[1]))
+        if not (spacing > 0 and grading > 0 and lo <= hi):
+            raise ValueError("need spacing > 0, grading > 0 and band[0] <= band[1]")
+
+        def delta(r):
+            return spacing * (1.0 + max(lo - r, r - hi, 0.0) / grading)
+
+        nodes = [0.0]
+        while True:
+            r = nodes[-1]
+            # midpoint rule for the spacing function: symmetric coarsening on both sides
+            step = delta(r + 0.5 * delta(r))
+            # stop when the last annulus (half-way edge to a) would be narrower than the step
+            if r + 1.5 * step > radius:
+                break
+            nodes.append(r + step)
+            if len(nodes) > max_nodes:
+                raise ValueError(f"banded grid needs more than {max_nodes} nodes (spacing "
+                                 f"{spacing:.3g} m on a radius of {radius:.3g} m)")
+        if len(nodes) < 2:
+            raise ValueError("the spacing does not fit inside the analysis radius")
+        return cls.from_nodes(np.array(nodes), radius)
+
+    @classmethod
     def from_nodes(cls, nodes, radius):
         """Annuli with edges half-way between the given nodes (nodes[0] must be 0)."""
         nodes = np.asarray(nodes, float)

@@ -4,6 +4,7 @@ positive = attractive, pulls the disk surface up), ``dpressure(h)`` (Pa/m) and `
 three belong together. The contact problem sums only the laws a scene names.
 
 - :mod:`.lj` - mean-plane Lennard-Jones, paper 1 eq (3)
+- :mod:`.lj82` - the Adhesion package's Lj82 law (by work of adhesion; the peer benchmark)
 - :mod:`.capillary` - condensate-filled gap (paper 2 physics in a paper 1 scene)
 - :mod:`.asperity` - eq (20) asperity adhesion as a smoothed step above sigma
 - :mod:`.gw` - Greenwood-Williamson elastic and adhesive asperity pressures (eqs 23-24)
@@ -14,6 +15,7 @@ from .capillary import CapillaryCondensate
 from .check import check_law
 from .gw import GWAdhesion, GWElastic, Summits, gw_integral
 from .lj import LennardJones
+from .lj82 import Lj82
 
-__all__ = ["LennardJones", "CapillaryCondensate", "AsperityAdhesion", "eq20_pressure",
+__all__ = ["LennardJones", "Lj82", "CapillaryCondensate", "AsperityAdhesion", "eq20_pressure",
            "GWElastic", "GWAdhesion", "Summits", "gw_integral", "check_law"]

@@ -11,6 +11,12 @@ Parametric in m = c/a (> 1, c the radius of the Dugdale cohesive zone):
     D = A^2 - (4/3) lam A s
 
 F positive = compressive load (the adhesive pull-off is the most negative P).
+
+Two pull-offs: under load control the contact breaks at the most negative P
+(:func:`maugis_pull_off`); under displacement control (fixed grips) it breaks where the P(D)
+curve has a vertical tangent, dD/dm = 0 with the separation -D largest
+(:func:`maugis_fixed_grip_pull_off`): -(5/6) in the JKR limit, and no such point (a smooth
+separation) below lambda ~ 0.938.
 """
 import math
 
@@ -19,8 +25,10 @@ from scipy import optimize
 
 
 def maugis_curve(lam, m):
-    """(A, P, D) arrays of the Maugis-Dugdale solution for lambda and m-values (> 1)."""
-    m = np.asarray(m, float)
+    """(A, P, D) arrays of the Maugis-Dugdale solution for lambda and m-values (> 1); complex
+    m is passed through (for complex-step derivatives)."""
+    m = np.asarray(m)
+    m = m.astype(np.result_type(m.dtype, float))
     s = np.sqrt(m * m - 1)
     at = np.arctan(s)
     alpha = 0.5 * lam * (s + (m * m - 2) * at)
@@ -31,19 +39,64 @@ def maugis_curve(lam, m):
     return A, P, D
 
 
+#: log(m - 1) range scanned for the extrema of the parametric curve: m - 1 from 1e-11 (the JKR
+#: end at large lambda) to 1.6e5 (A -> 0, the curve's end as the contact vanishes)
+_LOG_M1 = np.linspace(-25.0, 12.0, 1500)
+
+
+def _refined_min(f, xs, values):
+    """Minimum of f near the smallest of its sampled ``values`` (bounded Brent between the
+    sample's neighbours). Returns (x, f(x))."""
+    k = int(np.argmin(values))
+    lo, hi = xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]
+    res = optimize.minimize_scalar(f, bounds=(lo, hi), method="bounded",
+                                   options={"xatol": 1e-12})
+    return (float(res.x), float(res.fun)) if res.fun < values[k] else (xs[k], values[k])
+
+
 def maugis_pull_off(lam):
     """Load-controlled pull-off -min P (in units of pi dg R): 2 (DMT) at lam -> 0, 1.5 (JKR)
     at lam -> inf."""
     def P_of_logm(x):
         return maugis_curve(lam, 1.0 + np.exp(x))[1]
 
-    xs = np.linspace(-25, 12, 1500)
-    P = P_of_logm(xs)
-    k = int(np.argmin(P))
-    lo, hi = xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]
-    res = optimize.minimize_scalar(P_of_logm, bounds=(lo, hi), method="bounded",
-                                   options={"xatol": 1e-12})
-    return -float(min(res.fun, P[k]))
+    return -_refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))[1]
+
+
+def maugis_fixed_grip_pull_off(lam):
+    """Displacement-controlled (fixed-grip) pull-off of Maugis-Dugdale.
+
+    Under fixed grips the contact is stable until the P(D) curve has a vertical tangent:
+    dD/dm = 0 at the smallest (most tensile) approach D, after which the contact jumps off.
+
+    Parameters
+    ----------
+    lam : float
+        Maugis' lambda (-).
+
+    Returns
+    -------
+    (pull_off, D) or None
+        -P (units of pi dg R) and the approach D (Maugis units) at the vertical tangent; None
+        when D(m) decreases all the way to the curve's end (A -> 0): no fixed-grip
+        instability, the contact peels off smoothly (lambda below 0.9379). JKR limit: 5/6 at
+        A = 6^(-1/3), D = 6^(-2/3) - (2/3) 6^(1/3) = -0.9086.
+    """
+    def D_of_logm(x):
+        return maugis_curve(lam, 1.0 + np.exp(x))[2]
+
+    def dD_dlogm(x):
+        # complex-step derivative: exact to rounding, so the root is as sharp as the curve
+        # (minimising D itself locates a flat minimum only to sqrt(eps))
+        return float(np.imag(D_of_logm(complex(x, 1e-30)))) / 1e-30
+
+    D = D_of_logm(_LOG_M1)
+    k = int(np.argmin(D))
+    if k >= _LOG_M1.size - 2 or k == 0:
+        return None
+    x = optimize.brentq(dD_dlogm, _LOG_M1[k - 1], _LOG_M1[k + 1], xtol=1e-14, maxiter=100)
+    _, P, Dv = maugis_curve(lam, 1.0 + np.exp(x))
+    return -float(P), float(Dv)
 
 
 def jkr_curve(A):
@@ -69,6 +122,14 @@ def jkr_load(contact_radius, radius, e_star, work_of_adhesion):
     a = contact_radius
     return 4 * e_star * a**3 / (3 * radius) - math.sqrt(8 * math.pi * work_of_adhesion * e_star
                                                          * a**3)
+
+
+def maugis_length_units(radius, e_star, work_of_adhesion):
+    """(a_unit, delta_unit) in m: Maugis' A = a / a_unit, D = delta / delta_unit."""
+    K = 4.0 * e_star / 3.0
+    dg = work_of_adhesion
+    return ((math.pi * dg * radius**2 / K) ** (1 / 3),
+            (math.pi**2 * dg**2 * radius / K**2) ** (1 / 3))
 
 
 def lj_dugdale_lambda(tabor_mu):

@@ -1,24 +1,37 @@
-"""Smooth-sphere Lennard-Jones adhesion regime map (beyond the papers).
+"""Smooth-sphere Lennard-Jones adhesion regime map over the whole Tabor range (beyond the papers).
 
-A smooth elastic sphere against a flat with the LJ law of paper 1 eq (3) and no sigma-gap: the
-repulsive term carries the contact. Swept in the Tabor parameter
+A smooth elastic half-space against a rigid paraboloid with the LJ law of paper 1 eq (3) (or any
+gap law with ``work_of_adhesion`` and ``z0``, e.g. :class:`femadh.laws.Lj82`) and no sigma-gap:
+the repulsive term carries the contact. Swept in the Tabor parameter
 mu = (R dg^2 / (E*^2 z0^3))^(1/3), dg = A / (16 pi z0^2) (eq 19), by choosing E* at fixed R, A,
-z0. Each point traces the whole equilibrium curve F(d) by pseudo-arclength continuation
-(:mod:`femadh.contact.arclength`), through its folds; the approach and retract paths of a
-displacement-controlled experiment, the jump-in and jump-out separations (the folds) and the
-hysteresis follow from it. The pull-off is the largest tensile force on the retract path
-(load-controlled pull-off), normalised by pi R dg and compared with Maugis-Dugdale at
-lambda = 1.157 mu (Johnson & Greenwood 1997) and the JKR (1.5) and DMT (2) limits.
+z0. Each point traces the equilibrium curve F(d) by pseudo-arclength continuation
+(:mod:`femadh.contact.arclength`) through its folds; the approach and retract paths of a
+displacement-controlled experiment follow from it. Read off the curve:
 
-Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277 ("Adhesion of
-elastic spheres"); Feng 2000, J. Colloid Interface Sci. 238, 318.
+- load-controlled pull-off: the largest tension on the curve (Maugis-Dugdale's pull-off);
+- displacement-controlled pull-off: the tension where the retract path leaves the contact (the
+  jump-out fold: Maugis-Dugdale's vertical tangent of P(D), -(5/6) pi R dg in the JKR limit);
+- jump-in / jump-out separations (the folds) and the hysteresis (energy released at the jumps).
 
-Mesh: the contact edge must be resolved by nodes whose own stiffness exceeds the LJ law's
-largest softening stiffness, or single nodes snap on their own (lattice trapping, a mesh
-artefact). That spacing shrinks like mu^-2 in units of the contact radius, so the grid is
-uniform with that spacing only where the contact edge travels and grows geometrically beyond.
+Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277; Feng 2000,
+J. Colloid Interface Sci. 238, 318.
+
+Grid (JKR side): the law acts in a cohesive zone at the contact edge whose width scales like the
+elastocohesive length E* z0^2 / dg, while the contact radius grows like mu^(1/2): at mu = 20
+(R = 1 um) the zone is ~1 z0 wide at a contact of ~800 z0. A node coarser than the zone snaps on
+its own (lattice trapping: extra folds, an early jump-out). The grid is therefore a band of
+uniform fine spacing around the *current* contact edge, coarsening linearly with the distance
+from it (:meth:`RadialGrid.banded`), and it moves with the edge during the trace (a new grid
+when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``): the node count
+no longer grows like mu^2. The lateral length that sets the spacing is the smaller of the
+elastocohesive length and sqrt(R z0 / 8) (the DMT side, where the contact is smaller than the
+cohesive zone and the law's range over the paraboloid sets the scale).
+
+Accuracy: every result carries an a-posteriori error estimate from the next coarser member of
+the grid family (spacing x 2; Richardson with the observed order 2). ``accuracy=`` chooses the
+spacing and refines until the estimate meets the request.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 import math
 import time
 import warnings
@@ -28,37 +41,118 @@ import numpy as np
 from ..contact import ContactProblem
 from ..contact.arclength import trace_curve
 from ..elastic import GreenOperator, RadialGrid
-from ..errors import MeshResolutionWarning
+from ..errors import ConvergenceError, MeshResolutionWarning
 from ..indenter import Sphere
 from ..laws import LennardJones
 from ..reference.adhesion import dmt_contact_radius, jkr_contact_radius
-from ..reference.maugis import jkr_approach, lj_dugdale_lambda, maugis_pull_off
+from ..reference.maugis import (jkr_approach, lj_dugdale_lambda, maugis_fixed_grip_pull_off,
+                                maugis_length_units, maugis_pull_off)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
-#: a priori: the fine spacing keeps the LJ softening stiffness below this fraction of a node's
+#: a priori (legacy fixed grids): LJ softening stiffness below this fraction of a node's
 STIFFNESS_TARGET = 0.4
-#: a posteriori: above this local ratio (on any traced state) a node could snap on its own
+#: a posteriori: above this local ratio -P'(h_k)/K_kk (on any traced state) a node can snap on
+#: its own (lattice trapping): the point is not a converged result
 TRAPPING_LIMIT = 1.0
-#: compressive load (units pi R dg) at the deepest point of the sweep: beyond the jump-in
-#: landing (which is tensile), so the whole approach-retract cycle is on the curve
+#: compressive load (units pi R dg) at the deepest point of a curve without folds (DMT side)
 PRELOAD = 0.5
-#: uniform spacing up to this multiple of the JKR contact radius at PRELOAD (the largest
-#: contact of the sweep; JKR bounds Maugis-Dugdale's radius at a given load from above)
+#: legacy fixed grid: uniform spacing up to this multiple of the JKR radius at PRELOAD
 FINE_MARGIN = 1.15
-#: analysis radius in the same units (the rigid-LJ tail beyond it is added to the force)
-ANALYSIS_RADIUS = 4.32
+#: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
+#: it is added to the force exactly); at least sqrt(2 R 20 z0) (the rigid gap there is 20 z0)
+ANALYSIS_RADIUS = 8.0
+#: banded grid family (lengths in units of the lateral length ell, see lateral_length):
+#: band spacing (the family parameter), half-width of the fine band, and the grading length
+#: over which the spacing grows by one band spacing
+SPACING = 0.1
+BAND = 4.0
+GRADING = 2.0
+#: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
+EDGE_GAP = 1.5
+#: a contact edge beyond this fraction of the analysis radius is not resolved
+EDGE_LIMIT = 0.8
+#: observed order of the spacing error of the headline quantities (measured, see
+#: validation/results/accuracy_regime.md); Richardson divides the coarse-fine change by 2^p - 1
+ORDER = 2.0
+#: hysteresis errors are relative to max(hysteresis, this) (units pi R dg z0): near the onset
+#: of bistability the loop closes and a relative error of a vanishing work is not meaningful
+HYSTERESIS_FLOOR = 0.1
+#: refinements (halvings of the spacing) an accuracy request may take
+MAX_REFINEMENTS = 4
+#: the headline quantities and the accuracy they are judged by
+QUANTITIES = ("pull_off", "pull_off_displacement", "jump_in", "jump_out", "hysteresis")
+#: proven bounds of the load-controlled pull-off / (pi R dg) for a paraboloid (see
+#: _check_bounds): 2 (rigid Derjaguin, exact for a paraboloid) above, JKR's 1.5 below
+DERJAGUIN, JKR = 2.0, 1.5
+
+
+class ResolutionError(ConvergenceError):
+    """A traced state is not resolved by the grid (lattice trapping, a contact reaching the
+    analysis radius) or a result leaves its proven bounds: not a converged map point."""
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Discretisation of one regime-map point.
+
+    Attributes
+    ----------
+    spacing : float
+        Fine-band node spacing / lateral length ell (the grid family's parameter).
+    band, grading : float
+        Half-width of the fine band and grading length (units of ell).
+    analysis_radius : float
+        Analysis radius in units of Maugis' a_unit (at least sqrt(40 R z0)).
+    ds_max : float or None
+        Largest continuation step (units of z0); None: from the trace's length.
+    stiffness_target, min_nodes : float, int or None
+        Legacy fixed graded grid (today's explicit settings, no moving band): when either is
+        set the grid is :func:`_lj_problem`'s and its coarser member has twice the spacing.
+    """
+
+    spacing: float = SPACING
+    band: float = BAND
+    grading: float = GRADING
+    analysis_radius: float = ANALYSIS_RADIUS
+    ds_max: float | None = None
+    stiffness_target: float | None = None
+    min_nodes: int | None = None
+
+    @property
+    def legacy(self):
+        return self.stiffness_target is not None or self.min_nodes is not None
+
+    def coarser(self, factor=2.0):
+        """A coarser member of the same grid family (spacing x factor)."""
+        if self.legacy:
+            return replace(self, stiffness_target=factor * (self.stiffness_target or
+                                                            STIFFNESS_TARGET),
+                           min_nodes=max(8, int((self.min_nodes or 120) / factor)))
+        return replace(self, spacing=factor * self.spacing)
+
+    def finer(self, factor=2.0):
+        if self.legacy:
+            return replace(self, stiffness_target=(self.stiffness_target or STIFFNESS_TARGET)
+                           / factor, min_nodes=int((self.min_nodes or 120) * factor))
+        return replace(self, spacing=self.spacing / factor)
 
 
 @dataclass
 class RegimePoint:
-    """One point of the regime map (forces / (pi R dg), separations / z0)."""
+    """One point of the regime map (forces / (pi R dg), separations / z0, work / (pi R dg z0)).
+
+    ``*_error`` are the a-posteriori estimates of the absolute errors of the same quantities
+    (Richardson from the next coarser grid of the family); None where a quantity does not
+    exist (no folds: no jumps, no displacement-controlled jump-out).
+    """
 
     mu: float
     e_star: float
-    pull_off: float            # load-controlled pull-off (largest tension on the curve) / pi R dg
-    pull_off_displacement: float  # largest tension on the displacement-controlled retract path
-    maugis: float              # Maugis-Dugdale pull-off at lambda = 1.157 mu
+    pull_off: float            # load-controlled pull-off (largest tension on the curve)
+    pull_off_displacement: float | None  # tension at the jump-out (fixed-grip pull-off)
+    maugis: float              # Maugis-Dugdale load-controlled pull-off at lambda = 1.157 mu
+    maugis_displacement: float | None  # Maugis-Dugdale fixed-grip pull-off (None: none)
     jump_in: float | None      # d / z0 of the approach fold
     jump_out: float | None     # d / z0 of the last retract fold
     hysteresis: float          # energy dissipated per cycle / (pi R dg z0), from energy jumps
@@ -67,13 +161,53 @@ class RegimePoint:
     trapping_ratio: float      # max over states and nodes of -P'(h_k) / K_kk
     n_points: int
     n_solves: int
-    nodes: int
+    nodes: int                 # nodes of the (largest) grid of the reported result
     wall_time: float
     curves: dict
+    errors: dict = field(default_factory=dict)   # estimated absolute errors by quantity
+    resolution: Resolution | None = None
+    spacing_m: float = math.nan   # fine-band node spacing (m)
+    lateral_length: float = math.nan  # ell (m)
+    analysis_radius_m: float = math.nan
+    edge_ratio: float = math.nan  # largest contact-edge radius / analysis radius
+    n_grids: int = 1              # grids the moving band used along the curve
+    accuracy: float | None = None  # the requested relative accuracy (None: explicit settings)
+    failed: str | None = None      # why the point is not a converged result (None: it is)
+
+    def error(self, name):
+        """Estimated absolute error of quantity ``name`` (None if it does not exist)."""
+        return self.errors.get(name)
+
+    def relative_error(self, name):
+        """Estimated error relative to the quantity (hysteresis: to its floor)."""
+        e, v = self.errors.get(name), getattr(self, name)
+        if e is None or v is None:
+            return None
+        ref = max(abs(v), HYSTERESIS_FLOOR) if name == "hysteresis" else abs(v)
+        return e / ref
+
+    pull_off_error = property(lambda self: self.error("pull_off"))
+    pull_off_displacement_error = property(lambda self: self.error("pull_off_displacement"))
+    jump_in_error = property(lambda self: self.error("jump_in"))
+    jump_out_error = property(lambda self: self.error("jump_out"))
+    hysteresis_error = property(lambda self: self.error("hysteresis"))
+
+
+def lateral_length(law, radius, e_star):
+    """ell (m): the smaller of the elastocohesive length E* z0^2/dg (cohesive-zone width at a
+    JKR-like edge) and sqrt(R z0 / 8) (the gap of the rigid paraboloid grows by z0/16 over it:
+    the DMT side, where the law's range, not the edge, sets the lateral scale)."""
+    return min(e_star_length(law, e_star), math.sqrt(radius * law.z0 / 8))
+
+
+def e_star_length(law, e_star):
+    """Elastocohesive length E* z0^2 / dg (m)."""
+    return e_star * law.z0**2 / law.work_of_adhesion
 
 
 def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
-    """The smooth-sphere problem at Tabor mu, on a grid fine where the contact edge travels.
+    """Legacy fixed grid: the smooth-sphere problem at Tabor mu, uniform fine spacing (set by
+    the LJ softening stiffness against a node's) up to where the contact edge travels.
 
     Returns (problem, lj, e_star, a, d_min): a is the analysis radius (m), d_min the
     separation (m) of the deepest point, where the JKR load is PRELOAD pi R dg.
@@ -81,18 +215,10 @@ def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
     lj = LennardJones(hamaker, z0)
     dg = lj.work_of_adhesion
     e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
-    K = 4 * e_star / 3
-    a_unit = (math.pi * dg * radius**2 / K) ** (1 / 3)
-    a = max(ANALYSIS_RADIUS * a_unit, math.sqrt(2 * radius * 20 * z0))
-    load = PRELOAD * math.pi * radius * dg
-    a_max = jkr_contact_radius(load, radius, e_star, dg)
-    # the approach for that load in the nearer limit (DMT below mu = 1, JKR above), from
-    # where the rigid sphere's LJ force vanishes, d = z0 / 4^(1/6) (eq 14: U(d) = 0)
-    if mu < 1:
-        delta = dmt_contact_radius(load, radius, e_star, dg) ** 2 / radius
-    else:
-        delta = jkr_approach(a_max, radius, e_star, dg)
-    d_min = z0 / 4 ** (1 / 6) - delta
+    a_unit = maugis_length_units(radius, e_star, dg)[0]
+    a = max(4.32 * a_unit, math.sqrt(2 * radius * 20 * z0))
+    a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, e_star, dg)
+    d_min = _deepest(mu, radius, e_star, lj)
     # node self-stiffness scales like 1/spacing: calibrate it on a coarse uniform probe
     probe = ContactProblem(GreenOperator(RadialGrid.uniform(a, 60), e_star), Sphere(radius),
                            {"lj": lj})
@@ -106,102 +232,412 @@ def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
     return problem, lj, e_star, a, d_min
 
 
+def _deepest(mu, radius, e_star, law):
+    """Separation (m) of the deepest point: where the load is PRELOAD pi R dg in the nearer
+    limit (DMT below mu = 1, JKR above), from where the rigid sphere's force vanishes
+    (U(d) = 0: d = z0 / 4^(1/6) for LJ)."""
+    dg, z0 = law.work_of_adhesion, law.z0
+    load = PRELOAD * math.pi * radius * dg
+    if mu < 1:
+        delta = dmt_contact_radius(load, radius, e_star, dg) ** 2 / radius
+    else:
+        delta = jkr_approach(jkr_contact_radius(load, radius, e_star, dg), radius, e_star, dg)
+    return z0 / 4 ** (1 / 6) - delta
+
+
 def lj_force(problem, lj, d, w):
-    """Force on the disk (N, attractive positive) of a state: the LJ pressure integrated over
-    the analysis disk plus the tail beyond it, where the surface is undeformed and the
-    paraboloid's LJ force is eq 14's, -2 pi R U(b(a; d)) (the tail is 0.3-11 % of the rigid
-    force at d = z0 ... 10 z0 on the regime map's grids)."""
+    """Force on the disk (N, attractive positive) of a state: the law's pressure integrated
+    over the analysis disk plus the tail beyond it, where the surface is undeformed and the
+    paraboloid's force is exactly -2 pi R U(b(a; d)) (Derjaguin is exact for a paraboloid:
+    2 pi r dr = 2 pi R dh)."""
     a, radius = problem.grid.radius, problem.sphere.radius
     h = problem.contour(d) - w
     tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))
     return problem.grid.force(problem.pressure(h)) + tail
 
 
-def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, tol=1e-19,
-              stiffness_target=STIFFNESS_TARGET, min_nodes=120, ds_max=0.5, progress=None):
-    """Trace the equilibrium curve of a smooth LJ sphere at Tabor parameter mu (approach from
-    d = 12 z0 to a compressive load of about PRELOAD pi R dg) and read the regime-map numbers
-    off it. ``ds_max`` is the largest continuation step (units of z0).
-    """
-    t0 = time.perf_counter()
-    problem, lj, e_star, a, d_min = _lj_problem(mu, radius, hamaker, z0, stiffness_target,
-                                                   min_nodes)
-    dg = lj.work_of_adhesion
-    d0 = 12 * z0
-    curve = trace_curve(problem, d0, d_min, tol=tol, scale=z0, ds=0.2, ds_max=ds_max,
-                        progress=progress)
+def contact_edge(problem, w, d, gap):
+    """Radius (m) of the contact edge: the outermost r where h(r) <= gap (linear between
+    nodes); 0 when no node is that close."""
+    h = problem.contour(d) - w
+    close = np.flatnonzero(h <= gap)
+    if not close.size:
+        return 0.0
+    k, r = int(close[-1]), problem.grid.nodes
+    if k == r.size - 1:
+        return float(r[-1])
+    return float(r[k] + (gap - h[k]) / (h[k + 1] - h[k]) * (r[k + 1] - r[k]))
 
-    def force(d, w):
-        return lj_force(problem, lj, d, w)
 
-    scale = math.pi * radius * dg
-    paths = {k: curve.branch(k) for k in ("approach", "retract")}
-    F = {k: np.array([force(d, w) for _, d, w in v]) for k, v in paths.items()}
-    D = {k: np.array([d for _, d, _ in v]) for k, v in paths.items()}
+class _Setup:
+    """Physical problem of one map point and the grids of one resolution."""
 
+    def __init__(self, mu, radius, law, res):
+        self.mu, self.radius, self.law, self.res = mu, radius, law, res
+        dg, z0 = law.work_of_adhesion, law.z0
+        self.dg, self.z0 = dg, z0
+        self.e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
+        a_unit, d_unit = maugis_length_units(radius, self.e_star, dg)
+        self.a = max(res.analysis_radius * a_unit, math.sqrt(2 * radius * 20 * z0))
+        self.ell = lateral_length(law, radius, self.e_star)
+        # DMT side (the range, not an edge, sets ell): one grid, fine over the whole travel
+        # of the edge (up to the JKR radius at PRELOAD, which bounds Maugis-Dugdale's); a
+        # moving band would carry states across the narrow loops near the cusp
+        self.fixed_band = None
+        if self.ell < e_star_length(law, self.e_star):
+            a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, self.e_star, dg)
+            self.fixed_band = min(FINE_MARGIN * a_max, 0.5 * self.a)
+        self.spacing = res.spacing * self.ell
+        self.d_end = _deepest(mu, radius, self.e_star, law)
+        # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
+        # its landing on the approach branch is on the curve
+        fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
+        d_out = z0 - (fg[1] * d_unit if fg else 0.0)
+        self.d_start = max(12 * z0, 1.5 * d_out)
+        self.ds_max = res.ds_max if res.ds_max else max(0.5, 0.02 * self.d_start / z0)
+        self.sphere = Sphere(radius)
+        self.centers = {}
+
+    def problem(self, center=0.0):
+        """The problem on a grid fine around the contact edge at ``center`` (m)."""
+        if self.res.legacy:
+            if not isinstance(self.law, LennardJones):
+                raise ValueError("the legacy fixed grid is defined for LennardJones only")
+            return _lj_problem(self.mu, self.radius, self.law.hamaker, self.z0,
+                               self.res.stiffness_target or STIFFNESS_TARGET,
+                               self.res.min_nodes or 120)[0]
+        half = self.res.band * self.ell
+        band = ((0.0, self.fixed_band) if self.fixed_band else (center - half, center + half))
+        grid = RadialGrid.banded(self.a, self.spacing, band, self.res.grading * self.ell)
+        pb = ContactProblem(GreenOperator(grid, self.e_star), self.sphere, {"law": self.law},
+                            check_laws=not self.centers)
+        self.centers[id(pb)] = center
+        return pb
+
+    def stop(self, curve):
+        """End the trace once the stable branch after the folds has passed both the smallest
+        fold separation (so the jump-in's landing is on the curve) and its largest tension
+        (the tension falls again between the last two points: the load-controlled pull-off
+        is behind). Curves without folds run to d_end."""
+        pts = curve.points
+        if not curve.folds or curve.folds[-1].index >= len(pts) - 2:
+            return False
+        p, q = pts[-2], pts[-1]
+        if not (q.stable and p.stable and p.seg == q.seg and q.d < p.d):
+            return False
+        if q.d >= min(f.d for f in curve.folds):
+            return False
+        pb = curve.problem_of(q.seg)
+        return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
+
+    def regrid(self, problem, w, d):
+        """A grid whose band leads the edge, once the edge has left the band's middle half."""
+        if self.res.legacy or self.fixed_band:
+            return None
+        center = self.centers[id(problem)]
+        edge = contact_edge(problem, w, d, EDGE_GAP * self.z0)
+        half = self.res.band * self.ell
+        if abs(edge - center) <= 0.5 * half:
+            return None
+        # lead the moving edge: it crosses the whole band before the next exchange
+        return self.problem(edge + math.copysign(0.5 * half, edge - center))
+
+
+def _trace(setup, tol, progress):
+    z0 = setup.z0
+    return trace_curve(setup.problem(0.0), setup.d_start, setup.d_end, tol=tol, scale=z0,
+                       ds=0.2, ds_max=setup.ds_max, progress=progress,
+                       regrid=None if setup.res.legacy else setup.regrid,
+                       stop=setup.stop, max_points=20000)
+
+
+def _read(setup, curve):
+    """Headline quantities and diagnostics of a traced curve (dict)."""
+    law, z0, radius = setup.law, setup.z0, setup.radius
+    scale = math.pi * radius * setup.dg
+    pb = curve.problem_of
+
+    def force(seg):
+        return lambda d, w: lj_force(pb(seg), law, d, w)
+
+    paths = {k: curve.branch(k, segments=True) for k in ("approach", "retract")}
+    F = {k: np.array([force(g)(d, w) for _, d, w, g in v]) for k, v in paths.items()}
+    D = {k: np.array([d for _, d, _, _ in v]) for k, v in paths.items()}
     # hysteresis: the work of the closed cycle is the energy released at the jumps (the
     # interaction beyond a is continuous in d and drops out); the loop integral checks it
     released = 0.0
     for v in paths.values():
-        for (k1, d1, w1), (k2, _, w2) in zip(v, v[1:]):
+        for (k1, d1, w1, g1), (k2, _, w2, g2) in zip(v, v[1:]):
             if k1 == "fold" and k2 == "land":
-                released += problem.energy(w1, d1) - problem.energy(w2, d1)
+                released += pb(g1).energy(w1, d1) - pb(g2).energy(w2, d1)
     trap = getattr(np, "trapezoid", None) or np.trapz
     loop = trap(F["retract"], D["retract"]) + trap(F["approach"], D["approach"])
-
-    # pull-off under load control (as Maugis-Dugdale's): the largest tensile force anywhere on
-    # the equilibrium curve, refined between the neighbours of the best traced point; under
-    # displacement control the retract path may leave the curve (jump-out) before reaching it
-    cf = np.array([force(p.d, p.w) for p in curve.points])
+    # load control: the largest tension anywhere on the curve, refined between the
+    # neighbours of the best traced point
+    pts = curve.points
+    cf = np.array([force(p.seg)(p.d, p.w) for p in pts])
     i = int(np.argmax(cf))
     pull = cf[i]
-    if 0 < i < len(curve.points) - 1:
-        pull = max(pull, curve.maximize(i, force)[0])
-    # under displacement control the same maximum is reached if it lies on a stable state;
-    # otherwise the retract path jumps out before it, at its largest tension on the path
-    pull_disp = pull if curve.points[i].stable else float(np.max(F["retract"]))
+    if 0 < i < len(pts) - 1:
+        pull = max(pull, curve.maximize(i, force(pts[i].seg))[0])
+    # displacement control: the tension at the fold where the retract path leaves contact
+    r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
+    a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
+    pull_disp = force(r_folds[-1][2])(*r_folds[-1][:2]) / scale if r_folds else None
+    trapping = max(pb(p.seg).node_softening_ratio(pb(p.seg).contour(p.d) - p.w) for p in pts)
+    edge = max(contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts)
+    return {
+        "pull_off": float(pull / scale), "pull_off_displacement": pull_disp,
+        "jump_in": a_folds[0] / z0 if a_folds else None,
+        "jump_out": r_folds[-1][0] / z0 if r_folds else None,
+        "hysteresis": float(released / (scale * z0)),
+        "hysteresis_trapezoid": float(loop / (scale * z0)),
+        "trapping": float(trapping), "edge_ratio": edge / setup.a,
+        "nodes": max(t.problem.grid.n for t in curve.tracers),
+        "curves": {"curve_d": curve.d / z0, "curve_F": cf / scale,
+                   "curve_stable": np.array([p.stable for p in pts]),
+                   "approach_d": D["approach"] / z0, "approach_F": F["approach"] / scale,
+                   "retract_d": D["retract"] / z0, "retract_F": F["retract"] / scale,
+                   "n_factor": curve.n_factor, "n_krylov": curve.n_krylov},
+    }
 
-    folds_a = [d for kind, d, _ in paths["approach"] if kind == "fold"]
-    folds_r = [d for kind, d, _ in paths["retract"] if kind == "fold"]
-    trapping = max(problem.node_softening_ratio(problem.contour(p.d) - p.w)
-                   for p in curve.points)
-    if trapping > TRAPPING_LIMIT:
-        warnings.warn(f"mu = {mu:g}: a traced state reached -P'(h)/K_kk = {trapping:.2f} > "
-                      f"{TRAPPING_LIMIT} (nodes can snap alone); lower stiffness_target",
-                      MeshResolutionWarning, stacklevel=2)
-    cd = curve.d
+
+def _unresolved(setup, q):
+    """Why the traced states are not resolved (str naming quantity, value and the setting to
+    change), or None."""
+    if q["trapping"] > TRAPPING_LIMIT:
+        return (f"mu = {setup.mu:g}: a traced state reached the node softening ratio "
+                f"-P'(h)/K_kk = {q['trapping']:.2f} > {TRAPPING_LIMIT} (nodes can snap alone: "
+                f"lattice trapping); refine the grid (spacing = {setup.res.spacing:g} ell, "
+                f"stiffness_target = {setup.res.stiffness_target}) or give accuracy=")
+    if q["edge_ratio"] > EDGE_LIMIT:
+        return (f"mu = {setup.mu:g}: the contact edge reached {q['edge_ratio']:.2f} of the "
+                f"analysis radius (limit {EDGE_LIMIT}); raise analysis_radius "
+                f"(= {setup.res.analysis_radius:g} a_unit) or give accuracy=")
+    return None
+
+
+def _estimate(fine, coarse, ratio=2.0):
+    """Richardson estimates of the fine result's absolute errors from a coarser member whose
+    spacing is ``ratio`` times the fine one."""
+    out = {}
+    for k in QUANTITIES:
+        a, b = fine[k], coarse[k]
+        if a is None:
+            out[k] = None
+        elif b is None:   # the coarse grid missed the feature: its size is the estimate
+            out[k] = abs(a)
+        else:
+            out[k] = abs(a - b) / (ratio**ORDER - 1.0)
+    return out
+
+
+def _worst(q, errors):
+    """(name, relative error) of the quantity furthest from its accuracy."""
+    worst = (None, 0.0)
+    for k in QUANTITIES:
+        e, v = errors.get(k), q[k]
+        if e is None or v is None:
+            continue
+        rel = e / (max(abs(v), HYSTERESIS_FLOOR) if k == "hysteresis" else abs(v))
+        if rel > worst[1]:
+            worst = (k, rel)
+    return worst
+
+
+def _check_bounds(mu, q, errors):
+    """No pull-off outside what is proven for a paraboloid (ResolutionError otherwise).
+
+    Proven: the rigid paraboloid's pull-off is exactly 2 pi R dg (Derjaguin: F = -2 pi R U(d)
+    and U >= -dg). Elastic compliance lowers it towards JKR's 1.5 (every computation and
+    Maugis-Dugdale lie in [1.5, 2]: an empirical band for the elastic case, not a theorem).
+    The fixed-grip tension at the jump-out is a point of the curve: it cannot exceed the
+    largest tension on it (proven), and lies above the JKR fixed-grip 5/6 (empirical)."""
+    p, e = q["pull_off"], errors.get("pull_off") or 0.0
+    if not (JKR - e <= p <= DERJAGUIN + e):
+        raise ResolutionError(f"mu = {mu:g}: pull-off {p:.6f} pi R dg outside [{JKR}, "
+                              f"{DERJAGUIN}] (estimated error {e:.2g}): not a resolved result")
+    pd = q["pull_off_displacement"]
+    if pd is not None and pd > p * (1 + 1e-9) + e:
+        raise ResolutionError(f"mu = {mu:g}: fixed-grip pull-off {pd:.6f} exceeds the largest "
+                              f"tension on the curve {p:.6f}")
+
+
+def _solve(mu, radius, law, res, tol, progress):
+    setup = _Setup(mu, radius, law, res)
+    curve = _trace(setup, tol, progress)
+    q = _read(setup, curve)
+    q.update(setup=setup, n_points=len(curve.points), n_solves=curve.n_solves,
+             n_folds=len(curve.folds), n_grids=len(curve.tracers))
+    return q
+
+
+def _coarse_member(mu, radius, law, res, tol):
+    """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
+    traced). Returns (result, ratio)."""
+    for ratio in (COARSE_RATIO, 2.0):
+        try:
+            return _solve(mu, radius, law, res.coarser(ratio), tol, None), ratio
+        except (ConvergenceError, ValueError):
+            continue
+    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x 1.5, x 2 of "
+                          f"{res.spacing:g} ell) cannot be traced: no error estimate; lower "
+                          f"spacing")
+
+
+def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
+              accuracy=None, resolution=None, spacing=None, stiffness_target=None,
+              min_nodes=None, ds_max=None, progress=None):
+    """One regime-map point: trace the curve at Tabor parameter mu and read it.
+
+    Parameters
+    ----------
+    mu : float
+        Tabor parameter (-); sets E* at the given R and law.
+    radius, hamaker, z0 : float
+        Paraboloid radius R (m) and the LJ law's Hamaker constant (J) and z0 (m).
+    law : gap law, optional
+        Instead of LennardJones(hamaker, z0): any law with ``work_of_adhesion`` (J/m^2) and
+        ``z0`` (m), e.g. :class:`femadh.laws.Lj82`.
+    tol : float
+        Residual of eq (6) every traced state meets (m).
+    accuracy : float, optional
+        Requested relative accuracy of the headline quantities (pull-offs, jump separations,
+        hysteresis relative to max(value, HYSTERESIS_FLOOR)). The spacing starts from the
+        measured error model and is halved until the a-posteriori estimate meets it.
+    resolution : Resolution, optional
+        Explicit discretisation (default: :class:`Resolution` defaults); ``spacing`` (units of
+        ell), ``stiffness_target``/``min_nodes`` (legacy fixed grid) and ``ds_max`` (z0)
+        override its fields.
+
+    Returns
+    -------
+    RegimePoint
+        With the estimated errors (``pull_off_error``, ...), the chosen resolution and its
+        spacing (m), node count and grids.
+
+    Raises
+    ------
+    ResolutionError
+        A traced state is not resolved (lattice trapping, a contact at the analysis radius)
+        or the pull-off leaves its bounds, and no accuracy was requested (with one, the grid
+        is refined instead) or the refinement budget ran out.
+    """
+    t0 = time.perf_counter()
+    law = LennardJones(hamaker, z0) if law is None else law
+    res = resolution or Resolution()
+    over = {k: v for k, v in (("spacing", spacing), ("stiffness_target", stiffness_target),
+                              ("min_nodes", min_nodes), ("ds_max", ds_max)) if v is not None}
+    res = replace(res, **over)
+    if accuracy is not None:
+        if not accuracy > 0:
+            raise ValueError(f"accuracy must be > 0, got {accuracy}")
+        if "spacing" not in over and not res.legacy:
+            res = replace(res, spacing=initial_spacing(accuracy))
+    coarse, ratio = _coarse_member(mu, radius, law, res, tol)
+    for attempt in range(MAX_REFINEMENTS + 1):
+        fine = _solve(mu, radius, law, res, tol, progress)
+        why = _unresolved(fine["setup"], fine)
+        errors = _estimate(fine, coarse, ratio)
+        name, rel = _worst(fine, errors)
+        if accuracy is None or (why is None and rel <= accuracy):
+            break
+        if attempt == MAX_REFINEMENTS:
+            why = why or (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
+                          f"requested {accuracy:g} after {MAX_REFINEMENTS} refinements "
+                          f"(spacing {res.spacing:g} ell)")
+            raise ResolutionError(why, n_iter=attempt)
+        if fine["edge_ratio"] > EDGE_LIMIT:
+            res = replace(res, analysis_radius=1.5 * res.analysis_radius)
+        else:
+            coarse, ratio, res = fine, 2.0, res.finer()
+    if why is not None:
+        raise ResolutionError(why)
+    _check_bounds(mu, fine, errors)
+    if fine["trapping"] > 0.5 * TRAPPING_LIMIT:
+        warnings.warn(f"mu = {mu:g}: node softening ratio {fine['trapping']:.2f} is within 2x "
+                      f"of the lattice-trapping limit {TRAPPING_LIMIT}", MeshResolutionWarning,
+                      stacklevel=2)
+    setup = fine["setup"]
+    lam = lj_dugdale_lambda(mu)
+    fg = maugis_fixed_grip_pull_off(lam)
     return RegimePoint(
-        mu, e_star, float(pull / scale), pull_disp / scale, maugis_pull_off(lj_dugdale_lambda(mu)),
-        folds_a[0] / z0 if folds_a else None, folds_r[-1] / z0 if folds_r else None,
-        float(released / (scale * z0)), float(loop / (scale * z0)), len(curve.folds),
-        trapping, len(curve.points), curve.n_solves, problem.grid.n,
-        time.perf_counter() - t0,
-        {"curve_d": cd / z0, "curve_F": cf / scale,
-         "curve_stable": np.array([p.stable for p in curve.points]),
-         "approach_d": D["approach"] / z0, "approach_F": F["approach"] / scale,
-         "retract_d": D["retract"] / z0, "retract_F": F["retract"] / scale,
-         "n_factor": curve.n_factor, "n_krylov": curve.n_krylov})
+        mu, setup.e_star, fine["pull_off"], fine["pull_off_displacement"],
+        maugis_pull_off(lam), fg[0] if fg else None, fine["jump_in"], fine["jump_out"],
+        fine["hysteresis"], fine["hysteresis_trapezoid"], fine["n_folds"], fine["trapping"],
+        fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
+        fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
+        fine["n_grids"], accuracy)
+
+
+def initial_spacing(accuracy):
+    """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
+    model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
+    map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error."""
+    return min(MAX_SPACING, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+
+
+#: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
+#: (hysteresis, mu = 1) and 0.02 (fixed-grip pull-off, mu = 3) for spacing <= 0.1
+C_SPACING = 0.02
+#: largest spacing an accuracy request starts from: beyond ~0.1 ell the fixed-grip jump-out
+#: is not yet in the asymptotic range (mu = 3: 1.2 % off at 0.2, 1.3e-4 at 0.1)
+MAX_SPACING = 0.1
+#: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
+COARSE_RATIO = 1.5
 
 
 def regime_map(mus, progress=None, **kw):
-    """lj_sphere at each mu (keywords passed on); ``progress(i, point)`` after each."""
+    """lj_sphere at each mu (keywords passed on); ``progress(i, point)`` after each. A point
+    that cannot be resolved is kept with ``failed`` set (its message) and NaN values."""
     out = []
     for i, mu in enumerate(mus):
-        out.append(lj_sphere(float(mu), **kw))
+        try:
+            out.append(lj_sphere(float(mu), **kw))
+        except ConvergenceError as exc:
+            out.append(_failed_point(float(mu), str(exc)))
         if progress:
             progress(i, out[-1])
     return out
 
 
-REGIME_HEADER = ["mu", "lambda", "e_star_Pa", "nodes", "pull_off", "pull_off_displacement",
-                 "maugis_dugdale", "jump_in_d_over_z0", "jump_out_d_over_z0", "hysteresis",
+def _failed_point(mu, why):
+    nan = math.nan
+    lam = lj_dugdale_lambda(mu)
+    fg = maugis_fixed_grip_pull_off(lam)
+    return RegimePoint(mu, nan, nan, None, maugis_pull_off(lam), fg[0] if fg else None, None,
+                       None, nan, nan, 0, nan, 0, 0, 0, 0.0, {}, failed=why)
+
+
+REGIME_HEADER = ["mu", "lambda", "e_star_Pa", "nodes", "pull_off", "pull_off_error",
+                 "maugis_dugdale", "pull_off_displacement", "pull_off_displacement_error",
+                 "maugis_dugdale_fixed_grip", "jump_in_d_over_z0", "jump_in_error",
+                 "jump_out_d_over_z0", "jump_out_error", "hysteresis", "hysteresis_error",
                  "hysteresis_loop_integral", "n_folds", "trapping_ratio", "n_points",
-                 "wall_time_s"]
+                 "spacing_m", "wall_time_s", "failed"]
+
+
+def _fmt(x, spec):
+    return "" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+
+
+def regime_row(p):
+    """The csv row of a point (REGIME_HEADER order)."""
+    e = p.errors
+    return [f"{p.mu:.6g}", f"{lj_dugdale_lambda(p.mu):.6g}", _fmt(p.e_star, ".6g"), p.nodes,
+            _fmt(p.pull_off, ".6f"), _fmt(e.get("pull_off"), ".2e"), f"{p.maugis:.6f}",
+            _fmt(p.pull_off_displacement, ".6f"), _fmt(e.get("pull_off_displacement"), ".2e"),
+            _fmt(p.maugis_displacement, ".6f"), _fmt(p.jump_in, ".6f"),
+            _fmt(e.get("jump_in"), ".2e"), _fmt(p.jump_out, ".6f"),
+            _fmt(e.get("jump_out"), ".2e"), _fmt(p.hysteresis, ".6g"),
+            _fmt(e.get("hysteresis"), ".2e"), _fmt(p.hysteresis_trapezoid, ".6g"), p.n_folds,
+            _fmt(p.trapping_ratio, ".4f"), p.n_points, _fmt(p.spacing_m, ".4g"),
+            f"{p.wall_time:.3f}", p.failed or ""]
 
 
 def write_regime(pts, out_dir):
-    """regime.csv (forces / (pi R dg), separations / z0, work / (pi R dg z0)) and the figures.
-    Returns the csv path."""
+    """regime.csv (forces / (pi R dg), separations / z0, work / (pi R dg z0), estimated
+    errors) and the figures of the converged points. Returns the csv path."""
     import csv
     from pathlib import Path
 
@@ -213,11 +649,8 @@ def write_regime(pts, out_dir):
         w = csv.writer(f)
         w.writerow(REGIME_HEADER)
         for p in pts:
-            w.writerow([f"{p.mu:.6g}", f"{lj_dugdale_lambda(p.mu):.6g}", f"{p.e_star:.6g}",
-                        p.nodes, f"{p.pull_off:.6f}", f"{p.pull_off_displacement:.6f}",
-                        f"{p.maugis:.6f}", "" if p.jump_in is None else f"{p.jump_in:.6f}",
-                        "" if p.jump_out is None else f"{p.jump_out:.6f}",
-                        f"{p.hysteresis:.6g}", f"{p.hysteresis_trapezoid:.6g}", p.n_folds,
-                        f"{p.trapping_ratio:.4f}", p.n_points, f"{p.wall_time:.3f}"])
-    regime_figures(pts, out)
+            w.writerow(regime_row(p))
+    good = [p for p in pts if p.failed is None]
+    if good:
+        regime_figures(good, out)
     return out / "regime.csv"
