@@ -21,6 +21,11 @@ def _pyplot():
     return plt
 
 
+def _save(fig, path, dpi=100):
+    """PNG, atomically; fast zlib level (the files are small either way)."""
+    save_atomic(path, lambda p: fig.savefig(p, dpi=dpi, pil_kwargs={"compress_level": 1}))
+
+
 def force_unit(values):
     """(scale, label) so that values * scale are between 1 and 1000 in the returned unit."""
     m = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
@@ -61,7 +66,7 @@ def _effect_lines(res):
     out = [("F_ex_N", -1.0, "total (−F_ex)")]
     cols = next(iter(res.branches.values())).keys()
     for c in cols:
-        if c.startswith("F_") and c not in ("F_ex_N",):
+        if c.startswith("F_") and c not in ("F_ex_N", "F_tail_N"):
             if c == "F_el_N":
                 out.append((c, 1.0, "asperity contact (σ-gap)"))
             else:
@@ -78,7 +83,7 @@ def force_curve(res, path):
     alld = np.concatenate([c["d_m"] for c in res.branches.values()])
     fs, fl = force_unit(allF)
     ls, ll = length_unit(alld)
-    fig, ax = plt.subplots(figsize=(8.5, 5.2))
+    fig, ax = plt.subplots(figsize=(11, 5.2))
     styles = {"approach": "-", "retract": "--"}
     lines = _effect_lines(res)
     for i, (col, sign, label) in enumerate(lines):
@@ -111,31 +116,38 @@ def force_curve(res, path):
                  f"{length_unit([sc.sphere.radius])[1]}, E* = {sc.e_star / 1e9:.3g} GPa"
                  + (f", σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})"
                     if sc.gap else ", smooth sphere"))
-    _adhesion_zoom(ax, res, fs, ls)
-    ax.legend(fontsize=7, loc="upper right")
+    _adhesion_zoom(ax, res, fs, ls, fl)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    save_atomic(path, lambda p: fig.savefig(p, dpi=110))
+    # a fixed layout (tight_layout draws the figure twice): the legend right of the axes
+    fig.subplots_adjust(left=0.08, right=0.70, bottom=0.1, top=0.93)
+    _save(fig, path)
     plt.close(fig)
     return path
 
 
-def _adhesion_zoom(ax, res, fs, ls):
+def _adhesion_zoom(ax, res, fs, ls, fl):
     """An inset around the adhesion peak when the repulsive range dwarfs it."""
     tot = -np.concatenate([c["F_ex_N"] for c in res.branches.values()])
     d = np.concatenate([c["d_m"] for c in res.branches.values()])
     peak = float(np.min(tot))
     if peak >= 0 or np.max(tot) < 5 * abs(peak):
         return
-    k = int(np.argmin(tot))
     near = np.abs(tot) <= 3 * abs(peak)
-    ins = ax.inset_axes([0.08, 0.45, 0.38, 0.4])
+    ins = ax.inset_axes([0.38, 0.52, 0.36, 0.38])
     for b, c in res.branches.items():
         sel = np.abs(c["F_ex_N"]) <= 3 * abs(peak)
         ins.plot(c["d_m"][sel] * ls, -c["F_ex_N"][sel] * fs, "-" if b == "approach" else "--",
                  color="k", lw=1.2)
     ins.axhline(0, color="k", lw=0.5)
-    ins.set_title(f"adhesion peak {peak * fs:.4g} at d = {d[k] * ls:.3g}", fontsize=7)
+    hl = res.headline
+    if "max_adhesion_N" in hl:
+        F, dm = hl["max_adhesion_N"], hl["d_at_max_adhesion_m"]
+        err = hl.get("max_adhesion_N_error")
+        ins.plot([dm * ls], [-F * fs], "v", color="C3")
+        pm = f" ± {err * fs:.2g}" if err is not None else ""
+        ins.set_title(f"largest adhesion {F * fs:.4g}{pm} {fl} at d = {dm * ls:.4g}",
+                      fontsize=7)
     ins.tick_params(labelsize=6)
     ins.set_xlim(np.min(d[near]) * ls, np.max(d[near]) * ls)
     ins.grid(alpha=0.3)
@@ -200,8 +212,8 @@ def paper1_panels(res, path):
     Rs, Rl = length_unit([sc.sphere.radius])
     fig.suptitle(f"{sc.name}: R = {sc.sphere.radius * Rs:g} {Rl}, E* = {sc.e_star / 1e9:.1f} GPa, "
                  f"σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})")
-    fig.tight_layout()
-    save_atomic(path, lambda p: fig.savefig(p, dpi=110))
+    fig.subplots_adjust(left=0.05, right=0.98, bottom=0.07, top=0.92, wspace=0.25, hspace=0.3)
+    _save(fig, path)
     plt.close(fig)
     return path
 

@@ -15,7 +15,7 @@ from .kelvin import kelvin_radius
 from .profile_fe import MeridianFE
 from .shooting import solve_shooting
 
-METHODS = ("fe", "shooting", "circular", "no-film")
+from .methods import METHODS  # noqa: E402  (re-exported)
 
 
 @dataclass

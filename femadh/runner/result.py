@@ -110,9 +110,9 @@ def _cell(x):
 @dataclass
 class MeniscusRunResult:
     """A meniscus run: ``curves[(liquid, tip_radius_m, method)]`` is a dict of arrays
-    (p_ratio, film_m, kelvin_radius_m, force_N, force_over_4piRgamma, neck_radius_m; nan where
-    no meniscus exists), ``errors`` the points without one (dicts naming liquid, radius, method,
-    p/psat and why)."""
+    (p_ratio, film_m, kelvin_radius_m, force_N, force_over_4piRgamma, neck_radius_m and the
+    estimated error force_error_N; nan where no meniscus exists), ``errors`` the points without
+    one (dicts naming liquid, radius, method, p/psat and why)."""
 
     name: str
     scene: object
@@ -131,7 +131,7 @@ class MeniscusRunResult:
 
     def to_csv(self, path):
         cols = ["liquid", "tip_radius_m", "method", "p_ratio", "film_m", "kelvin_radius_m",
-                "force_N", "force_over_4piRgamma", "neck_radius_m"]
+                "force_N", "force_over_4piRgamma", "neck_radius_m", "force_error_N"]
         with open(path, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(cols)

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..meniscus.isotherms import default_isotherm
 from ..meniscus.liquids import LIQUIDS
-from ..meniscus.solve import METHODS
+from ..meniscus.methods import METHODS
 from ..schema import Key, Table
 from .liquids import read_liquid
 from .reader import BAD, any_bad, quantity
