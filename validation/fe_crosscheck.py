@@ -8,7 +8,6 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import time  # noqa: E402
-from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -17,7 +16,8 @@ from femadh.contact import trace  # noqa: E402
 from femadh.elastic import RadialGrid, disk_displacement  # noqa: E402
 from femadh.elastic.fe import FEOperator, FESettings  # noqa: E402
 from femadh.contact.forces import state_forces  # noqa: E402
-from femadh.runner.contact import run  # noqa: E402
+import femadh  # noqa: E402
+from femadh.io.render import render_run  # noqa: E402
 from femadh.scene import build_problem  # noqa: E402
 from femadh.studies.convergence import convergence, write_convergence  # noqa: E402
 from validation.paper1 import scene  # noqa: E402
@@ -55,7 +55,7 @@ def crosscheck_table():
         pg = build_problem(sc)
         fg = curves(pg, sc)
         tg = time.perf_counter() - t0
-        sc_fe = replace(sc, method="fe", fe_settings=FESettings())
+        sc_fe = sc.replace({"solver.method": "fe", "output.vtk": False})
         t0 = time.perf_counter()
         pf = build_problem(sc_fe)
         tb = time.perf_counter() - t0
@@ -75,29 +75,17 @@ def crosscheck_table():
 
 
 def render(out_png):
-    """Off-screen PyVista render of the deformed contact zone (von Mises) at d = -5 nm."""
-    import pyvista as pv
+    """Off-screen PyVista render of the deformed contact zone (von Mises) at d = -5 nm, as
+    ``femadh render`` draws it from the run's VTK files."""
+    import shutil
 
-    pv.OFF_SCREEN = True
-    sc = replace(scene("paper1_fig3", 200), method="fe", fe_settings=FESettings(), vtk=True,
-                 d_values=[2e-9, 0.0, -5e-9], directions=("approach",))
-    res = run(sc, "out/fe-render", figures=False, progress=False)
-    m = pv.read("out/fe-render/vtk/approach_0002.vtu")
-    a = sc.analysis_radius
-    clip = m.clip_box([0, 1.5 * a, -1.5 * a, 0, -1, 1], invert=False)
-    scale = 0.08 * a / max(abs(res.sweeps["approach"].states[-1].w).max(), 1e-30)
-    warped = clip.warp_by_vector("displacement", factor=scale)
-    warped.points[:] /= 1e-6  # micrometres on the axes
-    pl = pv.Plotter(off_screen=True, window_size=(1100, 700))
-    pl.add_mesh(warped, scalars="von_mises", cmap="viridis", show_edges=True,
-                edge_color="grey", line_width=0.3,
-                scalar_bar_args={"title": "von Mises (Pa)", "vertical": True})
-    pl.add_text(f"paper 1 Fig 3 scene, FE, d = -5 nm; displacement x {scale:.2g}; axes in um",
-                font_size=10)
-    pl.show_bounds(xtitle="r (um)", ytitle="z (um)", font_size=9)
-    pl.view_xy()
-    pl.screenshot(str(out_png))
-    pl.close()
+    sc = scene("paper1_fig3", 200).replace({
+        "solver.method": "fe", "output.vtk": True, "sweep.start": "2 nm",
+        "sweep.stop": "-5 nm", "sweep.step": "3.5 nm", "sweep.directions": ["approach"]})
+    out = Path("out/fe-render")
+    shutil.rmtree(out, ignore_errors=True)
+    femadh.run(sc, out_dir=out, progress=False)
+    render_run(out, png=out_png)
 
 
 def main():

@@ -81,11 +81,21 @@ def apply_overrides(raw, changes):
     for dotted, value in changes.items():
         parts = dotted.split(".")
         node = data
-        for p in parts[:-1]:
-            if not isinstance(node.get(p), dict):
+        for i, p in enumerate(parts):
+            last = i == len(parts) - 1
+            if isinstance(node, list):
+                # a list element by its index: "substrate.layers.0.thickness"
+                if not (p.isdigit() and int(p) < len(node)):
+                    raise SceneError(None, ".".join(parts[:i + 1]), value,
+                                     f"an index 0..{len(node) - 1} into "
+                                     f"[{'.'.join(parts[:i])}]")
+                p = int(p)
+            elif not last and not isinstance(node.get(p), (dict, list)):
                 node[p] = {}
-            node = node[p]
-        node[parts[-1]] = value
+            if last:
+                node[p] = value
+            else:
+                node = node[p]
     return data
 
 

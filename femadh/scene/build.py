@@ -3,15 +3,24 @@ function or condensed FE) on the scene's grid, and the contact problem with only
 scene names."""
 
 
-def build_operator(scene, progress=None):
-    """The scene's SurfaceOperator: Green function or condensed FE, on the scene's grid."""
+def build_operator(scene, progress=None, *, grid=None, settings=None):
+    """The scene's SurfaceOperator: Green function or condensed FE, on the scene's grid.
+
+    A layered scene gets the FE body of its layer stack on the disk material, with the
+    sphere's own compliance added (rigid without a slider material). ``grid`` and
+    ``settings`` (FESettings) replace the scene's (convergence studies).
+    """
     from ..elastic import GreenOperator, RadialGrid
 
-    grid = RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+    grid = grid or RadialGrid.uniform(scene.analysis_radius, scene.nodes)
     if scene.method == "fe":
         from ..elastic.fe import FEOperator
 
-        return FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, scene.fe_settings,
+        settings = settings or scene.fe_settings
+        if scene.layers:
+            return FEOperator(grid, settings=settings, progress=progress, substrate=scene.disk,
+                              layers=scene.layers, sphere=scene.slider)
+        return FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, settings,
                           progress=progress)
     return GreenOperator(grid, scene.e_star)
 

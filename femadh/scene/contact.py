@@ -130,6 +130,46 @@ OUTPUT = Table("output", "Outputs.", (
         "FE).", default=None),
 ))
 
+#: the largest Poisson ratio the FE body takes (its mixed formulation eliminates the pressure
+#: with a finite lambda; equal to femadh.elastic.fe.operator.NU_LIMIT, tested)
+LAYER_NU_LIMIT = 0.49999
+
+LAYER = Table("substrate.layers", "One bonded elastic layer (an element of the layers list, "
+              "top first).", (
+    Key("thickness", "length", "Layer thickness t.", lo=0.0),
+    Key("youngs_modulus", "pressure", "Young's modulus E of the layer.", lo=0.0),
+    Key("poisson_ratio", "number", "Poisson ratio nu of the layer (nearly incompressible "
+        f"layers up to {LAYER_NU_LIMIT}: the FE body switches to a mixed formulation above "
+        "0.45).", lo=-1.0, hi=LAYER_NU_LIMIT, hi_closed=True),
+))
+
+
+def _layers(reader, raw, path):
+    """The layer stack: a non-empty list of LAYER tables, top first, as (t, E, nu) tuples."""
+    if not isinstance(raw, list) or not raw:
+        return reader.fail(path, raw, "a non-empty list of tables { thickness, youngs_modulus, "
+                           "poisson_ratio }, top layer first")
+    out = []
+    for i, item in enumerate(raw):
+        v = reader.read(LAYER, item, f"{path}.{i}")
+        out.append(BAD if any_bad(v) else
+                   (v["thickness"], v["youngs_modulus"], v["poisson_ratio"]))
+    return BAD if any_bad(*out) else tuple(out)
+
+
+SUBSTRATE = Table("substrate", "Coatings: bonded elastic layers on the disk material "
+                  "([materials] disk is the substrate half-space below them). Needs "
+                  "[solver] method = 'fe': the Green function is the homogeneous half-space's. "
+                  "The sphere's own compliance ([materials] slider; omitted: rigid) is added "
+                  "as its half-space Green function on the same nodes. E* (eq 2) stays the bare "
+                  "disk/slider pair's: the JKR/DMT reference curves show the uncoated contact "
+                  "and the asperity laws use it.", (
+    Key("layers", "custom", "The layers, top first: [{ thickness = \"5 nm\", youngs_modulus "
+        "= \"200 GPa\", poisson_ratio = 0.25 }, ...].", default=(), parse=_layers,
+        expect="a list of tables { thickness, youngs_modulus, poisson_ratio }, top first"),
+))
+
+
 def _vary(reader, raw, path):
     if not isinstance(raw, dict) or not raw or not all(
             isinstance(v, (str, list)) for v in raw.values()):
@@ -145,10 +185,11 @@ STUDY = Table("study", "A parameter study over this scene (femadh study sweep SC
 ))
 
 #: the tables of a contact scene file
-TOP = ("scene", "sphere", "materials", "effects", "solver", "sweep", "output", "study")
+TOP = ("scene", "sphere", "materials", "substrate", "effects", "solver", "sweep", "output",
+       "study")
 #: every table description, for the reference page (femadh keys)
-TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, GAP, SOLVER, DELTA, MESH, SWEEP, OUTPUT,
-          STUDY)
+TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, SUBSTRATE, LAYER, GAP, SOLVER, DELTA, MESH,
+          SWEEP, OUTPUT, STUDY)
 
 
 def _material(reader, raw, path):
@@ -190,6 +231,7 @@ class Scene:
     continuation: str = "steps"
     disk: IsotropicMaterial | None = None
     slider: IsotropicMaterial | None = None
+    layers: tuple = ()
     study: dict | None = None
     accuracy: float | None = None
     raw: dict = field(repr=False, default_factory=dict)
@@ -224,6 +266,8 @@ class Scene:
             "name": self.name,
             "sphere": {"radius_m": self.sphere.radius, "profile": self.sphere.profile},
             "composite_modulus_Pa": self.e_star,
+            "layers": [{"thickness_m": t, "youngs_modulus_Pa": e, "poisson_ratio": nu}
+                       for t, e, nu in self.layers],
             "effects": {name: _law_dict(e) for name, e in self.effects.items()},
             "asperity_gap": None if self.gap is None else
             {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model,
@@ -259,6 +303,7 @@ def parse_contact(reader, data, file):
     sphere = None if any_bad(sp) else Sphere(sp["radius"], sp["profile"])
 
     e_star, disk, slider = _read_materials(reader, data)
+    layers = _read_layers(reader, data, disk)
     gap, effects = _read_effects(reader, data.get("effects"), e_star)
 
     so = reader.read(SOLVER, data.get("solver"), "solver")
@@ -279,8 +324,19 @@ def parse_contact(reader, data, file):
                         "method = \"fe\"")
         elif not any_bad(so["mesh"]):
             fe_settings, fe_nu = _fe_settings(so["mesh"], fe_nu)
+            if layers and so["mesh"]["poisson_ratio"] is not None:
+                reader.fail("solver.mesh.poisson_ratio", data["solver"]["mesh"]["poisson_ratio"],
+                            "no FE body Poisson ratio in a layered scene: each layer and the "
+                            "disk (substrate) carry their own")
     elif method == "fe":
         fe_settings, fe_nu = _fe_settings(reader.read(MESH, None, "solver.mesh"), fe_nu)
+    if layers and gap is not None and gap.contact_model == "hertz-closure":
+        reader.fail("effects.asperity_gap.contact_model", "hertz-closure", "'complementarity' "
+                    "for a layered substrate: the paper's closure (eq 9) is a Hertz pressure "
+                    "of one composite modulus E*")
+    if layers and method != "fe":
+        reader.fail("solver.method", method, "\"fe\" for a layered substrate ([substrate] "
+                    "layers): the Green function is the homogeneous half-space's")
     vtk = ou["vtk"] if ou["vtk"] is not None else method == "fe"
     if vtk is True and method != "fe":
         reader.fail("output.vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
@@ -294,7 +350,8 @@ def parse_contact(reader, data, file):
                  tolerance=so["tolerance"], max_iter=so["max_iter"], fe_settings=fe_settings,
                  d_values=d_values, directions=sw["directions"],
                  output_dir=ou["dir"] or f"out/{name}", fe_poisson_ratio=fe_nu, vtk=vtk,
-                 continuation=so["continuation"], disk=disk, slider=slider, study=study,
+                 continuation=so["continuation"], disk=disk, slider=slider,
+                 layers=layers if layers is not BAD else (), study=study,
                  accuracy=so["accuracy"], raw=copy.deepcopy(data))
 
 
@@ -316,6 +373,26 @@ def _read_materials(reader, data):
                     "materials.composite_modulus)")
         return BAD, None, None
     return composite_modulus(mt["disk"], mt["slider"]), mt["disk"], mt["slider"]
+
+
+def _read_layers(reader, data, disk):
+    """The [substrate] layers (top first) as (t, E, nu) tuples; () without the table."""
+    if "substrate" not in data:
+        return ()
+    v = reader.read(SUBSTRATE, data["substrate"], "substrate")
+    layers = v["layers"]
+    if layers is BAD:
+        return BAD
+    if not layers:
+        reader.fail("substrate.layers", None, "a non-empty list of layers (or no [substrate] "
+                    "table)")
+        return BAD
+    if disk is None and "materials" in data and isinstance(data["materials"], dict) \
+            and "composite_modulus" in data["materials"]:
+        reader.fail("materials.composite_modulus", data["materials"]["composite_modulus"],
+                    "disk (and slider) materials in a layered scene: the layers lie on the "
+                    "disk, and the sphere's compliance is added separately")
+    return layers
 
 
 def _read_effects(reader, table, e_star):

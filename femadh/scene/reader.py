@@ -127,7 +127,8 @@ class Reader:
 def _words(key):
     """'a length', 'a pressure', ... for a dimensional key (from units.DIMENSIONS)."""
     if key.kind in DIMENSIONS:
-        return "a " + key.kind.replace("_", " ")
+        word = key.kind.replace("_", " ")
+        return ("an " if word[0] in "aeiou" else "a ") + word
     return None
 
 

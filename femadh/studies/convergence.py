@@ -39,8 +39,8 @@ def convergence(scene, *, levels=3, green_factors=(0.25, 0.5, 1, 2), reference_f
     mesh / assembly / factorisation / condensation / sweep (s).
     """
     from ..elastic import GreenOperator, RadialGrid
-    from ..elastic.fe import FEOperator, FESettings
-    from ..scene import build_problem
+    from ..elastic.fe import FESettings
+    from ..scene import build_operator, build_problem
 
     say = progress or (lambda msg: None)
     base = FESettings() if scene.fe_settings is None else scene.fe_settings
@@ -55,7 +55,7 @@ def convergence(scene, *, levels=3, green_factors=(0.25, 0.5, 1, 2), reference_f
     for k, (growth, frac) in enumerate(FE_LEVELS[:levels]):
         settings = replace(base, growth=growth, surface_fraction=frac)
         say(f"FE level {k}: growth {growth}, surface fraction {frac}")
-        op = FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, settings)
+        op = build_operator(scene, grid=grid, settings=settings)
         f, wall = _sweep(build_problem(scene, op), scene)
         rows.append({"method": "fe", "level": k, "N": scene.nodes, "dofs": op.n_dofs,
                      "error_F_ex": float(np.abs(f[:, 2] - f_ref[:, 2]).max() / peak),

@@ -1,0 +1,149 @@
+"""A stiction map as a parameter study, and what parallel studies cost.
+
+``python -m validation.stiction_map`` runs the 2-mm slider of paper 1 with LJ forces, the
+sigma-gap and a condensed ethanol meniscus (validation/scenes/paper1_slider_meniscus.toml) over
+sigma = 0.3-2 nm x p/psat = 0.05-0.95 (10 x 10 points, each with its error estimate), exactly
+as
+
+    femadh study sweep validation/scenes/paper1_slider_meniscus.toml \\
+        --vary effects.asperity_gap.sigma="0.3 nm..2 nm:10" \\
+        --vary effects.capillary.relative_pressure="0.05..0.95:10" --out out/stiction-map
+
+does, and then times a 24-point sub-study on one local process, two local processes, and a
+two-worker Dask LocalCluster. Writes validation/results/stiction_map.md, stiction_map.png and
+study_scaling.md. A few minutes on two cores; run it on a quiet machine: the times are the
+numbers.
+"""
+import math
+from pathlib import Path
+import shutil
+import tempfile
+import time
+
+import numpy as np
+
+import femadh
+from femadh.studies.sweep import run_study
+
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results"
+SCENE = HERE / "scenes" / "paper1_slider_meniscus.toml"
+MAP = {"effects.asperity_gap.sigma": "0.3 nm..2 nm:10",
+       "effects.capillary.relative_pressure": "0.05..0.95:10"}
+SCALING = {"effects.asperity_gap.sigma": "0.3 nm..2 nm:6",
+           "effects.capillary.relative_pressure": "0.2..0.8:4"}
+
+
+def stiction_map(out):
+    scene = femadh.load_scene(SCENE)
+    t0 = time.perf_counter()
+    points, records = run_study(scene, MAP, out, workers=2, progress=True)
+    wall = time.perf_counter() - t0
+    sig = sorted({p.scene.gap.sigma for p in points})
+    def rel_of(p):
+        return float(p.scene.raw["effects"]["capillary"]["relative_pressure"])
+
+    rel = sorted({rel_of(p) for p in points})
+    F = np.full((len(rel), len(sig)), math.nan)
+    E = np.full_like(F, math.nan)
+    fails = []
+    gamma = points[0].scene.effects["capillary"].surface_tension
+    R = scene.sphere.radius
+    for p in points:
+        i = rel.index(rel_of(p))
+        j = sig.index(p.scene.gap.sigma)
+        rec = records[p.id]
+        if rec.get("status") == "converged":
+            F[i, j] = rec["max_adhesion_N"]
+            E[i, j] = rec.get("max_adhesion_N_error", math.nan)
+        else:
+            fails.append((p.changes, rec.get("error")))
+    norm = 4 * math.pi * R * gamma
+    return sig, rel, F, E, norm, wall, fails, len(points)
+
+
+def figure(sig, rel, F, norm, png):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
+    s_nm = np.asarray(sig) * 1e9
+    m = a1.pcolormesh(s_nm, rel, F / norm, shading="nearest", cmap="magma")
+    fig.colorbar(m, ax=a1, label=r"max adhesion / $4\pi R\gamma$")
+    a1.set_xlabel(r"asperity gap $\sigma$ (nm)")
+    a1.set_ylabel(r"$p/p_\mathrm{sat}$")
+    a1.set_title("2-mm slider, LJ + sigma-gap + ethanol meniscus")
+    for j in range(0, len(sig), 3):
+        a2.plot(rel, F[:, j] / norm, "o-", ms=3, label=rf"$\sigma$ = {s_nm[j]:.2f} nm")
+    a2.axhline(1.0, color="k", lw=0.8, ls="--", label=r"$4\pi R\gamma$")
+    a2.set_xlabel(r"$p/p_\mathrm{sat}$")
+    a2.set_ylabel(r"max adhesion / $4\pi R\gamma$")
+    a2.legend(fontsize=8)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
+def scaling():
+    scene = femadh.load_scene(SCENE)
+    rows = []
+    for label, kw in (("1 local process", {"workers": 1}),
+                      ("2 local processes", {"workers": 2}),
+                      ("Dask LocalCluster, 2 workers", {"scheduler": "local:2"})):
+        tmp = Path(tempfile.mkdtemp(prefix="femadh-scaling-"))
+        try:
+            t0 = time.perf_counter()
+            points, records = run_study(scene, SCALING, tmp / "study", **kw)
+            wall = time.perf_counter() - t0
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        ok = sum(r.get("status") == "converged" for r in records.values())
+        rows.append((label, len(points), ok, wall))
+    return rows
+
+
+def main():
+    RESULTS.mkdir(exist_ok=True)
+    out = Path("out/stiction-map")
+    shutil.rmtree(out, ignore_errors=True)
+    sig, rel, F, E, norm, wall, fails, n = stiction_map(out)
+    figure(sig, rel, F, norm, RESULTS / "stiction_map.png")
+    rel_err = np.nanmax(E / F)
+    lines = ["# Stiction map: the 2-mm slider with LJ, the sigma-gap and an ethanol meniscus",
+             "", "(`python -m validation.stiction_map`; scene "
+             "`validation/scenes/paper1_slider_meniscus.toml`, bare meniscus, "
+             "N = 400, analysis radius delta = 50 nm.)", "",
+             f"{n} points on 2 local processes in {wall:.1f} s "
+             f"({wall / n:.2f} s per point, each with its error estimate); "
+             f"{len(fails)} failed; largest estimated relative error of the max adhesion "
+             f"{rel_err:.1e}.", "",
+             f"Max adhesion / 4 pi R gamma (4 pi R gamma = {norm * 1e3:.4g} mN):", "",
+             "| p/psat \\ sigma (nm) | " + " | ".join(f"{s * 1e9:.2f}" for s in sig) + " |",
+             "|---|" + "---|" * len(sig)]
+    for i, r in enumerate(rel):
+        lines.append(f"| {r:.2f} | " + " | ".join(f"{x:.3f}" for x in F[i] / norm) + " |")
+    for ch, err in fails:
+        lines.append(f"\nfailed: {ch}: {err}")
+    lines += ["", "![](stiction_map.png)", ""]
+    (RESULTS / "stiction_map.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    rows = scaling()
+    base = rows[0][3]
+    sl = ["# What a parallel study costs (validation/stiction_map.py)", "",
+          f"24 points of the stiction map ({SCALING}), each a full sweep with its error "
+          "estimate; wall time from the study's start to its table and figure, this machine "
+          "(2 cores).", "", "| executor | points | converged | wall (s) | speed-up | "
+          "s per point |", "|---|---|---|---|---|---|"]
+    for label, npts, ok, wall in rows:
+        sl.append(f"| {label} | {npts} | {ok} | {wall:.1f} | {base / wall:.2f} | "
+                  f"{wall / npts:.3f} |")
+    over = (rows[2][3] - rows[1][3]) / rows[2][1]
+    sl += ["", f"Dask over the local pool: {over * 1e3:+.0f} ms per point (cluster start-up "
+           "included)."]
+    (RESULTS / "study_scaling.md").write_text("\n".join(sl) + "\n")
+    print("\n".join(sl))
+
+
+if __name__ == "__main__":
+    main()
