@@ -38,7 +38,7 @@ from .weakform import axisymmetric_elasticity, lame, projected_volumetric
 NU_DISPLACEMENT_MAX = 0.45
 #: largest Poisson ratio the FE body accepts (mixed formulation; its pressure is eliminated
 #: element by element with a finite lambda, so nu = 0.5 itself is excluded)
-NU_LIMIT = 0.4999
+NU_LIMIT = 0.49999
 
 
 @dataclass
