@@ -16,10 +16,12 @@ the load it grows like h_s + growth z), neighbouring columns are merged two into
 transition row, so thick layers do not carry the surface's fine columns down. Every interface
 is a row boundary, i.e. a mesh line, and every triangle knows its region.
 
-Below the stack a few more structured rows coarsen the columns to the size law (the substrate
-sees the same mesh law as under a homogeneous surface, and gmsh receives a boundary no finer
-than that), then gmsh meshes the rest with the distance-graded size field of the homogeneous
-mesh (distance from the loaded surface segment).
+The radial refinement for thin layers (see :func:`~femadh.elastic.fe.operator.layered_surface_size`)
+serves the layers only. Below the stack a few more structured rows, doubling in height, merge
+the columns two into one per row back to the grid's own surface size, then follow the size law
+until it is twice that (the substrate sees the same law as under a homogeneous surface, and
+gmsh receives a boundary no finer than that); gmsh meshes the rest with the distance-graded
+size field of the homogeneous mesh (distance from the loaded surface segment).
 """
 import math
 
@@ -100,7 +102,7 @@ def _row_triangles(top_ids, top_r, bottom_ids, kept):
     return tris
 
 
-def structured_bands(columns, row_depths, row_regions, size, growth):
+def structured_bands(columns, row_depths, row_regions, row_sizes, growth):
     """Vertices and triangles of the structured bands.
 
     Parameters
@@ -111,8 +113,10 @@ def structured_bands(columns, row_depths, row_regions, size, growth):
         Depths (> 0, increasing) of the row boundaries below the surface.
     row_regions : ndarray of int
         Region id of each row.
-    size, growth : float
-        The size law (units of a): size + growth * distance from the loaded segment.
+    row_sizes : ndarray
+        Base size of the size law (units of a) that decides merges at each row's bottom:
+        columns may coarsen to row_size + growth * distance from the loaded segment.
+    growth : float
 
     Returns
     -------
@@ -127,7 +131,7 @@ def structured_bands(columns, row_depths, row_regions, size, growth):
     n_pts = columns.size
     tris, regs = [], []
     prev = 0.0
-    for depth, region in zip(row_depths, row_regions):
+    for depth, region, size in zip(row_depths, row_regions, row_sizes):
         kept = _merge(top_r, depth, depth - prev, size, growth)
         r_bot = top_r[kept]
         bot_ids = n_pts + np.arange(r_bot.size)
@@ -140,14 +144,22 @@ def structured_bands(columns, row_depths, row_regions, size, growth):
     return (np.vstack(points), np.asarray(tris, int), np.asarray(regs, int), (top_ids, top_r))
 
 
-def transition_depths(start, size, growth, columns_size):
-    """Row boundaries (depths) below ``start`` that follow the size law under the load until
-    it reaches twice ``columns_size`` (then the columns have coarsened to the law and gmsh can
-    take over)."""
+def transition_depths(start, first, node_size, growth):
+    """Row boundaries (depths) of the substrate's structured zone below a stack at ``start``.
+
+    The rows double in height from ``first`` (the finest column width, so columns refined for a
+    thin layer merge two into one per row) until they reach ``node_size`` (the grid's own
+    surface size), then follow node_size + growth z until that reaches twice ``node_size``:
+    from there the columns match the substrate's size law and gmsh takes over.
+    """
     out = []
-    z = start
-    while size + growth * z < 2.0 * columns_size or not out:
-        z = z + size + growth * z
+    z, height = start, first
+    while height < node_size:
+        height *= 2.0
+        z += height
+        out.append(z)
+    while node_size + growth * z < 2.0 * node_size or not out:
+        z += node_size + growth * z
         out.append(z)
     return np.asarray(out)
 
@@ -212,32 +224,54 @@ def gmsh_substrate(bottom_r, depth, outer, size, growth):
     return xyz[pos], new[tri_tags.astype(int)]
 
 
-def layered_mesh(surface_points, outer, size, growth, thicknesses, min_elements):
+def layered_mesh(surface_points, outer, size, layer_size, growth, thicknesses, min_elements):
     """The whole layered mesh in units of a.
 
-    Returns points (n, 2), triangles (m, 3) and region ids (m,) (layer index from the top,
-    len(thicknesses) for the substrate), plus a dict of boundary edges (pairs of vertex
+    Parameters
+    ----------
+    surface_points : ndarray
+        Fixed surface vertices on [0, 1] (grid nodes and annulus edges).
+    outer : float
+        L / a.
+    size : float
+        The grid's surface element size h_s: the substrate's size law is h_s + growth * d.
+    layer_size : float
+        Radial element size on the loaded surface for the layers (<= size: the radial grading
+        rule for thin layers); the layers' own law is layer_size + growth * d.
+    growth : float
+    thicknesses : sequence of float
+        Layer thicknesses (units of a), top first.
+    min_elements : int
+        Least number of rows through a layer.
+
+    Returns
+    -------
+    points (n, 2), triangles (m, 3), region ids (m,) (layer index from the top,
+    len(thicknesses) for the substrate), and a dict of boundary edges (pairs of vertex
     indices): "surface", "axis", "far" and "interface_<i>".
     """
     pts = np.asarray(surface_points, float)
-    h_top = min(size, float(np.min(np.diff(pts))))
-    columns = surface_columns(pts, size, growth, outer)
-    depths, regions = [], []
+    node_size = min(size, float(np.min(np.diff(pts))))
+    h_top = min(layer_size, node_size)
+    columns = surface_columns(pts, h_top, growth, outer)
+    depths, regions, sizes = [], [], []
     top = 0.0
     for i, (t, frac) in enumerate(zip(thicknesses, layer_depths(thicknesses, h_top, growth,
                                                                   min_elements))):
         depths += list(top + t * frac)
         regions += [i] * frac.size
+        sizes += [h_top] * frac.size
         top += t
     n_layers = len(thicknesses)
-    node_size = float(np.max(np.diff(pts)))
-    zone = transition_depths(top, h_top, growth, node_size)
+    zone = transition_depths(top, h_top, node_size, growth)
     depths += list(zone)
     regions += [n_layers] * zone.size
+    sizes += [node_size] * zone.size
     p_s, t_s, r_s, (bot_ids, bot_r) = structured_bands(columns, np.asarray(depths),
-                                                       np.asarray(regions), h_top, growth)
+                                                       np.asarray(regions), np.asarray(sizes),
+                                                       growth)
     z_bottom = depths[-1]
-    p_g, t_g = gmsh_substrate(bot_r, z_bottom, outer, h_top, growth)
+    p_g, t_g = gmsh_substrate(bot_r, z_bottom, outer, node_size, growth)
     # glue: gmsh's first len(bot_r) vertices are the structured bottom row
     n_top = bot_r.size
     if np.max(np.abs(p_g[:n_top, 0] - bot_r)) > 1e-12 * outer:

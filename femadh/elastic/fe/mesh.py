@@ -39,6 +39,9 @@ class MeshSpec:
         h_s, element size at the loaded segment (m).
     layers : tuple of float
         Layer thicknesses (m), top first; empty for the homogeneous half-space.
+    layer_surface_size : float or None
+        Radial element size on the loaded surface inside the layers (m), <= surface_size
+        (thin layers are resolved radially; the substrate keeps surface_size).
     layer_min_elements : int
         Least number of elements through a layer (see
         :func:`~femadh.elastic.fe.layers.layer_depths`).
@@ -50,6 +53,7 @@ class MeshSpec:
     surface_size: float
     layers: tuple = ()
     layer_min_elements: int = 2
+    layer_surface_size: float = None
 
     @property
     def loaded_radius(self):
@@ -79,6 +83,8 @@ class MeshSpec:
         if self.layers:
             out["layers"] = [round(t / a, 12) for t in self.layers]
             out["layer_min_elements"] = int(self.layer_min_elements)
+            out["layer_surface_size"] = round((self.layer_surface_size or self.surface_size)
+                                              / a, 12)
         return out
 
     def key(self):
@@ -172,8 +178,9 @@ def build_layered_mesh(spec: MeshSpec, path):
     if not L > max(1.0, 2 * sum(thick)):
         raise ValueError(f"outer radius {spec.outer_radius} m must exceed the loaded radius "
                          f"{a} m and twice the stack depth {spec.depth} m")
-    points, tri, region, bnd = layered_mesh(pts, L, spec.surface_size / a, spec.growth, thick,
-                                            spec.layer_min_elements)
+    layer_size = (spec.layer_surface_size or spec.surface_size) / a
+    points, tri, region, bnd = layered_mesh(pts, L, spec.surface_size / a, layer_size,
+                                            spec.growth, thick, spec.layer_min_elements)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     write_msh(path, points, tri, region, bnd, len(thick))
     return Path(path)
