@@ -4,12 +4,13 @@ Homogeneous domain: the quarter disk r^2 + z^2 <= L^2 with r, -z >= 0. Boundarie
 (z = 0), ``axis`` (r = 0), ``far`` (the arc). Layered domain (:func:`build_layered_mesh`): the
 layers are structured bands 0 <= r <= L, -D <= z <= 0 (D the stack depth), a structured
 transition zone of the substrate follows, then the quarter disk of radius L centred on the axis
-below it; ``far`` is the bands' outer edge r = L plus that arc. On the loaded part of the surface, 0 <= r <= a, the mesh
-has a vertex at every collocation node *and* every annulus edge of the RadialGrid, so each
-surface facet lies inside one pressure annulus (the load is integrated exactly) and the nodal
-displacements are mesh values. The element size grows linearly with the distance from the
-loaded segment (gmsh Distance + MathEval fields), so L can be 1e4-1e5 times a for a few
-percent more elements.
+below it; ``far`` is the bands' outer edge r = L plus that arc.
+
+On the loaded part of the surface, 0 <= r <= a, the mesh has a vertex at every collocation
+node *and* every annulus edge of the RadialGrid, so each surface facet lies inside one pressure
+annulus (the load is integrated exactly) and the nodal displacements are mesh values. The
+element size grows linearly with the distance from the loaded segment (gmsh Distance + MathEval
+fields), so L can be 1e4-1e5 times a for a few percent more elements.
 """
 from dataclasses import dataclass
 import hashlib
