@@ -1,8 +1,11 @@
 """VTK output of FE states for ParaView/PyVista (written with meshio).
 
-Per state: ``vtk/<branch>_<k>.vtu`` with the (r, z) mesh (x = r, y = z), the displacement as a
-3-component vector (u_r, u_z, 0) for ParaView's "Warp By Vector", the stresses sigma_rr,
-sigma_zz, sigma_tt, sigma_rz and von Mises (Pa, L2-projected onto P1), and
+Per state: ``vtk/<branch>_<k>.vtu`` with the (r, z) mesh (x = r, y = z) as quadratic triangles
+("triangle6": the P2 nodes, so the volume keeps the FE solution's resolution), the displacement
+as a 3-component vector (u_r, u_z, 0) for ParaView's "Warp By Vector", the stresses sigma_rr,
+sigma_zz, sigma_tt, sigma_rz and von Mises (Pa, L2-projected onto continuous P2 in each
+region), the cell data ``region`` (0 = top layer ... substrate; interface nodes are repeated per
+region so stress jumps stay sharp), and
 ``vtk/<branch>_surface_<k>.vtu`` with the surface polyline: w, gap h, P_LJ, contact pressure.
 ``<branch>.pvd`` collects them with the timestep = d in nm.
 """
@@ -23,10 +26,11 @@ def write_state(out_dir, branch, index, state, problem):
     vdir.mkdir(parents=True, exist_ok=True)
     u = op.full_field(state.p_total)
     fields = fe_point_fields(op, u)
-    p = op.mesh.p
-    pts = np.column_stack([p[0], p[1], np.zeros(p.shape[1])])
+    proj = op.field_projector
+    pts = np.column_stack([proj.points, np.zeros(len(proj.points))])
     vol = f"{branch}_{index:04d}.vtu"
-    meshio.write(vdir / vol, meshio.Mesh(pts, [("triangle", op.mesh.t.T)], point_data=fields))
+    meshio.write(vdir / vol, meshio.Mesh(pts, [("triangle6", proj.cells)], point_data=fields,
+                                         cell_data={"region": [proj.cell_region]}))
     r = problem.grid.nodes
     spts = np.column_stack([r, state.w, np.zeros_like(r)])
     lines = np.column_stack([np.arange(r.size - 1), np.arange(1, r.size)])

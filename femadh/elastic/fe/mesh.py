@@ -1,12 +1,16 @@
 """gmsh builder of the axisymmetric half-space mesh (r, z), z <= 0, and its cache.
 
-Domain: the quarter disk r^2 + z^2 <= L^2 with r, -z >= 0. Boundaries: ``surface`` (z = 0),
-``axis`` (r = 0), ``far`` (the arc). On the loaded part of the surface, 0 <= r <= a, the mesh
-has a vertex at every collocation node *and* every annulus edge of the RadialGrid, so each
-surface facet lies inside one pressure annulus (the load is integrated exactly) and the nodal
-displacements are mesh values. The element size grows linearly with the distance from the
-loaded segment (gmsh Distance + MathEval fields), so L can be 1e4-1e5 times a for a few
-percent more elements.
+Homogeneous domain: the quarter disk r^2 + z^2 <= L^2 with r, -z >= 0. Boundaries: ``surface``
+(z = 0), ``axis`` (r = 0), ``far`` (the arc). Layered domain (:func:`build_layered_mesh`): the
+layers are structured bands 0 <= r <= L, -D <= z <= 0 (D the stack depth), a structured
+transition zone of the substrate follows, then the quarter disk of radius L centred on the axis
+below it; ``far`` is the bands' outer edge r = L plus that arc.
+
+On the loaded part of the surface, 0 <= r <= a, the mesh has a vertex at every collocation
+node *and* every annulus edge of the RadialGrid, so each surface facet lies inside one pressure
+annulus (the load is integrated exactly) and the nodal displacements are mesh values. The
+element size grows linearly with the distance from the loaded segment (gmsh Distance + MathEval
+fields), so L can be 1e4-1e5 times a for a few percent more elements.
 """
 from dataclasses import dataclass
 import hashlib
@@ -34,28 +38,60 @@ class MeshSpec:
         Element size growth rate: h = h_s + growth * distance from the loaded segment.
     surface_size : float
         h_s, element size at the loaded segment (m).
+    layers : tuple of float
+        Layer thicknesses (m), top first; empty for the homogeneous half-space.
+    layer_surface_size : float or None
+        Radial element size on the loaded surface inside the layers (m), <= surface_size
+        (thin layers are resolved radially; the substrate keeps surface_size).
+    layer_min_elements : int
+        Least number of elements through a layer (see
+        :func:`~femadh.elastic.fe.layers.layer_depths`).
     """
 
     surface_points: tuple
     outer_radius: float
     growth: float
     surface_size: float
+    layers: tuple = ()
+    layer_min_elements: int = 2
+    layer_surface_size: float = None
 
     @property
     def loaded_radius(self):
         return self.surface_points[-1]
 
+    @property
+    def depth(self):
+        """D, total thickness of the layers (m)."""
+        return float(sum(self.layers))
+
+    @property
+    def file_name(self):
+        """Cache file name: ``halfspace-<key>.msh`` or ``layered-<key>.msh``."""
+        return f"{'layered' if self.layers else 'halfspace'}-{self.key()}.msh"
+
     def normalised(self):
-        """The spec in units of the loaded radius a (what gmsh meshes and the file stores)."""
+        """The spec in units of the loaded radius a (what gmsh meshes and the file stores).
+
+        The layer entries appear only for a layered body, so homogeneous keys (and the
+        committed meshes named by them) are those of the meshes built before layers existed.
+        """
         a = self.loaded_radius
-        return {"surface_points": [round(x / a, 12) for x in self.surface_points],
-                "outer_factor": round(self.outer_radius / a, 9),
-                "growth": round(self.growth, 12),
-                "surface_size": round(self.surface_size / a, 12)}
+        out = {"surface_points": [round(x / a, 12) for x in self.surface_points],
+               "outer_factor": round(self.outer_radius / a, 9),
+               "growth": round(self.growth, 12),
+               "surface_size": round(self.surface_size / a, 12)}
+        if self.layers:
+            out["layers"] = [round(t / a, 12) for t in self.layers]
+            out["layer_min_elements"] = int(self.layer_min_elements)
+            out["layer_surface_size"] = round((self.layer_surface_size or self.surface_size)
+                                              / a, 12)
+        return out
 
     def key(self):
         """Content hash of the normalised parameters: the cache file name. Scale-free, so one
-        committed mesh serves every analysis radius with the same relative node layout."""
+        committed mesh serves every analysis radius with the same relative node layout (and,
+        layered, the same thicknesses relative to it)."""
         blob = json.dumps(self.normalised(), sort_keys=True).encode()
         return hashlib.sha1(blob).hexdigest()[:16]
 
@@ -69,8 +105,12 @@ def build_mesh(spec: MeshSpec, path):
     """Mesh ``spec`` with gmsh (linear triangles) and write it to ``path`` (.msh).
 
     Returns the path. gmsh runs headless and quiet; it is initialised and finalised here.
+    A spec with layers is meshed by :func:`build_layered_mesh`.
     """
     import gmsh
+
+    if spec.layers:
+        return build_layered_mesh(spec, path)
 
     # gmsh works in units of the loaded radius a: its geometric tolerances are absolute
     # (1e-8), which SI micrometre coordinates would fall below
@@ -121,20 +161,55 @@ def build_mesh(spec: MeshSpec, path):
     return Path(path)
 
 
-def read_mesh(path, scale=1.0):
+def build_layered_mesh(spec: MeshSpec, path):
+    """Mesh a layered body (layers on a substrate half-space) and write ``path`` (.msh).
+
+    Structured bands for the layers and a structured transition zone below them, gmsh for
+    the rest of the substrate (:mod:`~femadh.elastic.fe.layered_mesh`); the same surface
+    vertices and size law as the homogeneous mesh. Physical groups: triangles ``layer_<i>``
+    (tag i + 1, top layer i = 0) and ``substrate`` (tag n + 1); lines ``surface``, ``axis``,
+    ``far``, ``interface_<i>`` (below layer i).
+    """
+    from .layered_mesh import layered_mesh, write_msh
+
+    a = float(spec.surface_points[-1])
+    pts = np.asarray(spec.surface_points) / a
+    L = float(spec.outer_radius) / a
+    thick = [float(t) / a for t in spec.layers]
+    if not L > max(1.0, 2 * sum(thick)):
+        raise ValueError(f"outer radius {spec.outer_radius} m must exceed the loaded radius "
+                         f"{a} m and twice the stack depth {spec.depth} m")
+    layer_size = (spec.layer_surface_size or spec.surface_size) / a
+    points, tri, region, bnd = layered_mesh(pts, L, spec.surface_size / a, layer_size,
+                                            spec.growth, thick, spec.layer_min_elements)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_msh(path, points, tri, region, bnd, len(thick))
+    return Path(path)
+
+
+def read_mesh(path, scale=1.0, regions=False):
     """Read a .msh with meshio; returns (points (n, 2) times ``scale``, triangles (m, 3)).
 
-    Meshes are stored in units of the loaded radius; pass scale = a for SI coordinates.
+    Meshes are stored in units of the loaded radius; pass scale = a for SI coordinates. With
+    ``regions`` also returns each triangle's region id: the physical tag - 1, i.e. the layer
+    index from the top (0 ...) and the layer count for the substrate; a homogeneous mesh
+    (one physical group "solid") gives 0 everywhere.
     """
     import meshio
 
     m = meshio.read(str(path))
-    tri = np.concatenate([c.data for c in m.cells if c.type == "triangle"])
+    blocks = [i for i, c in enumerate(m.cells) if c.type == "triangle"]
+    tri = np.concatenate([m.cells[i].data for i in blocks])
     used = np.unique(tri)
     # drop points not used by triangles (gmsh keeps geometry points such as the arc centre)
     remap = -np.ones(len(m.points), int)
     remap[used] = np.arange(used.size)
-    return m.points[used, :2] * scale, remap[tri]
+    if not regions:
+        return m.points[used, :2] * scale, remap[tri]
+    tag = np.concatenate([m.cell_data["gmsh:physical"][i] for i in blocks]).astype(int)
+    if "solid" in m.field_data:
+        tag = np.ones_like(tag)
+    return m.points[used, :2] * scale, remap[tri], tag - 1
 
 
 def mesh_search_path():
@@ -157,7 +232,7 @@ def cached_mesh(spec: MeshSpec, cache_dir=None, *, progress=None):
     import os
     import tempfile
 
-    name = f"halfspace-{spec.key()}.msh"
+    name = spec.file_name
     for folder in mesh_search_path():
         if (folder / name).exists():
             return folder / name

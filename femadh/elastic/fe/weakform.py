@@ -2,6 +2,8 @@
 r-weighted bilinear form, and the stresses of a displacement field."""
 import math
 
+import numpy as np
+
 
 def lame(youngs, nu):
     """Lame constants (lambda, mu) (Pa) of Young's modulus E (Pa) and Poisson ratio nu."""
@@ -41,3 +43,74 @@ def stresses(u, r, lam, mu):
     tr = e[0] + e[1] + e[2]
     return {"sigma_rr": lam * tr + 2 * mu * e[0], "sigma_zz": lam * tr + 2 * mu * e[1],
             "sigma_tt": lam * tr + 2 * mu * e[2], "sigma_rz": 2 * mu * e[3]}
+
+
+def axisymmetric_divergence():
+    """Bilinear form b(u, q) = int q div(u) 2 pi r dr dz, div u = e_rr + e_zz + e_tt
+    (u: displacement trial field, q: scalar pressure test field)."""
+    from skfem import BilinearForm
+
+    @BilinearForm
+    def form(u, q, w):
+        r = w.x[0]
+        e = _strains(u, r)
+        return 2 * math.pi * r * q * (e[0] + e[1] + e[2])
+
+    return form
+
+
+def axisymmetric_mass():
+    """Bilinear form m(p, q) = int p q 2 pi r dr dz of a scalar field."""
+    from skfem import BilinearForm
+
+    @BilinearForm
+    def form(p, q, w):
+        return 2 * math.pi * w.x[0] * p * q
+
+    return form
+
+
+def projected_volumetric(ubasis, pbasis, elements):
+    """The volumetric part of the mixed (displacement, discontinuous pressure) formulation with
+    the pressure eliminated element by element.
+
+    The pressure-like field p = lambda P(div u), P the r-weighted L2 projection onto the
+    discontinuous space of ``pbasis`` on each element, makes the volumetric energy
+    lambda int P(div u) P(div v) 2 pi r = lambda (B u)^T M^-1 (B v), with B the divergence
+    coupling and M the (element-block-diagonal) pressure mass matrix. With a stable pair (P2 +
+    cubic bubble displacements, P1 discontinuous pressure) this does not lock as lambda/mu
+    grows, unlike lambda int div u div v on plain P2.
+
+    Parameters
+    ----------
+    ubasis : skfem Basis
+        Vector displacement basis restricted to ``elements``.
+    pbasis : skfem Basis
+        Discontinuous scalar basis (e.g. ElementTriP1DG) on the whole mesh.
+    elements : ndarray of int
+        The elements of the region.
+
+    Returns
+    -------
+    B : sparse (n_p, n_u)
+        int q div(u) 2 pi r on the region (rows of other elements are zero).
+    M_inv : sparse (n_p, n_p)
+        Inverse of the region's pressure mass matrix, block by block (zero elsewhere).
+    """
+    from scipy.sparse import coo_matrix
+    from skfem import Basis
+
+    pb = Basis(pbasis.mesh, pbasis.elem, elements=elements, quadrature=ubasis.quadrature)
+    B = axisymmetric_divergence().assemble(ubasis, pb).tocsr()
+    M = axisymmetric_mass().assemble(pb).tocsr()
+    dofs = pbasis.element_dofs[:, elements].T                 # (n_el, n_loc)
+    n_loc = dofs.shape[1]
+    blocks = np.empty((dofs.shape[0], n_loc, n_loc))
+    for i in range(n_loc):
+        for j in range(n_loc):
+            blocks[:, i, j] = np.asarray(M[dofs[:, i], dofs[:, j]]).ravel()
+    inv = np.linalg.inv(blocks)
+    rows = np.repeat(dofs, n_loc, axis=1).ravel()
+    cols = np.tile(dofs, (1, n_loc)).ravel()
+    M_inv = coo_matrix((inv.ravel(), (rows, cols)), shape=M.shape).tocsr()
+    return B, M_inv
