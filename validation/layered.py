@@ -36,6 +36,7 @@ from femadh.contact.forces import state_forces  # noqa: E402
 from femadh.elastic import GreenOperator, RadialGrid  # noqa: E402
 from femadh.elastic.fe import FEOperator, FESettings  # noqa: E402
 from femadh.elastic.fe.layers import Layer  # noqa: E402
+from femadh.elastic.hankel import HankelLayeredOperator  # noqa: E402
 from femadh.elastic.operator import SurfaceOperator  # noqa: E402
 from femadh.indenter import Sphere  # noqa: E402
 from femadh.laws import LennardJones  # noqa: E402
@@ -47,23 +48,6 @@ from femadh.studies.regime import _lj_problem, lj_force  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
 OUT = Path("out") / "layered-vtk"
-
-
-class ReferenceOperator(SurfaceOperator):
-    """The Hankel-transform reference as a surface operator: C = C_stack + C_sphere on a grid
-    (an independent second route through the same contact solvers)."""
-
-    name = "layered-reference"
-
-    def __init__(self, grid, layers, substrate, sphere=None):
-        self.grid = grid
-        stack = LayeredHalfSpace([(ly.thickness, ly.youngs_modulus, ly.poisson_ratio)
-                                  for ly in layers],
-                                 (substrate.youngs_modulus, substrate.poisson_ratio))
-        self.compliance = stack.annulus_compliance(grid.nodes, grid.edges)
-        if sphere is not None:
-            self.compliance = (self.compliance
-                               + GreenOperator(grid, sphere.plane_strain_modulus).compliance)
 
 
 def rel(w, ref):
@@ -353,7 +337,7 @@ def part_slider():
         # error cancels from the coating's effect
         same = FEOperator(grid, substrate=DISK, sphere=SLIDER,
                           layers=[Layer(t, DISK.youngs_modulus, DISK.poisson_ratio)])
-        ops.append((t, E, op, build, same, ReferenceOperator(grid, coat, DISK, SLIDER)))
+        ops.append((t, E, op, build, same, HankelLayeredOperator(grid, coat, DISK, SLIDER)))
     out = {}
     lines = []
     changes = []
@@ -560,7 +544,7 @@ def punch_table():
     for ah in (0.1, 1.0, 2.0, 5.0, 10.0, 20.0, 40.0):
         ly = [Layer(a_p / ah, film.youngs_modulus, film.poisson_ratio)]
         k_fe = flat_punch_stiffness(FEOperator(grid, substrate=base, layers=ly), a_p) / half
-        k_ref = flat_punch_stiffness(ReferenceOperator(grid, ly, base), a_p) / half
+        k_ref = flat_punch_stiffness(HankelLayeredOperator(grid, ly, base), a_p) / half
         lub = 3 * math.pi * mu * a_p**4 * ah**3 / (8 * a_p**3) / half
         lines.append(f"| {ah:g} | {k_fe:.4g} | {k_ref:.4g} | {k_fe / k_ref - 1:+.1e} | "
                      f"{lub:.4g} | {k_fe / lub:.3f} |")
@@ -585,7 +569,7 @@ def part_film():
         op = FEOperator(grid, substrate=GLASS, layers=layer, sphere=TIP)
         build = time.perf_counter() - t0
         fe = film_point(op, lj, z0, d_min)
-        ref = film_point(ReferenceOperator(grid, layer, GLASS, TIP), lj, z0, d_min)
+        ref = film_point(HankelLayeredOperator(grid, layer, GLASS, TIP), lj, z0, d_min)
         results.append((t, op, build, fe, ref))
         print(f"t = {t:.3g} m: FE pull-off {fe['pull']:.4f}, reference {ref['pull']:.4f}",
               flush=True)

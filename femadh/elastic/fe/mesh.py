@@ -195,9 +195,15 @@ def read_mesh(path, scale=1.0, regions=False):
     index from the top (0 ...) and the layer count for the substrate; a homogeneous mesh
     (one physical group "solid") gives 0 everywhere.
     """
+    import contextlib
+    import io
+
     import meshio
 
-    m = meshio.read(str(path))
+    # meshio's gmsh 4.1 reader prints a bare newline to stdout, which would end up in a
+    # user's piped output
+    with contextlib.redirect_stdout(io.StringIO()):
+        m = meshio.read(str(path))
     blocks = [i for i, c in enumerate(m.cells) if c.type == "triangle"]
     tri = np.concatenate([m.cells[i].data for i in blocks])
     used = np.unique(tri)
