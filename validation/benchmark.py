@@ -1,0 +1,130 @@
+"""End-to-end timings as a user runs femadh: process start to exit of ``femadh run`` on the
+bundled scenes (with figures, VTK and error estimates where the scene has them), the split the
+run itself records (operator, solve, estimates, figures), and the headline number with its
+estimated error beside the time.
+
+Also: import/start-up cost, and the default BLAS threading under load (a second core kept
+busy): femadh limits BLAS to one thread unless the user sets OPENBLAS_NUM_THREADS /
+OMP_NUM_THREADS; the table compares its default with two threads.
+
+``python -m validation.benchmark [--repeat 5]`` writes validation/results/benchmark.md. Run it
+on a quiet machine; each row is the median of the repeats. The same numbers from a shell::
+
+    femadh run validation/scenes/paper1_fig3.toml --out /tmp/f3 --overwrite   # 'time' it
+"""
+import argparse
+import json
+import multiprocessing as mp
+import os
+from pathlib import Path
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results"
+SCENES = HERE / "scenes"
+ROWS = (
+    ("paper1_fig3", []), ("paper1_fig3", ["--no-estimate"]),
+    ("paper1_fig3", ["--no-estimate", "--no-figures"]),
+    ("paper1_fig3_fe", []), ("paper1_fig3_fe", ["--no-estimate"]),
+    ("paper1_fig4", []), ("paper1_fig4_coated", ["--no-estimate"]),
+    ("paper1_slider_meniscus", []), ("paper2_ethanol_100nm", []),
+)
+
+
+def _env(**extra):
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+    env.update(extra)
+    return env
+
+
+def timed_run(scene, flags, out, env=None):
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-m", "femadh", "run", str(SCENES / f"{scene}.toml"),
+                        "--out", str(out), "--overwrite", "--quiet", *flags],
+                       capture_output=True, text=True, env=env or _env())
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise RuntimeError(f"{scene}: {p.stderr.strip()}")
+    return wall, json.loads((out / "summary.json").read_text())
+
+
+def _busy(stop):
+    while not stop.is_set():
+        sum(i * i for i in range(10000))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+    RESULTS.mkdir(exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix="femadh-bench-"))
+    lines = ["# End to end, as a user runs it (validation/benchmark.py)", "",
+             f"Median of {args.repeat} runs of `femadh run SCENE --out DIR --overwrite --quiet "
+             "[flags]`, process start to exit, this machine (2 cores), femadh's defaults "
+             "(one BLAS thread). The split is what the run records in summary.json "
+             "(operator = Green function or FE mesh + assembly + condensation; solve includes "
+             "writing every state's csv/VTK rows; estimates = the coarser grids, the peak "
+             "search and the FE-vs-Green run).", "",
+             "| scene | flags | wall (s) | operator | solve | estimates | figures | "
+             "headline ± estimated error |", "|---|---|---|---|---|---|---|---|"]
+    # the first run of a scene warms the mesh cache and the file system; not counted
+    for scene, flags in ROWS:
+        out = tmp / scene
+        timed_run(scene, flags, out)
+        walls, summ = [], None
+        for _ in range(args.repeat):
+            w, summ = timed_run(scene, flags, out)
+            walls.append(w)
+        t = summ.get("timings_s", {})
+        hl = summ.get("headline", {})
+        if "max_adhesion_N" in hl:
+            err = hl.get("max_adhesion_N_error")
+            head = (f"max adhesion {hl['max_adhesion_N'] * 1e6:.4g} µN"
+                    + (f" ± {err * 1e6:.2g}" if err is not None else " (no estimate)"))
+        elif "max_force_over_4piRgamma" in hl:
+            head = f"max F/4πRγ {hl['max_force_over_4piRgamma']:.4g}"
+        else:
+            head = ""
+        fmt = (lambda k: f"{t[k]:.2f}" if k in t else "-")
+        lines.append(f"| {scene} | {' '.join(flags) or '(default)'} | "
+                     f"{statistics.median(walls):.2f} | {fmt('operator_s')} | "
+                     f"{fmt('solve_s')} | {fmt('estimate_s')} | {fmt('figures_s')} | {head} |")
+        print(lines[-1], flush=True)
+    # start-up
+    starts = []
+    for _ in range(args.repeat):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "femadh", "--version"], capture_output=True,
+                       env=_env())
+        starts.append(time.perf_counter() - t0)
+    lines += ["", f"`femadh --version` (interpreter start + import): "
+              f"{statistics.median(starts):.2f} s.", ""]
+    # threads under load
+    lines += ["## BLAS threads with the second core busy", "",
+              "| scene | threads | wall (s) |", "|---|---|---|"]
+    stop = mp.Event()
+    hog = mp.Process(target=_busy, args=(stop,))
+    hog.start()
+    try:
+        for label, env in (("femadh default (1)", _env()),
+                           ("OPENBLAS_NUM_THREADS=2 (user's choice)",
+                            _env(OPENBLAS_NUM_THREADS="2", OMP_NUM_THREADS="2"))):
+            walls = [timed_run("paper1_fig4", ["--no-estimate", "--no-figures"],
+                               tmp / "threads", env)[0] for _ in range(args.repeat)]
+            lines.append(f"| paper1_fig4 | {label} | {statistics.median(walls):.2f} |")
+            print(lines[-1], flush=True)
+    finally:
+        stop.set()
+        hog.join()
+    (RESULTS / "benchmark.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
