@@ -47,8 +47,12 @@ NEWTON_RTOL = 1e-4
 #: low-rank change that GMRES absorbs in a few iterations per changed node)
 GMRES_MAX = 8
 GMRES_PER_NODE = 25
-#: a grid may be exchanged (regrid) only where |dd/ds| exceeds this: the state is carried
-#: over at fixed d, which is well posed away from folds
+#: a grid exchange (regrid) carries the state over at fixed d where |dd/ds| exceeds this
+#: (well posed away from folds); closer to a fold, where the problem at fixed d turns
+#: singular, on the hyperplane through the interpolated state normal to the interpolated
+#: tangent (the bordered system stays regular there), so the grid can follow the contact
+#: edge through folds: on the JKR side the edge travels ~0.05 z0 R / ell (mu = 20: ~200 ell)
+#: while |dd/ds| < 0.05
 REGRID_MIN_TD = 0.05
 #: the step length is tuned so that the corrector moves no gap by more than about this
 #: fraction of itself away from the prediction (the predictor error grows like step^2)
@@ -357,7 +361,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         if len(curve.points) >= max_points:
             raise fail(f"arclength continuation needed more than {max_points} points",
                        d, res, it)
-        if regrid is not None and abs(t[n]) >= REGRID_MIN_TD:
+        if regrid is not None:
             new = regrid(problem, w, d)
             moved = None if new is None else _carry_over(new, q, tr, scale, tol, curve)
             if moved is not None:
@@ -388,24 +392,44 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
 
 
 def _carry_over(problem, q, tr, scale, tol, curve):
-    """Point q (on tracer tr's grid) carried to ``problem``'s grid: w and the tangent
-    interpolated in r, the state solved again at the same d, its stability checked by the
-    Hessian. Returns (new tracer, new CurvePoint), or None (the old grid is kept) if the
-    solve fails or the stability differs (the new grid does not resolve the state)."""
+    """Point q (on tracer tr's grid) carried to ``problem``'s grid.
+
+    w and the tangent are interpolated in r and the state is solved again on the new grid:
+    at the same d away from folds (|dd/ds| >= REGRID_MIN_TD; the seam is then at one d), else
+    on the hyperplane through the interpolated state normal to the interpolated tangent (at
+    a fold the problem at fixed d is singular, the bordered one is not; d moves by the grids'
+    difference times |dd/ds|). The new state must lie on the same side of every fold as q
+    (dd/ds of the same sign) and, away from folds, have q's stability by the Hessian.
+
+    Returns (new tracer, new CurvePoint), or None (the old grid is kept; the reason is
+    appended to ``curve.refused``).
+    """
     r_old, r_new = tr.problem.grid.nodes, problem.grid.nodes
     n = problem.grid.n
     w = np.interp(r_new, r_old, q.w)
-    t_w = np.interp(r_new, r_old, q.t[:-1])
-    fixed_d = np.zeros(n + 1)
-    fixed_d[n] = 1.0
+    t_old = np.r_[np.interp(r_new, r_old, q.t[:-1]), q.t[-1]]
+    near_fold = abs(q.t_d) < REGRID_MIN_TD
+    if near_fold:
+        normal = t_old
+    else:
+        normal = np.zeros(n + 1)
+        normal[n] = 1.0
     new = _Tracer(problem, scale, tol, curve)
-    xc, it, res, ok = new.correct(np.r_[w, q.d] / scale, fixed_d)
-    if not ok or _hessian_stable(problem, xc[:n] * scale, q.d) != q.stable:
+    xc, it, res, ok = new.correct(np.r_[w, q.d] / scale, normal)
+    if not ok:
+        curve.refused.append((q.d, f"corrector: residual {res:.3g} m after {it} iterations"))
         return None
-    w = xc[:n] * scale
+    w, d = xc[:n] * scale, xc[n] * scale
+    t = new.tangent(w, d, t_old)
+    if t[-1] * q.t_d < 0:
+        curve.refused.append((q.d, f"a fold between the grids (dd/ds {q.t_d:.3g} -> "
+                                   f"{t[-1]:.3g})"))
+        return None
+    if not near_fold and _hessian_stable(problem, w, d) != q.stable:
+        curve.refused.append((q.d, "stability differs on the new grid"))
+        return None
     new.register()
-    t = new.tangent(w, q.d, np.r_[t_w, q.t[-1]])
-    return new, CurvePoint(q.d, w, t, q.stable, it, res, new.seg)
+    return new, CurvePoint(d, w, t, q.stable, it, res, new.seg)
 
 
 def _locate_fold(tr, p, step, index):

@@ -45,7 +45,8 @@ class EquilibriumCurve:
 
     A curve traced on a grid that moves with the contact edge is made of segments, one per
     grid (``tracers[k].problem``); consecutive points of different segments are the same
-    equilibrium at the same d on two grids (a seam), not an interval of the curve.
+    equilibrium on two grids (a seam: at the same d, or near a fold at d differing by the
+    grids' difference), not an interval of the curve.
     """
 
     points: list = field(default_factory=list)
@@ -55,6 +56,7 @@ class EquilibriumCurve:
     n_krylov: int = 0
     wall_time: float = 0.0
     tracers: list = field(default_factory=list)
+    refused: list = field(default_factory=list)   # (d, why) of grid exchanges not made
 
     @property
     def _tracer(self):
@@ -190,11 +192,15 @@ class EquilibriumCurve:
         """Largest value(d, w) on the curve between points i-1 and i+1 (bounded search in
         arclength; each evaluation is a corrected point). Returns (value, d, w)."""
         pts = self.points
-        s1, s2 = self._dist(pts[i - 1], pts[i]), self._dist(pts[i], pts[i + 1])
+        # a seam is no interval of the curve: search only the neighbours on point i's grid
+        s1 = 0.0 if self._seam(i - 1) else self._dist(pts[i - 1], pts[i])
+        s2 = 0.0 if self._seam(i) else self._dist(pts[i], pts[i + 1])
         best = [value(pts[i].d, pts[i].w), pts[i].d, pts[i].w]
+        if s1 + s2 == 0.0:
+            return tuple(best)
 
         def neg(s):
-            r = self._on_curve(*((pts[i - 1], s) if s <= s1 else (pts[i], s - s1)))
+            r = self._on_curve(*((pts[i - 1], s) if s < s1 else (pts[i], s - s1)))
             if r is None:
                 return -best[0]
             v = value(*r)
