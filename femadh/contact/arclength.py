@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 from scipy import linalg
-from scipy.sparse import linalg as sla
+from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
@@ -47,6 +47,12 @@ NEWTON_RTOL = 1e-4
 #: low-rank change that GMRES absorbs in a few iterations per changed node)
 GMRES_MAX = 8
 GMRES_PER_NODE = 25
+#: below this many nodes each linear solve factorises afresh: an LU costs 0.1 ms at N = 130
+#: and 0.5 ms at 260 (one BLAS thread, measured); preconditioned GMRES needs ~6-10
+#: iterations per solve here, and traces at N = 232-290 took the same time either way
+DIRECT_MAX_N = 250
+#: with direct solves the stability is verified by the Hessian every this many points
+HESSIAN_EVERY = 8
 #: a grid exchange (regrid) carries the state over at fixed d where |dd/ds| exceeds this
 #: (well posed away from folds); closer to a fold, where the problem at fixed d turns
 #: singular, on the hyperplane through the interpolated state normal to the interpolated
@@ -77,7 +83,8 @@ class _Bordered:
     An LU factorisation of the bordered matrix at some earlier state preconditions GMRES on the
     exact current matrix (applied as dense mat-vecs, O(N^2)). Along a curve the Jacobian changes
     slowly, so a factorisation serves many points; it is refreshed (O(N^3)) only when GMRES
-    needs more than GMRES_MAX iterations. ``n_factor`` counts refreshes.
+    needs more than ``krylov_max`` iterations. Below DIRECT_MAX_N nodes every solve factorises
+    afresh (cheaper there than the Krylov iterations). ``n_factor`` counts factorisations.
     """
 
     def __init__(self, problem, omega):
@@ -89,6 +96,7 @@ class _Bordered:
         self.n_factor = 0
         self.n_krylov = 0
         self.krylov_max = max(GMRES_MAX, self.n // GMRES_PER_NODE)
+        self.direct = self.n < DIRECT_MAX_N
 
     def matrix(self, D, t):
         n, K = self.n, self.problem.K
@@ -103,33 +111,81 @@ class _Bordered:
     def solve(self, D, t, rhs, rtol, atol=0.0):
         """x with M(D, t) x = rhs, M = [[K + diag D, -D], [kappa omega t_w, kappa t_d]],
         to rtol * |rhs| or atol (residual units: Pa), whichever is larger."""
-        n, K = self.n, self.problem.K
-        kt = self.kappa * self.omega * t[:n]
-        if self.lu is not None:
+        if self.lu is not None and not self.direct:
+            n, K = self.n, self.problem.K
+            kt = self.kappa * self.omega * t[:n]
+            ktd = self.kappa * t[n]
+
             def mv(x):
                 y = np.empty(n + 1)
                 y[:n] = K @ x[:n] + D * (x[:n] - x[n])
-                y[n] = kt @ x[:n] + self.kappa * t[n] * x[n]
+                y[n] = kt @ x[:n] + ktd * x[n]
                 return y
-            its = [0]
-
-            def count(_):
-                its[0] += 1
-
-            def pre(y):
-                return linalg.lu_solve(self.lu, y, check_finite=False)
-            # right preconditioning: GMRES then watches the true residual (Pa), not a
-            # preconditioned one in other units
-            op = sla.LinearOperator((n + 1, n + 1), matvec=lambda y: mv(pre(y)), dtype=float)
-            y, info = sla.gmres(op, rhs, rtol=rtol, atol=atol, restart=self.krylov_max, maxiter=1,
-                                callback=count, callback_type="pr_norm")
-            x = pre(y)
-            self.n_krylov += its[0]
-            if info == 0 and np.all(np.isfinite(x)):
+            x, its = _gmres(mv, self._lu_solve, rhs, max(rtol * _norm(rhs), atol),
+                            self.krylov_max)
+            self.n_krylov += its
+            if x is not None:
                 return x
-        self.lu = linalg.lu_factor(self.matrix(D, t), check_finite=False)
+        lu, piv, info = lapack.dgetrf(self.matrix(D, t), overwrite_a=True)
+        if info > 0:
+            raise ConvergenceError("bordered Jacobian is singular", residual=math.nan,
+                                   n_iter=0)
+        self.lu = (lu, piv)
         self.n_factor += 1
-        return linalg.lu_solve(self.lu, rhs, check_finite=False)
+        return self._lu_solve(rhs)
+
+    def _lu_solve(self, y):
+        return lapack.dgetrs(*self.lu, y)[0]
+
+
+def _norm(x):
+    return math.sqrt(float(x @ x))
+
+
+def _gmres(mv, pre, b, tol, m):
+    """Right-preconditioned GMRES from x = 0, no restart: x with |b - A x| <= tol (the true
+    residual, in b's units), A x = mv(x), preconditioner pre(y) ~ A^-1 y.
+
+    Returns (x, iterations), x None if m iterations do not reach tol (or break down). A
+    lean version of scipy's gmres: on a few hundred unknowns its per-call overhead (~0.3 ms)
+    exceeded the iterations' own cost.
+    """
+    beta = _norm(b)
+    if beta <= tol:
+        return np.zeros_like(b), 0
+    V = np.empty((m + 1, b.size))
+    Z = np.empty((m, b.size))
+    H = np.zeros((m + 1, m))
+    cs, sn = np.zeros(m), np.zeros(m)
+    g = np.zeros(m + 1)
+    g[0] = beta
+    V[0] = b / beta
+    for j in range(m):
+        Z[j] = pre(V[j])
+        w = mv(Z[j])
+        for _ in range(2):       # classical Gram-Schmidt, twice (as stable as modified)
+            h = V[:j + 1] @ w
+            w -= h @ V[:j + 1]
+            H[:j + 1, j] += h
+        H[j + 1, j] = h_next = _norm(w)
+        for i in range(j):       # previous Givens rotations on the new column
+            H[i, j], H[i + 1, j] = (cs[i] * H[i, j] + sn[i] * H[i + 1, j],
+                                    -sn[i] * H[i, j] + cs[i] * H[i + 1, j])
+        r = math.hypot(H[j, j], H[j + 1, j])
+        if not r > 0 or not np.isfinite(r):
+            return None, j + 1
+        cs[j], sn[j] = H[j, j] / r, H[j + 1, j] / r
+        H[j, j], H[j + 1, j] = r, 0.0
+        g[j + 1] = -sn[j] * g[j]
+        g[j] *= cs[j]
+        if abs(g[j + 1]) <= tol or j == m - 1:
+            y = linalg.solve_triangular(H[:j + 1, :j + 1], g[:j + 1], check_finite=False)
+            x = y @ Z[:j + 1]
+            if abs(g[j + 1]) <= tol and np.all(np.isfinite(x)):
+                return x, j + 1
+            return None, j + 1
+        V[j + 1] = w / h_next
+    return None, m
 
 
 class _Tracer:
@@ -197,6 +253,13 @@ def _residual(problem, w, d):
 
 def _hessian_stable(problem, w, d):
     return is_positive_definite(problem.energy_hessian(problem.contour(d) - w))
+
+
+def _negative_modes(problem, w, d):
+    """Negative eigenvalues of the energy Hessian at a fold state other than the one closest
+    to zero (the mode that crosses zero there)."""
+    ev = linalg.eigvalsh(problem.energy_hessian(problem.contour(d) - w), check_finite=False)
+    return int(np.sum(ev < 0) - (ev[np.argmin(np.abs(ev))] < 0))
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
@@ -329,10 +392,19 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             continue
         folded = p.t_d * t[n] < 0
         stable = p.stable != folded
-        # (not next to a fold: there the symmetric energy Hessian and the collocation
-        # Jacobian, whose singularity defines the fold, turn singular at slightly different
-        # points, an O(h) asymmetry of the discretisation)
-        if tr.lin.n_factor != factors and not (folded or check_next):
+        fold = _locate_fold(tr, p, step, len(curve.points) - 1) if folded else None
+        if stable and folded and _negative_modes(problem, fold.w, fold.d) > 0:
+            # the mode crossing zero at this fold was not the only negative one: the curve
+            # passes from one unstable branch to another (index 1 -> 2; measured at mu = 5-20
+            # after the jump-in, a second mode turns negative), not back to a stable one
+            stable = False
+        # (checked when GMRES needed a fresh factorisation, or every HESSIAN_EVERY points
+        # with direct solves; not next to a fold: there the symmetric energy Hessian and the
+        # collocation Jacobian, whose singularity defines the fold, turn singular at slightly
+        # different points, an O(h) asymmetry of the discretisation)
+        due = (len(curve.points) % HESSIAN_EVERY == 0 if tr.lin.direct
+               else tr.lin.n_factor != factors)
+        if due and not (folded or check_next):
             if _hessian_stable(problem, w, d) != stable:
                 # likely two folds inside the step (resolve them); at the smallest step a
                 # bifurcation, which this continuation does not follow
@@ -343,7 +415,6 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         attempts = 0
         q = CurvePoint(d, w, t, stable, it, res, tr.seg)
         if folded:
-            fold = _locate_fold(tr, p, step, len(curve.points) - 1)
             fold.seg = tr.seg
             curve.folds.append(fold)
         curve.points.append(q)

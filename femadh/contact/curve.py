@@ -121,7 +121,11 @@ class EquilibriumCurve:
             d_f = self.folds[k_fold].d
             out.append(("fold", k_fold, None))
             landing = None
-            for r in runs:
+            # the nearest stable piece along the curve first: past a lattice micro-loop (a
+            # fold pair as the edge crosses a node, d within ~1e-4 z0) the surface descends
+            # to the adjacent piece of the same branch, not to a distant branch at that d
+            k_at = self.folds[k_fold].index
+            for r in sorted(runs, key=lambda r: min(abs(r[0] - k_at), abs(r[1] - k_at))):
                 if r in visited:
                     continue
                 # a stable branch's pieces: fold -> first point, point -> point, last -> fold

@@ -533,7 +533,8 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
         if "spacing" not in over and not res.legacy:
-            res = replace(res, spacing=initial_spacing(accuracy))
+            res = replace(res, spacing=initial_spacing(accuracy, _lattice_cap(mu, radius,
+                                                                               law)))
     coarse, ratio = _coarse_member(mu, radius, law, res, tol)
     for attempt in range(MAX_REFINEMENTS + 1):
         fine = _solve(mu, radius, law, res, tol, progress)
@@ -570,19 +571,37 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["n_grids"], accuracy)
 
 
-def initial_spacing(accuracy):
+def initial_spacing(accuracy, cap=None):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
-    map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error."""
-    return min(MAX_SPACING, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+    map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error, at
+    most ``cap`` (default MAX_SPACING; see :func:`_lattice_cap`)."""
+    cap = MAX_SPACING if cap is None else cap
+    return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+
+
+def _lattice_cap(mu, radius, law):
+    """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
+    below LATTICE_SPACING elastocohesive lengths (lattice wiggles at the flat jump-out fold;
+    on the DMT side ell is the smaller length and the cap is MAX_SPACING)."""
+    dg, z0 = law.work_of_adhesion, law.z0
+    e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
+    ratio = e_star_length(law, e_star) / lateral_length(law, radius, e_star)
+    return min(MAX_SPACING, LATTICE_SPACING * ratio / COARSE_RATIO)
 
 
 #: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
 #: (hysteresis, mu = 1) and 0.02 (fixed-grip pull-off, mu = 3) for spacing <= 0.1
 C_SPACING = 0.02
-#: largest spacing an accuracy request starts from: beyond ~0.1 ell the fixed-grip jump-out
-#: is not yet in the asymptotic range (mu = 3: 1.2 % off at 0.2, 1.3e-4 at 0.1)
-MAX_SPACING = 0.1
+#: largest spacing an accuracy request starts from (units of ell): on the DMT side the
+#: members converge like spacing^2 from 0.4 down (mu = 0.5, 1: no lattice folds, measured)
+MAX_SPACING = 0.4
+#: largest band spacing in elastocohesive lengths E* z0^2 / dg for the members of an
+#: estimate: beyond it lattice wiggles spoil the flat jump-out fold (measured: mu = 3
+#: fixed-grip pull-off 1.2 % off at 0.2, 1.3e-4 at 0.1; mu = 5: 8 folds at 0.15, 38 at 0.2,
+#: the physical 4 at 0.1; mu = 2: on the spacing^2 line within 4e-6 up to 0.08, 4e-5 off
+#: it at 0.1)
+LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
 
