@@ -582,12 +582,14 @@ def initial_spacing(accuracy, cap=None):
 
 def _lattice_cap(mu, radius, law):
     """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
-    below LATTICE_SPACING elastocohesive lengths (lattice wiggles at the flat jump-out fold;
-    on the DMT side ell is the smaller length and the cap is MAX_SPACING)."""
+    below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
+    jump-out fold). On the DMT side (ell = sqrt(R z0 / 8) < E* z0^2 / dg: ratio > 1) the
+    fold is not flat: the cap grows like ratio^2 up to MAX_SPACING (empirical: mu = 1, ratio
+    2.8, converges like spacing^2 from 0.4 ell; mu = 2, ratio 1, lattice folds at 0.3)."""
     dg, z0 = law.work_of_adhesion, law.z0
     e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
     ratio = e_star_length(law, e_star) / lateral_length(law, radius, e_star)
-    return min(MAX_SPACING, LATTICE_SPACING * ratio / COARSE_RATIO)
+    return min(MAX_SPACING, LATTICE_SPACING * ratio**2 / COARSE_RATIO)
 
 
 #: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
