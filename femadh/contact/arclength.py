@@ -63,6 +63,10 @@ REGRID_MIN_TD = 0.05
 #: the step length is tuned so that the corrector moves no gap by more than about this
 #: fraction of itself away from the prediction (the predictor error grows like step^2)
 TARGET_CORRECTION = 0.05
+#: after a corrector failure the step stays below this fraction of the failed one, a ceiling
+#: that then rises by CEILING_GROWTH per accepted point
+BASIN_MARGIN = 0.8
+CEILING_GROWTH = 1.05
 #: the predictor may change no gap by more than this fraction of itself (resolves the law)
 MAX_GAP_CHANGE = 0.3
 #: the smallest step length, relative to the first one, before the trace gives up
@@ -332,6 +336,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     if on_point:
         on_point(0, curve.points[0])
     step, ds_min = ds, ds * MIN_STEP_FRACTION
+    ceiling = math.inf      # step length below the last one whose corrector failed
     weights = np.r_[np.full(n, tr.omega), 1.0]
 
     def fail(msg, d, res, it):
@@ -369,6 +374,9 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         attempts += 1
         xc, it, res, ok = tr.correct(x_pred, p.t)
         if not ok:
+            # remember where Newton's basin ended: growing right back into it wastes a
+            # corrector (measured at mu = 7: 449 failures for 762 points)
+            ceiling = BASIN_MARGIN * step
             shorten("the corrector did not converge", x_pred[n] * scale, res, it)
             continue
         w, d = xc[:n] * scale, xc[n] * scale
@@ -418,8 +426,9 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             fold.seg = tr.seg
             curve.folds.append(fold)
         curve.points.append(q)
-        step = min(ds_max, step * min(2.0, max(0.5, math.sqrt(TARGET_CORRECTION
-                                                             / max(corr, 1e-12)))))
+        step = min(ds_max, ceiling, step * min(2.0, max(0.5, math.sqrt(
+            TARGET_CORRECTION / max(corr, 1e-12)))))
+        ceiling *= CEILING_GROWTH
         if progress:
             progress(min(1.0, (d - d_start) / (d_end - d_start)))
         if direction * (d - d_end) >= 0:

@@ -9,6 +9,10 @@ from scipy import optimize
 
 from ..errors import ConvergenceError
 
+#: arclength resolution of :meth:`EquilibriumCurve.maximize`, relative to its bracket: the
+#: value at a smooth maximum is off by ~(curvature) x (this x bracket)^2, ~1e-10 relative
+MAXIMIZE_XTOL = 1e-5
+
 
 @dataclass
 class CurvePoint:
@@ -212,7 +216,7 @@ class EquilibriumCurve:
                 best[:] = [v, r[0], r[1]]
             return -v
         optimize.minimize_scalar(neg, bounds=(0.0, s1 + s2), method="bounded",
-                                 options={"xatol": 1e-7 * (s1 + s2)})
+                                 options={"xatol": MAXIMIZE_XTOL * (s1 + s2)})
         return tuple(best)
 
     def branch(self, direction, segments=False):

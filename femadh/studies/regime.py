@@ -70,6 +70,10 @@ BAND = 4.0
 GRADING = 2.0
 #: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
 EDGE_GAP = 1.5
+#: a contact edge further than this fraction of the band's half-width from its centre is
+#: not resolved (the cohesive zone, ~0.7 ell wide, reaches the graded part); exchanges keep
+#: it within ~0.55 (measured max 0.53-0.74 at mu = 3-20, band 4 ell)
+BAND_LIMIT = 0.9
 #: a contact edge beyond this fraction of the analysis radius is not resolved
 EDGE_LIMIT = 0.8
 #: observed order of the spacing error of the headline quantities (measured, see
@@ -173,6 +177,7 @@ class RegimePoint:
     n_grids: int = 1              # grids the moving band used along the curve
     accuracy: float | None = None  # the requested relative accuracy (None: explicit settings)
     failed: str | None = None      # why the point is not a converged result (None: it is)
+    band_offset: float = math.nan  # largest |contact edge - band centre| / band half-width
 
     def error(self, name):
         """Estimated absolute error of quantity ``name`` (None if it does not exist)."""
@@ -330,6 +335,13 @@ class _Setup:
         pb = curve.problem_of(q.seg)
         return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
 
+    def band_offset(self, problem, edge):
+        """|edge - band centre| / band half-width on ``problem``'s grid (0 for a fixed band
+        or the legacy grid; above 1 the edge is outside the fine band)."""
+        if self.res.legacy or self.fixed_band:
+            return 0.0
+        return abs(edge - self.centers[id(problem)]) / (self.res.band * self.ell)
+
     def regrid(self, problem, w, d):
         """A grid whose band leads the edge, once the edge has left the band's middle half."""
         if self.res.legacy or self.fixed_band:
@@ -385,7 +397,10 @@ def _read(setup, curve):
     a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
     pull_disp = force(r_folds[-1][2])(*r_folds[-1][:2]) / scale if r_folds else None
     trapping = max(pb(p.seg).node_softening_ratio(pb(p.seg).contour(p.d) - p.w) for p in pts)
-    edge = max(contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts)
+    edges = [contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts]
+    edge = max(edges)
+    band_offset = max((setup.band_offset(pb(p.seg), e) for p, e in zip(pts, edges)),
+                      default=0.0)
     return {
         "pull_off": float(pull / scale), "pull_off_displacement": pull_disp,
         "jump_in": a_folds[0] / z0 if a_folds else None,
@@ -393,6 +408,7 @@ def _read(setup, curve):
         "hysteresis": float(released / (scale * z0)),
         "hysteresis_trapezoid": float(loop / (scale * z0)),
         "trapping": float(trapping), "edge_ratio": edge / setup.a,
+        "band_offset": band_offset,
         "nodes": max(t.problem.grid.n for t in curve.tracers),
         "curves": {"curve_d": curve.d / z0, "curve_F": cf / scale,
                    "curve_stable": np.array([p.stable for p in pts]),
@@ -410,6 +426,10 @@ def _unresolved(setup, q):
                 f"-P'(h)/K_kk = {q['trapping']:.2f} > {TRAPPING_LIMIT} (nodes can snap alone: "
                 f"lattice trapping); refine the grid (spacing = {setup.res.spacing:g} ell, "
                 f"stiffness_target = {setup.res.stiffness_target}) or give accuracy=")
+    if q["band_offset"] > BAND_LIMIT:
+        return (f"mu = {setup.mu:g}: the contact edge left the fine band (|edge - centre| = "
+                f"{q['band_offset']:.2f} half-widths > {BAND_LIMIT}): the grid did not follow "
+                f"it; widen the band (band = {setup.res.band:g} ell)")
     if q["edge_ratio"] > EDGE_LIMIT:
         return (f"mu = {setup.mu:g}: the contact edge reached {q['edge_ratio']:.2f} of the "
                 f"analysis radius (limit {EDGE_LIMIT}); raise analysis_radius "
@@ -568,7 +588,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["hysteresis"], fine["hysteresis_trapezoid"], fine["n_folds"], fine["trapping"],
         fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
         fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
-        fine["n_grids"], accuracy)
+        fine["n_grids"], accuracy, band_offset=fine["band_offset"])
 
 
 def initial_spacing(accuracy, cap=None):
