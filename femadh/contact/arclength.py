@@ -287,10 +287,12 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     progress : callable(float), optional
         Called with the fraction of |d_end - d_start| covered so far.
     regrid : callable(problem, w, d) -> ContactProblem or None, optional
-        Asked after each accepted point away from folds (|dd/ds| >= REGRID_MIN_TD) for a grid
-        that suits the state better (e.g. fine around the contact edge, which has moved); the
-        state is interpolated to the new grid, solved again at the same d, and the trace goes
-        on there (a new segment of the curve: :attr:`CurvePoint.seg`). None keeps the grid.
+        Asked after each accepted point for a grid that suits the state better (e.g. fine
+        around the contact edge, which has moved); the state is interpolated to the new grid,
+        solved again (at the same d, or near a fold on the tangent's normal hyperplane: see
+        :func:`_carry_over`), and the trace goes on there (a new segment of the curve:
+        :attr:`CurvePoint.seg`; ``on_point`` sees the carried-over point too). None keeps
+        the grid; a refused exchange is recorded in ``curve.refused``.
     stop : callable(EquilibriumCurve) -> bool, optional
         Asked after each accepted point; True ends the trace there (before d_end).
     on_point : callable(int, CurvePoint), optional

@@ -22,14 +22,23 @@ elastocohesive length E* z0^2 / dg, while the contact radius grows like mu^(1/2)
 its own (lattice trapping: extra folds, an early jump-out). The grid is therefore a band of
 uniform fine spacing around the *current* contact edge, coarsening linearly with the distance
 from it (:meth:`RadialGrid.banded`), and it moves with the edge during the trace (a new grid
-when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``): the node count
+when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``, also through
+the folds, where on the JKR side the edge travels ~0.05 z0 R / ell while |dd/ds| < 0.05:
+~200 ell at mu = 20; ``band_offset`` reports how far it strayed): the node count
 no longer grows like mu^2. The lateral length that sets the spacing is the smaller of the
 elastocohesive length and sqrt(R z0 / 8) (the DMT side, where the contact is smaller than the
 cohesive zone and the law's range over the paraboloid sets the scale).
 
-Accuracy: every result carries an a-posteriori error estimate from the next coarser member of
-the grid family (spacing x 2; Richardson with the observed order 2). ``accuracy=`` chooses the
-spacing and refines until the estimate meets the request.
+Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
+grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).
+``accuracy=`` chooses the spacing from the measured error model, capped so that the coarser
+member stays below 0.075 elastocohesive lengths on the JKR side (coarser, lattice wiggles
+move the flat jump-out fold and Richardson no longer applies), and refines until the
+estimate meets the request.
+
+Stability: each fold flips it unless another Hessian mode is already negative there (at
+mu >= 5 a second mode turns negative after the jump-in and back: four folds, the piece
+between the middle two of index 2).
 """
 from dataclasses import dataclass, field, replace
 import math
@@ -595,29 +604,31 @@ def initial_spacing(accuracy, cap=None):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
     map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error, at
-    most ``cap`` (default MAX_SPACING; see :func:`_lattice_cap`)."""
-    cap = MAX_SPACING if cap is None else cap
+    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`_lattice_cap`)."""
+    cap = MAX_SPACING / COARSE_RATIO if cap is None else cap
     return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
 
 
 def _lattice_cap(mu, radius, law):
     """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
     below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
-    jump-out fold). On the DMT side (ell = sqrt(R z0 / 8) < E* z0^2 / dg: ratio > 1) the
-    fold is not flat: the cap grows like ratio^2 up to MAX_SPACING (empirical: mu = 1, ratio
-    2.8, converges like spacing^2 from 0.4 ell; mu = 2, ratio 1, lattice folds at 0.3)."""
+    jump-out fold) and below MAX_SPACING ell. On the DMT side (ell = sqrt(R z0 / 8) <
+    E* z0^2 / dg: ratio > 1) the fold is not flat: the first bound grows like ratio^2
+    (empirical: mu = 1, ratio 2.8, no lattice folds up to 0.4 ell; mu = 2, ratio 1, lattice
+    folds at 0.3)."""
     dg, z0 = law.work_of_adhesion, law.z0
     e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
     ratio = e_star_length(law, e_star) / lateral_length(law, radius, e_star)
-    return min(MAX_SPACING, LATTICE_SPACING * ratio**2 / COARSE_RATIO)
+    return min(MAX_SPACING, LATTICE_SPACING * ratio**2) / COARSE_RATIO
 
 
 #: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
 #: (hysteresis, mu = 1) and 0.02 (fixed-grip pull-off, mu = 3) for spacing <= 0.1
 C_SPACING = 0.02
-#: largest spacing an accuracy request starts from (units of ell): on the DMT side the
-#: members converge like spacing^2 from 0.4 down (mu = 0.5, 1: no lattice folds, measured)
-MAX_SPACING = 0.4
+#: largest spacing of the coarser member of an estimate (units of ell): the pull-off
+#: converges like spacing^2 below 0.2 (mu = 1: error ratios 3.9 for 0.2 -> 0.1 and 4.0 for
+#: 0.1 -> 0.05, but 2.4 for 0.3 -> 0.2 and 1.3 for 0.4 -> 0.3, measured)
+MAX_SPACING = 0.2
 #: largest band spacing in elastocohesive lengths E* z0^2 / dg for the members of an
 #: estimate: beyond it lattice wiggles spoil the flat jump-out fold (measured: mu = 3
 #: fixed-grip pull-off 1.2 % off at 0.2, 1.3e-4 at 0.1; mu = 5: 8 folds at 0.15, 38 at 0.2,
