@@ -77,6 +77,10 @@ ANALYSIS_RADIUS = 8.0
 SPACING = 0.1
 BAND = 4.0
 GRADING = 2.0
+#: above this Tabor parameter the band's half-width grows like mu: near the flat jump-out
+#: fold the two grids of an exchange disagree on the side of the fold (measured at mu = 20,
+#: band 4 ell: 43 exchanges refused while the edge travelled ~3 ell, and it left the band)
+BAND_MU = 10.0
 #: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
 EDGE_GAP = 1.5
 #: a contact edge further than this fraction of the band's half-width from its centre is
@@ -93,6 +97,9 @@ ORDER = 2.0
 HYSTERESIS_FLOOR = 0.1
 #: refinements (halvings of the spacing) an accuracy request may take
 MAX_REFINEMENTS = 4
+#: node budget of a refinement (a dense grid of N nodes costs ~N^2 per Krylov iteration at
+#: every continuation step: 1600 nodes ~ 10x the cost of 500)
+MAX_NODES = 1600
 #: the headline quantities and the accuracy they are judged by
 QUANTITIES = ("pull_off", "pull_off_displacement", "jump_in", "jump_out", "hysteresis")
 #: proven bounds of the load-controlled pull-off / (pi R dg) for a paraboloid (see
@@ -114,7 +121,8 @@ class Resolution:
     spacing : float
         Fine-band node spacing / lateral length ell (the grid family's parameter).
     band, grading : float
-        Half-width of the fine band and grading length (units of ell).
+        Half-width of the fine band (units of ell; x mu / BAND_MU beyond BAND_MU) and grading
+        length (units of ell).
     analysis_radius : float
         Analysis radius in units of Maugis' a_unit (at least sqrt(40 R z0)).
     ds_max : float or None
@@ -302,6 +310,9 @@ class _Setup:
             a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, self.e_star, dg)
             self.fixed_band = min(FINE_MARGIN * a_max, 0.5 * self.a)
         self.spacing = res.spacing * self.ell
+        # half-width of the moving band (m): wider beyond BAND_MU, where the jump-out fold is
+        # so flat that the grids' folds lie apart and exchanges are refused over a window
+        self.half = res.band * self.ell * max(1.0, mu / BAND_MU)
         self.d_end = _deepest(mu, radius, self.e_star, law)
         # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
         # its landing on the approach branch is on the curve
@@ -320,7 +331,7 @@ class _Setup:
             return _lj_problem(self.mu, self.radius, self.law.hamaker, self.z0,
                                self.res.stiffness_target or STIFFNESS_TARGET,
                                self.res.min_nodes or 120)[0]
-        half = self.res.band * self.ell
+        half = self.half
         band = ((0.0, self.fixed_band) if self.fixed_band else (center - half, center + half))
         grid = RadialGrid.banded(self.a, self.spacing, band, self.res.grading * self.ell)
         pb = ContactProblem(GreenOperator(grid, self.e_star), self.sphere, {"law": self.law},
@@ -349,7 +360,7 @@ class _Setup:
         or the legacy grid; above 1 the edge is outside the fine band)."""
         if self.res.legacy or self.fixed_band:
             return 0.0
-        return abs(edge - self.centers[id(problem)]) / (self.res.band * self.ell)
+        return abs(edge - self.centers[id(problem)]) / self.half
 
     def regrid(self, problem, w, d):
         """A grid whose band leads the edge, once the edge has left the band's middle half."""
@@ -357,7 +368,7 @@ class _Setup:
             return None
         center = self.centers[id(problem)]
         edge = contact_edge(problem, w, d, EDGE_GAP * self.z0)
-        half = self.res.band * self.ell
+        half = self.half
         if abs(edge - center) <= 0.5 * half:
             return None
         # lead the moving edge: it crosses the whole band before the next exchange
@@ -577,6 +588,11 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                           f"requested {accuracy:g} after {MAX_REFINEMENTS} refinements "
                           f"(spacing {res.spacing:g} ell)")
             raise ResolutionError(why, n_iter=attempt)
+        if why is None and 2 * fine["nodes"] > MAX_NODES:
+            raise ResolutionError(
+                f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > requested "
+                f"{accuracy:g} at spacing {res.spacing:g} ell ({fine['nodes']} nodes); the "
+                f"next refinement would exceed MAX_NODES = {MAX_NODES}", n_iter=attempt)
         if fine["edge_ratio"] > EDGE_LIMIT:
             res = replace(res, analysis_radius=1.5 * res.analysis_radius)
         else:
