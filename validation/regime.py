@@ -4,7 +4,8 @@ accuracy-vs-time table.
 ``python -m validation.regime`` writes results/regime_map.md, regime_map.csv, regime_map.png
 (load- and displacement-controlled pull-off vs Maugis-Dugdale, jumps, hysteresis) and
 results/accuracy_regime.md (requested accuracy, achieved error against a converged reference,
-estimated error, wall time). ``--mu-max`` bounds the map (default 20); ``--quick``: 5 points.
+estimated error, wall time). ``--mu-min``/``--mu-max`` bound the map (default 0.01, 20);
+``--quick``: 5 points; ``--no-accuracy-table``: the map only.
 """
 import argparse
 import csv
@@ -105,13 +106,17 @@ def accuracy_table(mus=(1.0, 3.0), accuracies=(1e-2, 1e-3, 1e-4)):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--mu-min", type=float, default=0.01)
     ap.add_argument("--mu-max", type=float, default=20.0)
+    ap.add_argument("--no-accuracy-table", action="store_true")
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore")
     RESULTS.mkdir(exist_ok=True)
-    mus = np.geomspace(0.01, args.mu_max, 5 if args.quick else 20)
+    mus = np.geomspace(args.mu_min, args.mu_max, 5 if args.quick else 20)
     t0 = time.perf_counter()
-    pts = regime_map(mus, accuracy=1e-3)
+    pts = regime_map(mus, accuracy=1e-3, progress=lambda i, p: print(
+        f"mu = {p.mu:.4g}: {'failed: ' + p.failed if p.failed else 'ok'} "
+        f"({p.wall_time:.1f} s)", flush=True))
     wall = time.perf_counter() - t0
     with open(RESULTS / "regime_map.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -133,7 +138,7 @@ machine (indicative).
 """
     (RESULTS / "regime_map.md").write_text(text)
     print(text)
-    if not args.quick:
+    if not (args.quick or args.no_accuracy_table):
         acc = accuracy_table()
         (RESULTS / "accuracy_regime.md").write_text(
             "# Accuracy on demand: the regime map (validation/regime.py)\n\nAchieved error "

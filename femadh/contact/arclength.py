@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 from scipy import linalg
-from scipy.sparse import linalg as sla
+from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
@@ -39,6 +39,9 @@ from .stability import is_positive_definite
 
 #: Newton iterations allowed per corrector
 MAX_ITER = 15
+#: a corrector whose residual stalls (falls by less than half per iteration) within this
+#: factor of the tolerance has reached the rounding floor: converged
+ROUNDING_SLACK = 10.0
 #: relative accuracy of a Newton step's linear solve (inexact Newton: ample for convergence)
 NEWTON_RTOL = 1e-4
 #: GMRES iterations before the preconditioning factorisation is refreshed (small grids); on
@@ -47,12 +50,26 @@ NEWTON_RTOL = 1e-4
 #: low-rank change that GMRES absorbs in a few iterations per changed node)
 GMRES_MAX = 8
 GMRES_PER_NODE = 25
-#: a grid may be exchanged (regrid) only where |dd/ds| exceeds this: the state is carried
-#: over at fixed d, which is well posed away from folds
+#: below this many nodes each linear solve factorises afresh: an LU costs 0.1 ms at N = 130
+#: and 0.5 ms at 260 (one BLAS thread, measured); preconditioned GMRES needs ~6-10
+#: iterations per solve here, and traces at N = 232-290 took the same time either way
+DIRECT_MAX_N = 250
+#: with direct solves the stability is verified by the Hessian every this many points
+HESSIAN_EVERY = 8
+#: a grid exchange (regrid) carries the state over at fixed d where |dd/ds| exceeds this
+#: (well posed away from folds); closer to a fold, where the problem at fixed d turns
+#: singular, on the hyperplane through the interpolated state normal to the interpolated
+#: tangent (the bordered system stays regular there), so the grid can follow the contact
+#: edge through folds: on the JKR side the edge travels ~0.05 z0 R / ell (mu = 20: ~200 ell)
+#: while |dd/ds| < 0.05
 REGRID_MIN_TD = 0.05
 #: the step length is tuned so that the corrector moves no gap by more than about this
 #: fraction of itself away from the prediction (the predictor error grows like step^2)
 TARGET_CORRECTION = 0.05
+#: after a corrector failure the step stays below this fraction of the failed one, a ceiling
+#: that then rises by CEILING_GROWTH per accepted point
+BASIN_MARGIN = 0.8
+CEILING_GROWTH = 1.05
 #: the predictor may change no gap by more than this fraction of itself (resolves the law)
 MAX_GAP_CHANGE = 0.3
 #: the smallest step length, relative to the first one, before the trace gives up
@@ -73,7 +90,8 @@ class _Bordered:
     An LU factorisation of the bordered matrix at some earlier state preconditions GMRES on the
     exact current matrix (applied as dense mat-vecs, O(N^2)). Along a curve the Jacobian changes
     slowly, so a factorisation serves many points; it is refreshed (O(N^3)) only when GMRES
-    needs more than GMRES_MAX iterations. ``n_factor`` counts refreshes.
+    needs more than ``krylov_max`` iterations. Below DIRECT_MAX_N nodes every solve factorises
+    afresh (cheaper there than the Krylov iterations). ``n_factor`` counts factorisations.
     """
 
     def __init__(self, problem, omega):
@@ -85,6 +103,7 @@ class _Bordered:
         self.n_factor = 0
         self.n_krylov = 0
         self.krylov_max = max(GMRES_MAX, self.n // GMRES_PER_NODE)
+        self.direct = self.n < DIRECT_MAX_N
 
     def matrix(self, D, t):
         n, K = self.n, self.problem.K
@@ -99,33 +118,81 @@ class _Bordered:
     def solve(self, D, t, rhs, rtol, atol=0.0):
         """x with M(D, t) x = rhs, M = [[K + diag D, -D], [kappa omega t_w, kappa t_d]],
         to rtol * |rhs| or atol (residual units: Pa), whichever is larger."""
-        n, K = self.n, self.problem.K
-        kt = self.kappa * self.omega * t[:n]
-        if self.lu is not None:
+        if self.lu is not None and not self.direct:
+            n, K = self.n, self.problem.K
+            kt = self.kappa * self.omega * t[:n]
+            ktd = self.kappa * t[n]
+
             def mv(x):
                 y = np.empty(n + 1)
                 y[:n] = K @ x[:n] + D * (x[:n] - x[n])
-                y[n] = kt @ x[:n] + self.kappa * t[n] * x[n]
+                y[n] = kt @ x[:n] + ktd * x[n]
                 return y
-            its = [0]
-
-            def count(_):
-                its[0] += 1
-
-            def pre(y):
-                return linalg.lu_solve(self.lu, y, check_finite=False)
-            # right preconditioning: GMRES then watches the true residual (Pa), not a
-            # preconditioned one in other units
-            op = sla.LinearOperator((n + 1, n + 1), matvec=lambda y: mv(pre(y)), dtype=float)
-            y, info = sla.gmres(op, rhs, rtol=rtol, atol=atol, restart=self.krylov_max, maxiter=1,
-                                callback=count, callback_type="pr_norm")
-            x = pre(y)
-            self.n_krylov += its[0]
-            if info == 0 and np.all(np.isfinite(x)):
+            x, its = _gmres(mv, self._lu_solve, rhs, max(rtol * _norm(rhs), atol),
+                            self.krylov_max)
+            self.n_krylov += its
+            if x is not None:
                 return x
-        self.lu = linalg.lu_factor(self.matrix(D, t), check_finite=False)
+        lu, piv, info = lapack.dgetrf(self.matrix(D, t), overwrite_a=True)
+        if info > 0:
+            raise ConvergenceError("bordered Jacobian is singular", residual=math.nan,
+                                   n_iter=0)
+        self.lu = (lu, piv)
         self.n_factor += 1
-        return linalg.lu_solve(self.lu, rhs, check_finite=False)
+        return self._lu_solve(rhs)
+
+    def _lu_solve(self, y):
+        return lapack.dgetrs(*self.lu, y)[0]
+
+
+def _norm(x):
+    return math.sqrt(float(x @ x))
+
+
+def _gmres(mv, pre, b, tol, m):
+    """Right-preconditioned GMRES from x = 0, no restart: x with |b - A x| <= tol (the true
+    residual, in b's units), A x = mv(x), preconditioner pre(y) ~ A^-1 y.
+
+    Returns (x, iterations), x None if m iterations do not reach tol (or break down). A
+    lean version of scipy's gmres: on a few hundred unknowns its per-call overhead (~0.3 ms)
+    exceeded the iterations' own cost.
+    """
+    beta = _norm(b)
+    if beta <= tol:
+        return np.zeros_like(b), 0
+    V = np.empty((m + 1, b.size))
+    Z = np.empty((m, b.size))
+    H = np.zeros((m + 1, m))
+    cs, sn = np.zeros(m), np.zeros(m)
+    g = np.zeros(m + 1)
+    g[0] = beta
+    V[0] = b / beta
+    for j in range(m):
+        Z[j] = pre(V[j])
+        w = mv(Z[j])
+        for _ in range(2):       # classical Gram-Schmidt, twice (as stable as modified)
+            h = V[:j + 1] @ w
+            w -= h @ V[:j + 1]
+            H[:j + 1, j] += h
+        H[j + 1, j] = h_next = _norm(w)
+        for i in range(j):       # previous Givens rotations on the new column
+            H[i, j], H[i + 1, j] = (cs[i] * H[i, j] + sn[i] * H[i + 1, j],
+                                    -sn[i] * H[i, j] + cs[i] * H[i + 1, j])
+        r = math.hypot(H[j, j], H[j + 1, j])
+        if not r > 0 or not np.isfinite(r):
+            return None, j + 1
+        cs[j], sn[j] = H[j, j] / r, H[j + 1, j] / r
+        H[j, j], H[j + 1, j] = r, 0.0
+        g[j + 1] = -sn[j] * g[j]
+        g[j] *= cs[j]
+        if abs(g[j + 1]) <= tol or j == m - 1:
+            y = linalg.solve_triangular(H[:j + 1, :j + 1], g[:j + 1], check_finite=False)
+            x = y @ Z[:j + 1]
+            if abs(g[j + 1]) <= tol and np.all(np.isfinite(x)):
+                return x, j + 1
+            return None, j + 1
+        V[j + 1] = w / h_next
+    return None, m
 
 
 class _Tracer:
@@ -157,7 +224,7 @@ class _Tracer:
         problem, n, scale, omega = self.problem, self.n, self.scale, self.omega
         self.curve.n_solves += 1
         x = x_pred.copy()
-        res = res_first = math.inf
+        res = res_first = res_prev = math.inf
         for it in range(1, MAX_ITER + 1):
             w, d = x[:n] * scale, x[n] * scale
             h = problem.contour(d) - w
@@ -165,13 +232,17 @@ class _Tracer:
                 return x, it, math.inf, False
             P = problem.pressure(h)
             res = float(np.max(np.abs(w - problem.C @ P)))   # residual of eq (6), m
+            plane = omega * (t[:n] @ (x[:n] - x_pred[:n])) + t[n] * (x[n] - x_pred[n])
+            if abs(plane) < 1e-10 and (res <= self.tol or (
+                    res <= ROUNDING_SLACK * self.tol and res > 0.5 * res_prev)):
+                # (the second: stalled within ROUNDING_SLACK of tol, the floor of the
+                # residual's rounding: measured ~1e-19 m at mu = 13, N = 600)
+                return x, it, res, True
             if it == 1:
                 res_first = res
             elif res > 4 * res_first or (it >= 8 and res > 1e-3 * res_first):
                 return x, it, res, False  # diverging or crawling: a shorter step does better
-            plane = omega * (t[:n] @ (x[:n] - x_pred[:n])) + t[n] * (x[n] - x_pred[n])
-            if res <= self.tol and abs(plane) < 1e-10:
-                return x, it, res, True
+            res_prev = res
             rhs = np.concatenate([P - problem.K @ w, [-self.lin.kappa * plane * scale]])
             # (dw, dd) in m; the step need not be more accurate than a fraction of tol (the
             # residual near convergence is rounding noise a relative criterion cannot meet)
@@ -195,6 +266,13 @@ def _hessian_stable(problem, w, d):
     return is_positive_definite(problem.energy_hessian(problem.contour(d) - w))
 
 
+def _negative_modes(problem, w, d):
+    """Negative eigenvalues of the energy Hessian at a fold state other than the one closest
+    to zero (the mode that crosses zero there)."""
+    ev = linalg.eigvalsh(problem.energy_hessian(problem.contour(d) - w), check_finite=False)
+    return int(np.sum(ev < 0) - (ev[np.argmin(np.abs(ev))] < 0))
+
+
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
                 max_points=5000, progress=None, regrid=None, stop=None, on_point=None):
     """Follow the equilibrium curve from separation d_start until it passes d_end (m).
@@ -206,7 +284,8 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     d_start, d_end : float
         Separations (m) where the curve starts (solved there first) and where it ends.
     tol : float
-        Residual of eq (6) every point meets (m).
+        Residual of eq (6) every point meets (m) (up to ROUNDING_SLACK times it where the
+        residual stalls at its rounding floor).
     scale : float
         Length (m) of one unit of arclength (e.g. z0).
     ds : float
@@ -216,10 +295,12 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     progress : callable(float), optional
         Called with the fraction of |d_end - d_start| covered so far.
     regrid : callable(problem, w, d) -> ContactProblem or None, optional
-        Asked after each accepted point away from folds (|dd/ds| >= REGRID_MIN_TD) for a grid
-        that suits the state better (e.g. fine around the contact edge, which has moved); the
-        state is interpolated to the new grid, solved again at the same d, and the trace goes
-        on there (a new segment of the curve: :attr:`CurvePoint.seg`). None keeps the grid.
+        Asked after each accepted point for a grid that suits the state better (e.g. fine
+        around the contact edge, which has moved); the state is interpolated to the new grid,
+        solved again (at the same d, or near a fold on the tangent's normal hyperplane: see
+        :func:`_carry_over`), and the trace goes on there (a new segment of the curve:
+        :attr:`CurvePoint.seg`; ``on_point`` sees the carried-over point too). None keeps
+        the grid; a refused exchange is recorded in ``curve.refused``.
     stop : callable(EquilibriumCurve) -> bool, optional
         Asked after each accepted point; True ends the trace there (before d_end).
     on_point : callable(int, CurvePoint), optional
@@ -265,6 +346,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
     if on_point:
         on_point(0, curve.points[0])
     step, ds_min = ds, ds * MIN_STEP_FRACTION
+    ceiling = math.inf      # step length below the last one whose corrector failed
     weights = np.r_[np.full(n, tr.omega), 1.0]
 
     def fail(msg, d, res, it):
@@ -302,6 +384,9 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         attempts += 1
         xc, it, res, ok = tr.correct(x_pred, p.t)
         if not ok:
+            # remember where Newton's basin ended: growing right back into it wastes a
+            # corrector (measured at mu = 7: 449 failures for 762 points)
+            ceiling = BASIN_MARGIN * step
             shorten("the corrector did not converge", x_pred[n] * scale, res, it)
             continue
         w, d = xc[:n] * scale, xc[n] * scale
@@ -325,10 +410,19 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             continue
         folded = p.t_d * t[n] < 0
         stable = p.stable != folded
-        # (not next to a fold: there the symmetric energy Hessian and the collocation
-        # Jacobian, whose singularity defines the fold, turn singular at slightly different
-        # points, an O(h) asymmetry of the discretisation)
-        if tr.lin.n_factor != factors and not (folded or check_next):
+        fold = _locate_fold(tr, p, step, len(curve.points) - 1) if folded else None
+        if stable and folded and _negative_modes(problem, fold.w, fold.d) > 0:
+            # the mode crossing zero at this fold was not the only negative one: the curve
+            # passes from one unstable branch to another (index 1 -> 2; measured at mu = 5-20
+            # after the jump-in, a second mode turns negative), not back to a stable one
+            stable = False
+        # (checked when GMRES needed a fresh factorisation, or every HESSIAN_EVERY points
+        # with direct solves; not next to a fold: there the symmetric energy Hessian and the
+        # collocation Jacobian, whose singularity defines the fold, turn singular at slightly
+        # different points, an O(h) asymmetry of the discretisation)
+        due = (len(curve.points) % HESSIAN_EVERY == 0 if tr.lin.direct
+               else tr.lin.n_factor != factors)
+        if due and not (folded or check_next):
             if _hessian_stable(problem, w, d) != stable:
                 # likely two folds inside the step (resolve them); at the smallest step a
                 # bifurcation, which this continuation does not follow
@@ -339,12 +433,12 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         attempts = 0
         q = CurvePoint(d, w, t, stable, it, res, tr.seg)
         if folded:
-            fold = _locate_fold(tr, p, step, len(curve.points) - 1)
             fold.seg = tr.seg
             curve.folds.append(fold)
         curve.points.append(q)
-        step = min(ds_max, step * min(2.0, max(0.5, math.sqrt(TARGET_CORRECTION
-                                                             / max(corr, 1e-12)))))
+        step = min(ds_max, ceiling, step * min(2.0, max(0.5, math.sqrt(
+            TARGET_CORRECTION / max(corr, 1e-12)))))
+        ceiling *= CEILING_GROWTH
         if progress:
             progress(min(1.0, (d - d_start) / (d_end - d_start)))
         if direction * (d - d_end) >= 0:
@@ -357,7 +451,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         if len(curve.points) >= max_points:
             raise fail(f"arclength continuation needed more than {max_points} points",
                        d, res, it)
-        if regrid is not None and abs(t[n]) >= REGRID_MIN_TD:
+        if regrid is not None:
             new = regrid(problem, w, d)
             moved = None if new is None else _carry_over(new, q, tr, scale, tol, curve)
             if moved is not None:
@@ -388,24 +482,44 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
 
 
 def _carry_over(problem, q, tr, scale, tol, curve):
-    """Point q (on tracer tr's grid) carried to ``problem``'s grid: w and the tangent
-    interpolated in r, the state solved again at the same d, its stability checked by the
-    Hessian. Returns (new tracer, new CurvePoint), or None (the old grid is kept) if the
-    solve fails or the stability differs (the new grid does not resolve the state)."""
+    """Point q (on tracer tr's grid) carried to ``problem``'s grid.
+
+    w and the tangent are interpolated in r and the state is solved again on the new grid:
+    at the same d away from folds (|dd/ds| >= REGRID_MIN_TD; the seam is then at one d), else
+    on the hyperplane through the interpolated state normal to the interpolated tangent (at
+    a fold the problem at fixed d is singular, the bordered one is not; d moves by the grids'
+    difference times |dd/ds|). The new state must lie on the same side of every fold as q
+    (dd/ds of the same sign) and, away from folds, have q's stability by the Hessian.
+
+    Returns (new tracer, new CurvePoint), or None (the old grid is kept; the reason is
+    appended to ``curve.refused``).
+    """
     r_old, r_new = tr.problem.grid.nodes, problem.grid.nodes
     n = problem.grid.n
     w = np.interp(r_new, r_old, q.w)
-    t_w = np.interp(r_new, r_old, q.t[:-1])
-    fixed_d = np.zeros(n + 1)
-    fixed_d[n] = 1.0
+    t_old = np.r_[np.interp(r_new, r_old, q.t[:-1]), q.t[-1]]
+    near_fold = abs(q.t_d) < REGRID_MIN_TD
+    if near_fold:
+        normal = t_old
+    else:
+        normal = np.zeros(n + 1)
+        normal[n] = 1.0
     new = _Tracer(problem, scale, tol, curve)
-    xc, it, res, ok = new.correct(np.r_[w, q.d] / scale, fixed_d)
-    if not ok or _hessian_stable(problem, xc[:n] * scale, q.d) != q.stable:
+    xc, it, res, ok = new.correct(np.r_[w, q.d] / scale, normal)
+    if not ok:
+        curve.refused.append((q.d, f"corrector: residual {res:.3g} m after {it} iterations"))
         return None
-    w = xc[:n] * scale
+    w, d = xc[:n] * scale, xc[n] * scale
+    t = new.tangent(w, d, t_old)
+    if t[-1] * q.t_d < 0:
+        curve.refused.append((q.d, f"a fold between the grids (dd/ds {q.t_d:.3g} -> "
+                                   f"{t[-1]:.3g})"))
+        return None
+    if not near_fold and _hessian_stable(problem, w, d) != q.stable:
+        curve.refused.append((q.d, "stability differs on the new grid"))
+        return None
     new.register()
-    t = new.tangent(w, q.d, np.r_[t_w, q.t[-1]])
-    return new, CurvePoint(q.d, w, t, q.stable, it, res, new.seg)
+    return new, CurvePoint(d, w, t, q.stable, it, res, new.seg)
 
 
 def _locate_fold(tr, p, step, index):

@@ -9,6 +9,10 @@ from scipy import optimize
 
 from ..errors import ConvergenceError
 
+#: arclength resolution of :meth:`EquilibriumCurve.maximize`, relative to its bracket: the
+#: value at a smooth maximum is off by ~(curvature) x (this x bracket)^2, ~1e-10 relative
+MAXIMIZE_XTOL = 1e-5
+
 
 @dataclass
 class CurvePoint:
@@ -45,7 +49,8 @@ class EquilibriumCurve:
 
     A curve traced on a grid that moves with the contact edge is made of segments, one per
     grid (``tracers[k].problem``); consecutive points of different segments are the same
-    equilibrium at the same d on two grids (a seam), not an interval of the curve.
+    equilibrium on two grids (a seam: at the same d, or near a fold at d differing by the
+    grids' difference), not an interval of the curve.
     """
 
     points: list = field(default_factory=list)
@@ -55,6 +60,7 @@ class EquilibriumCurve:
     n_krylov: int = 0
     wall_time: float = 0.0
     tracers: list = field(default_factory=list)
+    refused: list = field(default_factory=list)   # (d, why) of grid exchanges not made
 
     @property
     def _tracer(self):
@@ -119,7 +125,11 @@ class EquilibriumCurve:
             d_f = self.folds[k_fold].d
             out.append(("fold", k_fold, None))
             landing = None
-            for r in runs:
+            # the nearest stable piece along the curve first: past a lattice micro-loop (a
+            # fold pair as the edge crosses a node, d within ~1e-4 z0) the surface descends
+            # to the adjacent piece of the same branch, not to a distant branch at that d
+            k_at = self.folds[k_fold].index
+            for r in sorted(runs, key=lambda r: min(abs(r[0] - k_at), abs(r[1] - k_at))):
                 if r in visited:
                     continue
                 # a stable branch's pieces: fold -> first point, point -> point, last -> fold
@@ -190,11 +200,15 @@ class EquilibriumCurve:
         """Largest value(d, w) on the curve between points i-1 and i+1 (bounded search in
         arclength; each evaluation is a corrected point). Returns (value, d, w)."""
         pts = self.points
-        s1, s2 = self._dist(pts[i - 1], pts[i]), self._dist(pts[i], pts[i + 1])
+        # a seam is no interval of the curve: search only the neighbours on point i's grid
+        s1 = 0.0 if self._seam(i - 1) else self._dist(pts[i - 1], pts[i])
+        s2 = 0.0 if self._seam(i) else self._dist(pts[i], pts[i + 1])
         best = [value(pts[i].d, pts[i].w), pts[i].d, pts[i].w]
+        if s1 + s2 == 0.0:
+            return tuple(best)
 
         def neg(s):
-            r = self._on_curve(*((pts[i - 1], s) if s <= s1 else (pts[i], s - s1)))
+            r = self._on_curve(*((pts[i - 1], s) if s < s1 else (pts[i], s - s1)))
             if r is None:
                 return -best[0]
             v = value(*r)
@@ -202,7 +216,7 @@ class EquilibriumCurve:
                 best[:] = [v, r[0], r[1]]
             return -v
         optimize.minimize_scalar(neg, bounds=(0.0, s1 + s2), method="bounded",
-                                 options={"xatol": 1e-7 * (s1 + s2)})
+                                 options={"xatol": MAXIMIZE_XTOL * (s1 + s2)})
         return tuple(best)
 
     def branch(self, direction, segments=False):

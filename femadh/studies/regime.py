@@ -22,14 +22,23 @@ elastocohesive length E* z0^2 / dg, while the contact radius grows like mu^(1/2)
 its own (lattice trapping: extra folds, an early jump-out). The grid is therefore a band of
 uniform fine spacing around the *current* contact edge, coarsening linearly with the distance
 from it (:meth:`RadialGrid.banded`), and it moves with the edge during the trace (a new grid
-when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``): the node count
+when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``, also through
+the folds, where on the JKR side the edge travels ~0.05 z0 R / ell while |dd/ds| < 0.05:
+~200 ell at mu = 20; ``band_offset`` reports how far it strayed): the node count
 no longer grows like mu^2. The lateral length that sets the spacing is the smaller of the
 elastocohesive length and sqrt(R z0 / 8) (the DMT side, where the contact is smaller than the
 cohesive zone and the law's range over the paraboloid sets the scale).
 
-Accuracy: every result carries an a-posteriori error estimate from the next coarser member of
-the grid family (spacing x 2; Richardson with the observed order 2). ``accuracy=`` chooses the
-spacing and refines until the estimate meets the request.
+Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
+grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).
+``accuracy=`` chooses the spacing from the measured error model, capped so that the coarser
+member stays below 0.075 elastocohesive lengths on the JKR side (coarser, lattice wiggles
+move the flat jump-out fold and Richardson no longer applies), and refines until the
+estimate meets the request.
+
+Stability: each fold flips it unless another Hessian mode is already negative there (at
+mu >= 5 a second mode turns negative after the jump-in and back: four folds, the piece
+between the middle two of index 2).
 """
 from dataclasses import dataclass, field, replace
 import math
@@ -68,8 +77,16 @@ ANALYSIS_RADIUS = 8.0
 SPACING = 0.1
 BAND = 4.0
 GRADING = 2.0
+#: above this Tabor parameter the band's half-width grows like mu: near the flat jump-out
+#: fold the two grids of an exchange disagree on the side of the fold (measured at mu = 20,
+#: band 4 ell: 43 exchanges refused while the edge travelled ~3 ell, and it left the band)
+BAND_MU = 10.0
 #: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
 EDGE_GAP = 1.5
+#: a contact edge further than this fraction of the band's half-width from its centre is
+#: not resolved (the cohesive zone, ~0.7 ell wide, reaches the graded part); exchanges keep
+#: it within ~0.55 (measured max 0.53-0.74 at mu = 3-20, band 4 ell)
+BAND_LIMIT = 0.9
 #: a contact edge beyond this fraction of the analysis radius is not resolved
 EDGE_LIMIT = 0.8
 #: observed order of the spacing error of the headline quantities (measured, see
@@ -80,6 +97,9 @@ ORDER = 2.0
 HYSTERESIS_FLOOR = 0.1
 #: refinements (halvings of the spacing) an accuracy request may take
 MAX_REFINEMENTS = 4
+#: node budget of a refinement (a dense grid of N nodes costs ~N^2 per Krylov iteration at
+#: every continuation step: 1600 nodes ~ 10x the cost of 500)
+MAX_NODES = 1600
 #: the headline quantities and the accuracy they are judged by
 QUANTITIES = ("pull_off", "pull_off_displacement", "jump_in", "jump_out", "hysteresis")
 #: proven bounds of the load-controlled pull-off / (pi R dg) for a paraboloid (see
@@ -101,7 +121,8 @@ class Resolution:
     spacing : float
         Fine-band node spacing / lateral length ell (the grid family's parameter).
     band, grading : float
-        Half-width of the fine band and grading length (units of ell).
+        Half-width of the fine band (units of ell; x mu / BAND_MU beyond BAND_MU) and grading
+        length (units of ell).
     analysis_radius : float
         Analysis radius in units of Maugis' a_unit (at least sqrt(40 R z0)).
     ds_max : float or None
@@ -173,6 +194,7 @@ class RegimePoint:
     n_grids: int = 1              # grids the moving band used along the curve
     accuracy: float | None = None  # the requested relative accuracy (None: explicit settings)
     failed: str | None = None      # why the point is not a converged result (None: it is)
+    band_offset: float = math.nan  # largest |contact edge - band centre| / band half-width
 
     def error(self, name):
         """Estimated absolute error of quantity ``name`` (None if it does not exist)."""
@@ -288,6 +310,9 @@ class _Setup:
             a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, self.e_star, dg)
             self.fixed_band = min(FINE_MARGIN * a_max, 0.5 * self.a)
         self.spacing = res.spacing * self.ell
+        # half-width of the moving band (m): wider beyond BAND_MU, where the jump-out fold is
+        # so flat that the grids' folds lie apart and exchanges are refused over a window
+        self.half = res.band * self.ell * max(1.0, mu / BAND_MU)
         self.d_end = _deepest(mu, radius, self.e_star, law)
         # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
         # its landing on the approach branch is on the curve
@@ -306,7 +331,7 @@ class _Setup:
             return _lj_problem(self.mu, self.radius, self.law.hamaker, self.z0,
                                self.res.stiffness_target or STIFFNESS_TARGET,
                                self.res.min_nodes or 120)[0]
-        half = self.res.band * self.ell
+        half = self.half
         band = ((0.0, self.fixed_band) if self.fixed_band else (center - half, center + half))
         grid = RadialGrid.banded(self.a, self.spacing, band, self.res.grading * self.ell)
         pb = ContactProblem(GreenOperator(grid, self.e_star), self.sphere, {"law": self.law},
@@ -330,13 +355,20 @@ class _Setup:
         pb = curve.problem_of(q.seg)
         return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
 
+    def band_offset(self, problem, edge):
+        """|edge - band centre| / band half-width on ``problem``'s grid (0 for a fixed band
+        or the legacy grid; above 1 the edge is outside the fine band)."""
+        if self.res.legacy or self.fixed_band:
+            return 0.0
+        return abs(edge - self.centers[id(problem)]) / self.half
+
     def regrid(self, problem, w, d):
         """A grid whose band leads the edge, once the edge has left the band's middle half."""
         if self.res.legacy or self.fixed_band:
             return None
         center = self.centers[id(problem)]
         edge = contact_edge(problem, w, d, EDGE_GAP * self.z0)
-        half = self.res.band * self.ell
+        half = self.half
         if abs(edge - center) <= 0.5 * half:
             return None
         # lead the moving edge: it crosses the whole band before the next exchange
@@ -385,7 +417,10 @@ def _read(setup, curve):
     a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
     pull_disp = force(r_folds[-1][2])(*r_folds[-1][:2]) / scale if r_folds else None
     trapping = max(pb(p.seg).node_softening_ratio(pb(p.seg).contour(p.d) - p.w) for p in pts)
-    edge = max(contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts)
+    edges = [contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts]
+    edge = max(edges)
+    band_offset = max((setup.band_offset(pb(p.seg), e) for p, e in zip(pts, edges)),
+                      default=0.0)
     return {
         "pull_off": float(pull / scale), "pull_off_displacement": pull_disp,
         "jump_in": a_folds[0] / z0 if a_folds else None,
@@ -393,6 +428,7 @@ def _read(setup, curve):
         "hysteresis": float(released / (scale * z0)),
         "hysteresis_trapezoid": float(loop / (scale * z0)),
         "trapping": float(trapping), "edge_ratio": edge / setup.a,
+        "band_offset": band_offset,
         "nodes": max(t.problem.grid.n for t in curve.tracers),
         "curves": {"curve_d": curve.d / z0, "curve_F": cf / scale,
                    "curve_stable": np.array([p.stable for p in pts]),
@@ -410,6 +446,10 @@ def _unresolved(setup, q):
                 f"-P'(h)/K_kk = {q['trapping']:.2f} > {TRAPPING_LIMIT} (nodes can snap alone: "
                 f"lattice trapping); refine the grid (spacing = {setup.res.spacing:g} ell, "
                 f"stiffness_target = {setup.res.stiffness_target}) or give accuracy=")
+    if q["band_offset"] > BAND_LIMIT:
+        return (f"mu = {setup.mu:g}: the contact edge left the fine band (|edge - centre| = "
+                f"{q['band_offset']:.2f} half-widths > {BAND_LIMIT}): the grid did not follow "
+                f"it; widen the band (band = {setup.res.band:g} ell)")
     if q["edge_ratio"] > EDGE_LIMIT:
         return (f"mu = {setup.mu:g}: the contact edge reached {q['edge_ratio']:.2f} of the "
                 f"analysis radius (limit {EDGE_LIMIT}); raise analysis_radius "
@@ -533,7 +573,8 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
         if "spacing" not in over and not res.legacy:
-            res = replace(res, spacing=initial_spacing(accuracy))
+            res = replace(res, spacing=initial_spacing(accuracy, _lattice_cap(mu, radius,
+                                                                               law)))
     coarse, ratio = _coarse_member(mu, radius, law, res, tol)
     for attempt in range(MAX_REFINEMENTS + 1):
         fine = _solve(mu, radius, law, res, tol, progress)
@@ -547,6 +588,11 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                           f"requested {accuracy:g} after {MAX_REFINEMENTS} refinements "
                           f"(spacing {res.spacing:g} ell)")
             raise ResolutionError(why, n_iter=attempt)
+        if why is None and 2 * fine["nodes"] > MAX_NODES:
+            raise ResolutionError(
+                f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > requested "
+                f"{accuracy:g} at spacing {res.spacing:g} ell ({fine['nodes']} nodes); the "
+                f"next refinement would exceed MAX_NODES = {MAX_NODES}", n_iter=attempt)
         if fine["edge_ratio"] > EDGE_LIMIT:
             res = replace(res, analysis_radius=1.5 * res.analysis_radius)
         else:
@@ -567,22 +613,44 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["hysteresis"], fine["hysteresis_trapezoid"], fine["n_folds"], fine["trapping"],
         fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
         fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
-        fine["n_grids"], accuracy)
+        fine["n_grids"], accuracy, band_offset=fine["band_offset"])
 
 
-def initial_spacing(accuracy):
+def initial_spacing(accuracy, cap=None):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
-    map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error."""
-    return min(MAX_SPACING, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+    map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error, at
+    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`_lattice_cap`)."""
+    cap = MAX_SPACING / COARSE_RATIO if cap is None else cap
+    return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
+
+
+def _lattice_cap(mu, radius, law):
+    """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
+    below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
+    jump-out fold) and below MAX_SPACING ell. On the DMT side (ell = sqrt(R z0 / 8) <
+    E* z0^2 / dg: ratio > 1) the fold is not flat: the first bound grows like ratio^2
+    (empirical: mu = 1, ratio 2.8, no lattice folds up to 0.4 ell; mu = 2, ratio 1, lattice
+    folds at 0.3)."""
+    dg, z0 = law.work_of_adhesion, law.z0
+    e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
+    ratio = e_star_length(law, e_star) / lateral_length(law, radius, e_star)
+    return min(MAX_SPACING, LATTICE_SPACING * ratio**2) / COARSE_RATIO
 
 
 #: measured error constant of the banded family: rel_err ~ C spacing^2 with C up to 0.016
 #: (hysteresis, mu = 1) and 0.02 (fixed-grip pull-off, mu = 3) for spacing <= 0.1
 C_SPACING = 0.02
-#: largest spacing an accuracy request starts from: beyond ~0.1 ell the fixed-grip jump-out
-#: is not yet in the asymptotic range (mu = 3: 1.2 % off at 0.2, 1.3e-4 at 0.1)
-MAX_SPACING = 0.1
+#: largest spacing of the coarser member of an estimate (units of ell): the pull-off
+#: converges like spacing^2 below 0.2 (mu = 1: error ratios 3.9 for 0.2 -> 0.1 and 4.0 for
+#: 0.1 -> 0.05, but 2.4 for 0.3 -> 0.2 and 1.3 for 0.4 -> 0.3, measured)
+MAX_SPACING = 0.2
+#: largest band spacing in elastocohesive lengths E* z0^2 / dg for the members of an
+#: estimate: beyond it lattice wiggles spoil the flat jump-out fold (measured: mu = 3
+#: fixed-grip pull-off 1.2 % off at 0.2, 1.3e-4 at 0.1; mu = 5: 8 folds at 0.15, 38 at 0.2,
+#: the physical 4 at 0.1; mu = 2: on the spacing^2 line within 4e-6 up to 0.08, 4e-5 off
+#: it at 0.1)
+LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
 
