@@ -106,8 +106,13 @@ def _parser():
                     "parameters mu = (R dg^2/(E*^2 z0^3))^(1/3); writes regime.csv (pull-off / "
                     "pi R dg vs Maugis-Dugdale, jump-in/out d / z0, hysteresis), "
                     "regime_map.png and regime_curves.png.")
-    rg.add_argument("--mu", type=float, nargs=2, default=(0.1, 5.0), metavar=("FROM", "TO"),
-                    help="Tabor parameter range (default 0.1 5)")
+    rg.add_argument("--mu", type=float, nargs=2, default=(0.01, 5.0), metavar=("FROM", "TO"),
+                    help="Tabor parameter range (default 0.01 5: under a minute; up to 20 works, "
+                         "the points above 5 take minutes each)")
+    rg.add_argument("--accuracy", type=float, default=1e-3,
+                    help="relative accuracy of every point's pull-offs, jumps and hysteresis "
+                         "(default 1e-3; 0: the fixed default spacing, whose error estimates "
+                         "are unreliable for mu >= 2)")
     rg.add_argument("--points", type=int, default=20, help="log-spaced points (default 20)")
     rg.add_argument("--radius", default="1 um", help="sphere radius (default '1 um')")
     rg.add_argument("--hamaker", default="1e-19 J", help="Hamaker constant (default '1e-19 J')")
@@ -304,6 +309,8 @@ def _regime(args):
         raise SceneError("command line", "--mu", list(args.mu), "0 < FROM < TO")
     if args.points < 1:
         raise SceneError("command line", "--points", args.points, "an integer >= 1")
+    if not (0 <= args.accuracy <= 0.1):
+        raise SceneError("command line", "--accuracy", args.accuracy, "a number in [0, 0.1]")
     kw = {k: to_si(getattr(args, a), dim, file="command line", key=f"--{a}")
           for k, a, dim in (("radius", "radius", "length"), ("hamaker", "hamaker", "energy"),
                             ("z0", "z0", "length"))}
@@ -315,7 +322,7 @@ def _regime(args):
         say = default_progress()
         pts = regime_map(mus, progress=(lambda i, p: say(
             f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
-            if say else None, **kw)
+            if say else None, accuracy=args.accuracy or None, **kw)
         path = write_regime(pts, args.out)
     print(path.read_text(), end="")
     print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")

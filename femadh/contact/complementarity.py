@@ -59,25 +59,13 @@ def _residual(problem, w, p_net):
 DISK_MARGIN_FRACTION = 0.05
 
 
-#: a branch-guarded solve gives up once the iterate has moved some gap by more than
-#: BRANCH_EXIT_FRACTION of the predicted gap, BRANCH_EXIT_PATIENCE iterations in a row: it is
-#: heading for another branch, which the continuation rejects anyway (it accepts 1/4 of the gap,
-#: stepping.MAX_CORRECTION_FRACTION); without the guard such a solve ran its whole budget with a
-#: refactorisation per iteration (a snap-in at N = 1200: 40 iterations, 16 s per attempt)
-BRANCH_EXIT_FRACTION, BRANCH_EXIT_PATIENCE = 0.25, 3
-
-
-def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
-                          branch_guard=False):
+def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None):
     """Equilibrium at separation d (m) from displacements w0 (m): semismooth Newton on the
     sigma-gap complementarity problem (without a gap, Newton on eq 6).
 
     Returns a :class:`State` whose ``converged`` flag tells whether ``residual <= tol`` was
     reached within ``max_iter`` iterations; never raises for non-convergence (the continuation
     decides what to do). ``active0`` is the predicted active set.
-
-    ``branch_guard``: the solve continues a branch from the prediction ``w0`` and gives up
-    (not converged) once it has clearly left it (see BRANCH_EXIT_FRACTION).
 
     ``factor`` = (lu, inactive mask) of an earlier Jacobian: while the active set equals that
     mask the factorisation is reused (chord steps), and refreshed only when the residual stops
@@ -103,8 +91,6 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         lu, lu_I = factor if factor is not None else (None, None)
     fresh = False
     res, res_prev, it = math.inf, math.inf, 0
-    w_pred, h_pred = (w.copy(), np.maximum(b - w, 0.0)) if branch_guard else (None, None)
-    away = 0
     for it in range(1, max_iter + 1):
         if sigma is not None:
             w[A] = b[A] - sigma
@@ -167,11 +153,6 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         if not np.array_equal(new_A, A):
             res = math.inf
         A = new_A
-        if branch_guard:
-            left = np.any(np.abs(w - w_pred) > BRANCH_EXIT_FRACTION * h_pred + 1e-15)
-            away = away + 1 if left else 0
-            if away >= BRANCH_EXIT_PATIENCE:
-                break
     h = b - w
     pc = np.zeros(n)
     if sigma is not None and np.all(h[~A] > 0):

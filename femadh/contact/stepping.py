@@ -183,9 +183,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             sweep.d_current = d_try
             w_pred, act = _predict(problem, state, d_try)
             new = solve_complementarity(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
-                                        active0=act, factor=state.lu,
-                                        # the fold itself is decided by a full solve
-                                        branch_guard=abs(step) > min_step * 1.5)
+                                        active0=act, factor=state.lu)
             sweep.n_solves += 1
             if _accept(new, w_pred, d_try):
                 state = new
