@@ -3,6 +3,7 @@ existing file as the output folder. Every fault ends in one clear line and loses
 state; a resumed run gives the states an uninterrupted one gives."""
 import json
 import os
+import re
 from pathlib import Path
 import signal
 import subprocess
@@ -93,6 +94,73 @@ def test_signal_stops_cleanly_and_resume_completes(tmp_path, sig, code):
     assert p.returncode == 0, err
     assert json.loads((out / "summary.json").read_text())["status"] == "converged"
     assert check_curve_against_fields(out) == 702
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_fe_run_interrupted_keeps_its_vtk_consistent_and_resumes(tmp_path):
+    """An FE run with VTK, stopped by SIGTERM and resumed: the .pvd collections list exactly
+    the committed states (the resumed run keeps the earlier entries), every listed file
+    exists and opens, and the curve equals an uninterrupted run's."""
+    import meshio
+
+    text = (ROOT / "validation" / "scenes" / "paper1_fig3_fe.toml").read_text()
+    text = text.replace("nodes = 200", "nodes = 60").replace('step = "0.2 nm"',
+                                                              'step = "0.05 nm"')
+    scene = tmp_path / "fe.toml"
+    scene.write_text(text)
+    out = tmp_path / "out"
+    p = start(scene, out)
+    wait_rows(out, 15, p)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143, err
+    p = start(scene, out, "--resume")
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    n = check_curve_against_fields(out)
+    c = read_curve(out / "curve.csv")
+    listed = 0
+    for branch in ("approach", "retract"):
+        text = (out / f"{branch}.pvd").read_text()
+        files = re.findall(r'file="([^"]+)"', text)
+        states = sorted({int(x) for x in re.findall(r'timestep="(\d+)"', text)})
+        assert states == [int(k) for k, b in zip(c["state"], c["branch"]) if b == branch]
+        assert len(files) == 2 * len(states)
+        for f in files[:2] + files[-2:]:
+            assert len(meshio.read(out / f).points) > 0
+        listed += len(states)
+    assert listed == n
+    assert not list((out / "vtk").glob(".*"))          # no temporary file left behind
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_arclength_run_interrupted_is_traced_again_on_resume(tmp_path):
+    """An arclength trace stopped by SIGINT keeps its streamed points consistent; --resume
+    traces the curve again from its start (its paths are read off the whole curve) and says
+    so, ending equal to an uninterrupted run."""
+    text = (ROOT / "validation" / "scenes" / "lj_sphere_mu2_arclength.toml").read_text()
+    scene = tmp_path / "arc.toml"
+    scene.write_text(text.replace('step = "0.1 nm"', 'step = "0.004 nm"'))
+    out = tmp_path / "out"
+    p = start(scene, out)
+    t0 = time.time()
+    eq = out / "equilibrium_curve.csv"
+    while not (eq.exists() and eq.read_text().count("\n") > 30):
+        assert p.poll() is None and time.time() - t0 < 60, "the trace ended before 30 points"
+        time.sleep(0.05)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted"
+    rows = eq.read_text().splitlines()
+    assert len(rows) > 30 and all(r.count(",") == rows[0].count(",") for r in rows)
+    p = start(scene, out, "--resume")
+    _, err = p.communicate(timeout=180)
+    assert p.returncode == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "converged"
+    assert any("traced again from its start" in w for w in summary["warnings"])
     assert_same_as_uninterrupted(scene, out)
 
 

@@ -29,36 +29,38 @@ HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
 SCENE = HERE / "scenes" / "paper1_slider_meniscus.toml"
 MAP = {"effects.asperity_gap.sigma": "0.3 nm..2 nm:10",
-       "effects.capillary.relative_pressure": "0.05..0.95:10"}
-SCALING = {"effects.asperity_gap.sigma": "0.3 nm..2 nm:6",
-           "effects.capillary.relative_pressure": "0.2..0.8:4"}
+       "effects.capillary.relative_pressure": "0.05..0.95:10",
+       # from well above the largest sigma, so that every peak lies inside the sweep
+       "sweep.start": "4 nm"}
+SCALING = {"effects.asperity_gap.sigma": "0.6 nm..2 nm:6",
+           "effects.capillary.relative_pressure": "0.2..0.8:4", "sweep.start": "4 nm"}
 
 
 def stiction_map(out):
+    """The map at the scene's N (points femadh refuses keep their reason)."""
     scene = femadh.load_scene(SCENE)
     t0 = time.perf_counter()
     points, records = run_study(scene, MAP, out, workers=2, progress=True)
     wall = time.perf_counter() - t0
-    sig = sorted({p.scene.gap.sigma for p in points})
+
     def rel_of(p):
         return float(p.scene.raw["effects"]["capillary"]["relative_pressure"])
 
+    sig = sorted({p.scene.gap.sigma for p in points})
     rel = sorted({rel_of(p) for p in points})
     F = np.full((len(rel), len(sig)), math.nan)
     E = np.full_like(F, math.nan)
     fails = []
     gamma = points[0].scene.effects["capillary"].surface_tension
-    R = scene.sphere.radius
     for p in points:
-        i = rel.index(rel_of(p))
-        j = sig.index(p.scene.gap.sigma)
+        i, j = rel.index(rel_of(p)), sig.index(p.scene.gap.sigma)
         rec = records[p.id]
         if rec.get("status") == "converged":
             F[i, j] = rec["max_adhesion_N"]
             E[i, j] = rec.get("max_adhesion_N_error", math.nan)
         else:
-            fails.append((p.changes, rec.get("error")))
-    norm = 4 * math.pi * R * gamma
+            fails.append((p.scene.gap.sigma, rel_of(p), rec.get("error")))
+    norm = 4 * math.pi * scene.sphere.radius * gamma
     return sig, rel, F, E, norm, wall, fails, len(points)
 
 
@@ -72,6 +74,12 @@ def figure(sig, rel, F, norm, png):
     s_nm = np.asarray(sig) * 1e9
     m = a1.pcolormesh(s_nm, rel, F / norm, shading="nearest", cmap="magma")
     fig.colorbar(m, ax=a1, label=r"max adhesion / $4\pi R\gamma$")
+    bad = ~np.isfinite(F)
+    if bad.any():
+        ii, jj = np.nonzero(bad)
+        a1.plot(s_nm[jj], np.asarray(rel)[ii], "x", color="0.6", ms=7,
+                label="refused or failed (see stiction_map.md)")
+        a1.legend(fontsize=7, loc="upper right")
     a1.set_xlabel(r"asperity gap $\sigma$ (nm)")
     a1.set_ylabel(r"$p/p_\mathrm{sat}$")
     a1.set_title("2-mm slider, LJ + sigma-gap + ethanol meniscus")
@@ -109,22 +117,23 @@ def main():
     shutil.rmtree(out, ignore_errors=True)
     sig, rel, F, E, norm, wall, fails, n = stiction_map(out)
     figure(sig, rel, F, norm, RESULTS / "stiction_map.png")
-    rel_err = np.nanmax(E / F)
     lines = ["# Stiction map: the 2-mm slider with LJ, the sigma-gap and an ethanol meniscus",
              "", "(`python -m validation.stiction_map`; scene "
              "`validation/scenes/paper1_slider_meniscus.toml`, bare meniscus, "
              "N = 400, analysis radius delta = 50 nm.)", "",
              f"{n} points on 2 local processes in {wall:.1f} s "
-             f"({wall / n:.2f} s per point, each with its error estimate); "
-             f"{len(fails)} failed; largest estimated relative error of the max adhesion "
-             f"{rel_err:.1e}.", "",
+             f"({wall / n:.2f} s per point, each with its error estimate); {len(fails)} "
+             "refused or failed (below, with femadh's reasons); largest estimated relative "
+             f"error of the max adhesion {np.nanmax(E / F):.1e} (median "
+             f"{np.nanmedian(E / F):.1e}).", "",
              f"Max adhesion / 4 pi R gamma (4 pi R gamma = {norm * 1e3:.4g} mN):", "",
              "| p/psat \\ sigma (nm) | " + " | ".join(f"{s * 1e9:.2f}" for s in sig) + " |",
              "|---|" + "---|" * len(sig)]
     for i, r in enumerate(rel):
         lines.append(f"| {r:.2f} | " + " | ".join(f"{x:.3f}" for x in F[i] / norm) + " |")
-    for ch, err in fails:
-        lines.append(f"\nfailed: {ch}: {err}")
+    lines += ["", "Refused or failed points (sigma, p/psat: femadh's message):", ""]
+    for sg, r, err in fails:
+        lines.append(f"- {sg * 1e9:.3g} nm, {r:.2f}: {err}")
     lines += ["", "![](stiction_map.png)", ""]
     (RESULTS / "stiction_map.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -3,13 +3,13 @@ pass ``enabled`` (default: stderr is a terminal), so pipes, logs and tests stay 
 import sys
 
 
-def bar(total, desc, enabled=True):
-    """A tqdm bar of ``total`` steps, or None when disabled."""
+def bar(total, desc, enabled=True, unit="state"):
+    """A tqdm bar of ``total`` steps (of ``unit``), or None when disabled."""
     if not enabled:
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, desc=desc, unit="state", leave=False, file=sys.stderr,
+    return tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stderr,
                 dynamic_ncols=True)
 
 

@@ -52,7 +52,7 @@ def _g(x):
 def state_row(problem, state, extra):
     """The curve.csv values of a state after ``state`` and ``branch`` (forces in N).
     F_tail is the laws' force beyond the analysis radius (not in F_ex: the truncation)."""
-    from ..runner.estimates import tail_force
+    from ..contact.forces import tail_force
 
     f_lj, f_el, f_ex = state_forces(problem, state)
     g = problem.grid
@@ -89,7 +89,7 @@ class ContactWriter:
         self.jumps = RowLog(self.dir / "jumps.csv", JUMP_HEADER, keep("jumps"))
         self.eq_curve = None
         self.count = r.get("states", 0)
-        self._pvd = {}
+        self._pvd = self._committed_vtk() if (resume and vtk) else {}
 
     def write_state(self, branch, state):
         """Write one state to every file (curve.csv last); returns its state number."""
@@ -123,6 +123,18 @@ class ContactWriter:
                 _g(float(np.min(state.p_contact[state.active]))) if state.active.any() else "",
                 _g(state.diagnostics.get("eq10_violation_inside_m", 0.0)),
                 _g(p.node_softening_ratio(state.h))]
+
+    def _committed_vtk(self):
+        """The collections' entries of the committed states (resume): the files of state k
+        of its branch, as curve.csv lists them."""
+        c = read_curve(self.dir / "curve.csv")
+        out = {}
+        for k, b in zip(c["state"][:self.count], c["branch"][:self.count]):
+            k, b = int(k), str(b)
+            vol, surf = f"vtk/{b}_{k:04d}.vtu", f"vtk/{b}_surface_{k:04d}.vtu"
+            if (self.dir / vol).exists() and (self.dir / surf).exists():
+                out.setdefault(b, []).extend([(k, vol, 0), (k, surf, 1)])
+        return out
 
     def _write_vtk(self, k, branch, state):
         from .vtk import write_pvd, write_state

@@ -46,7 +46,7 @@ class AsperityAdhesion(SmoothStepLaw):
 def _build(values, ctx):
     """Eq 20 on the sigma-gap contact set: exactly (range-less, carried by the constraint:
     a contact node holds tension up to P_LJa), or as the smoothed step law."""
-    from .registry import Built
+    from .registration import Built
 
     p = eq20_pressure(values["asperity_radius"], values["surface_energy"], values["density"],
                       values["contact_probability"])
@@ -57,7 +57,7 @@ def _build(values, ctx):
 
 
 def _registration():
-    from .registry import Output, Registration
+    from .registration import Output, Registration
 
     table = Table("effects.asperity_adhesion", "Asperity adhesion over the sigma-gap contact "
                   "region, paper 1 eq (20): P_LJa = 2 pi R_a dg rho p.", (

@@ -60,7 +60,7 @@ def _build(values, ctx):
     from ..meniscus.isotherms import default_isotherm
     from ..meniscus.kelvin import kelvin_radius
     from ..meniscus.liquids import LIQUIDS
-    from .registry import Built
+    from .registration import Built
 
     liquid, x = values["liquid"], values["relative_pressure"]
     iso = values["isotherm"]
@@ -74,7 +74,7 @@ def _build(values, ctx):
 
 
 def _registration():
-    from .registry import Output, Registration
+    from .registration import Output, Registration
 
     table = Table("effects.capillary", "Capillary condensate filling the gap where a meniscus "
                   "of Kelvin curvature spans it (paper 2 physics in a contact scene).", (

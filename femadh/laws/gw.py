@@ -129,7 +129,7 @@ class GWAdhesion:
 
 
 def _build(values, ctx):
-    from .registry import Built
+    from .registration import Built
 
     s = Summits(values["rms_height"], values["mean_height"], values["asperity_radius"],
                 values["density"])
@@ -140,7 +140,7 @@ def _build(values, ctx):
 
 
 def _registration():
-    from .registry import Output, Registration
+    from .registration import Output, Registration
 
     table = Table("effects.asperity_contact", "Greenwood-Williamson asperity pressures "
                   "(eqs 23-24) as smooth laws of the mean-plane gap, instead of the hard "

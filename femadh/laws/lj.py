@@ -55,13 +55,13 @@ class LennardJones:
 
 
 def _build(values, ctx):
-    from .registry import Built
+    from .registration import Built
 
     return Built({"lj": LennardJones(values["hamaker"], values["equilibrium_distance"])})
 
 
 def _registration():
-    from .registry import Output, Registration
+    from .registration import Output, Registration
 
     table = Table("effects.lennard_jones", "Mean-plane Lennard-Jones pressure, paper 1 eq (3).", (
         Key("hamaker", "energy", "Hamaker constant A (paper 1 Table 1: 1e-19 J).", lo=0.0),

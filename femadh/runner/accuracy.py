@@ -23,9 +23,10 @@ def _relative(res):
     return grid, tail
 
 
-def run_to_accuracy(scene, out_dir, *, figures=True, progress=None, overwrite=False,
+def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwrite=False,
                     resume=False):
-    from .contact import run
+    """Run ``scene`` (with ``run``, :func:`femadh.runner.contact.run`) on ever finer grids
+    until its estimated error meets ``scene.accuracy``; see the module docstring."""
 
     target = scene.accuracy
     nodes, delta = scene.nodes, scene.analysis_radius**2 / (2 * scene.sphere.radius)
@@ -72,7 +73,8 @@ def run_to_accuracy(scene, out_dir, *, figures=True, progress=None, overwrite=Fa
                      f"{MAX_REFINEMENTS} refinements)")
     if out_dir is not None:
         from ..io.run_folder import RunFolder
-        from .contact import scene_id, summary
+        from ..scene import scene_id
+        from .result import contact_summary as summary
 
         with RunFolder(out_dir, scene_id(variant(scene, nodes=steps[-1]["nodes"])),
                        scene.name, "overwrite") as folder:

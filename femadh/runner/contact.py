@@ -7,8 +7,6 @@ atomically at the end, every committed state is in every csv, SIGINT/SIGTERM sto
 current state with status ``interrupted``, and ``resume=True`` continues an interrupted or
 failed sweep from its last committed state.
 """
-import hashlib
-import json
 import math
 import sys
 import time
@@ -17,28 +15,19 @@ import warnings
 import numpy as np
 
 from .._threads import blas_threads
-from .._version import __version__
 from ..contact import Jump, State, trace
 from ..contact.forces import state_forces
 from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning
-from ..scene import build_problem, load_scene
+from ..scene import build_problem, load_scene, scene_id  # noqa: F401 (scene_id: the API)
 from . import interrupt
 from .estimates import GuardError
 from .result import ContactResult
+from .result import contact_summary as summary
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
 #: surface profiles kept in the result per branch (all of them are in fields.csv)
 PROFILES = 12
-
-
-def scene_id(scene):
-    """Content hash of a scene's resolved values (its output folder aside): two runs of the
-    same physics and numerics have the same id."""
-    data = dict(scene.resolved)
-    data.pop("output_dir", None)
-    blob = json.dumps(data, sort_keys=True, default=repr).encode()
-    return hashlib.sha1(blob).hexdigest()[:16]
 
 
 def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
@@ -91,8 +80,8 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         if getattr(scene, "accuracy", None) and estimate is True:
             from .accuracy import run_to_accuracy
 
-            return run_to_accuracy(scene, out_dir, figures=figures, progress=progress,
-                                   overwrite=overwrite, resume=resume)
+            return run_to_accuracy(scene, out_dir, run=run, figures=figures,
+                                   progress=progress, overwrite=overwrite, resume=resume)
         if out_dir is None:
             return _run(scene, None, progress=progress, operator=operator, estimate=estimate)
         from ..io.run_folder import RunFolder
@@ -143,6 +132,15 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
     resume = _resume_point(folder) if folder is not None and folder.previous else None
+    if resume and scene.continuation == "arclength":
+        # an arclength trace cannot restart mid-curve from the files: its paths are read off
+        # the whole curve, whose orientation and fold history are not on disk; it is traced
+        # again from its start (the files are rewritten, consistent at every point)
+        eq = folder.path / "equilibrium_curve.csv"
+        n_eq = max(0, len(eq.read_text().splitlines()) - 1) if eq.exists() else 0
+        res.warnings.append("resume: the arclength curve was traced again from its start "
+                            f"({n_eq} points of the interrupted trace replaced)")
+        resume = None
     writer = None
     with interrupt.interruptible():
         try:
@@ -193,7 +191,7 @@ def _finish(scene, res, problem, sink, estimate):
     if estimate:
         half = refine_peak(scene, res, problem, sink)
         if estimate is True:
-            res.estimates = estimate_errors(scene, res, problem, sink, half)
+            res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
         guard_bounds(res, problem)
     res.timings["estimate_s"] = time.perf_counter() - t1
 
@@ -438,26 +436,3 @@ def _trace_arclength(scene, problem, sink):
             if kind == "land":
                 sink.jump(Jump(branch, dk, dk, 0.0, before, st))
     sink.close()
-
-
-def summary(res, status=None):
-    """summary.json of a run."""
-    scene = res.scene
-    from ..io.writers import SIGN_NOTE
-
-    branches = {}
-    for b, cols in res.branches.items():
-        n = len(cols["d_m"])
-        if not n:
-            continue
-        k = int(np.argmax(cols["F_ex_N"]))
-        branches[b] = {"n_states": n, "max_F_ex_N": float(cols["F_ex_N"][k]),
-                       "d_at_max_F_ex_m": float(cols["d_m"][k]),
-                       "all_converged": bool(np.all(cols["converged"])),
-                       "all_stable": bool(np.all(cols["stable"]))}
-    return {"femadh_version": __version__, "scene_file": scene.path,
-            "status": status or res.status, "error": res.error,
-            "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
-            "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
-            "accuracy": res.accuracy, "warnings": res.warnings,
-            "timings_s": res.timings, "wall_time_s": res.wall_time}

@@ -34,6 +34,7 @@ import math
 import numpy as np
 from scipy import optimize
 
+from ..contact.forces import tail_force
 from ..errors import FemadhError
 
 #: convergence order of the P2 FE body in the headline forces under element-size halving
@@ -73,15 +74,6 @@ def check_state(problem, state, scene):
             f"{ratio:.2f} x its own stiffness: single nodes snap on their own (lattice "
             f"trapping) and the result depends on the mesh; use [solver] nodes >= "
             f"{int(math.ceil(n * ratio / 0.5))}")
-
-
-def tail_force(problem, d):
-    """Force (N, attractive positive) of the laws beyond the analysis radius on the undeformed
-    paraboloid: 2 pi R int_{h_a}^inf P dh = -2 pi R U(h_a), h_a = b(a; d)."""
-    a, R = problem.grid.radius, problem.sphere.radius
-    h_a = np.array([d + problem.sphere.shape(a)])
-    return float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
-                                        for e in problem.effects.values()))
 
 
 def tolerance_force(problem, state, tol):
@@ -168,14 +160,15 @@ def refine_peak(scene, res, problem, sink):
     return half
 
 
-def estimate_errors(scene, res, problem, sink, half=0.0):
+def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     """Fill ``res.headline`` with ``<quantity>_error`` entries and return the breakdown
     {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
-    bracket (:func:`refine_peak`)."""
+    bracket (:func:`refine_peak`); ``run`` runs the coarser members
+    (:func:`femadh.runner.contact.run`)."""
     import warnings
 
     from ..errors import MeshResolutionWarning
-    from .contact import run as _run_quiet
+    _run_quiet = run
 
     def run(*a, **kw):
         # the coarser members are coarse on purpose: their resolution warnings are noise

@@ -33,7 +33,7 @@ FE_ORDER = 4.0
 def run_meniscus(scene, out_dir=None, *, figures=True, progress=None, overwrite=False):
     """Solve a meniscus scene; writes nothing unless ``out_dir`` is given. Returns a
     MeniscusRunResult (status "failed" when no point of the scene has a meniscus)."""
-    from .contact import scene_id
+    from ..scene import scene_id
 
     if progress is None:
         progress = sys.stderr.isatty()

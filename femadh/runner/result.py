@@ -139,3 +139,28 @@ class MeniscusRunResult:
                 for i in range(len(c["p_ratio"])):
                     w.writerow([liq, repr(R), meth] + [repr(float(c[k][i])) for k in cols[3:]])
         return path
+
+
+def contact_summary(res, status=None):
+    """summary.json of a contact run."""
+    from .._version import __version__
+
+    scene = res.scene
+    from ..io.writers import SIGN_NOTE
+
+    branches = {}
+    for b, cols in res.branches.items():
+        n = len(cols["d_m"])
+        if not n:
+            continue
+        k = int(np.argmax(cols["F_ex_N"]))
+        branches[b] = {"n_states": n, "max_F_ex_N": float(cols["F_ex_N"][k]),
+                       "d_at_max_F_ex_m": float(cols["d_m"][k]),
+                       "all_converged": bool(np.all(cols["converged"])),
+                       "all_stable": bool(np.all(cols["stable"]))}
+    return {"femadh_version": __version__, "scene_file": scene.path,
+            "status": status or res.status, "error": res.error,
+            "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
+            "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
+            "accuracy": res.accuracy, "warnings": res.warnings,
+            "timings_s": res.timings, "wall_time_s": res.wall_time}

@@ -10,6 +10,8 @@ reported at once, each naming the file, the key, the value and what was expected
 ``femadh keys`` prints every key (:func:`reference_page`).
 """
 import copy
+import hashlib
+import json
 from pathlib import Path
 
 try:
@@ -24,7 +26,7 @@ from .meniscus import MeniscusScene, parse_meniscus
 from .reader import Reader
 
 __all__ = ["Scene", "MeniscusScene", "load_scene", "scene_from_dict", "apply_overrides",
-           "build_operator", "build_problem", "reference_page"]
+           "build_operator", "build_problem", "reference_page", "scene_id"]
 
 
 def load_scene(path):
@@ -64,7 +66,10 @@ def scene_from_dict(data, file=None, *, bare_numbers=True):
     """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`.
     ``bare_numbers``: whether plain numbers are SI for dimensional keys (code) or errors
     (files)."""
-    reader = Reader(file, bare_numbers=bare_numbers)
+    from .liquids import read_isotherm, read_liquid
+
+    reader = Reader(file, bare_numbers=bare_numbers,
+                    kinds={"liquid": read_liquid, "isotherm": read_isotherm})
     if not isinstance(data, dict):
         reader.fail("(top level)", data, "a table of tables")
         reader.finish()
@@ -126,3 +131,12 @@ def reference_page():
             lines.append(f"| `{k.name}` | {k.expected(_words(k))} | {default} | {k.doc} |")
         lines.append("")
     return "\n".join(lines)
+
+
+def scene_id(scene):
+    """Content hash of a scene's resolved values (its output folder aside): two runs of the
+    same physics and numerics have the same id."""
+    data = dict(scene.resolved)
+    data.pop("output_dir", None)
+    blob = json.dumps(data, sort_keys=True, default=repr).encode()
+    return hashlib.sha1(blob).hexdigest()[:16]

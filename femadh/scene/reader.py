@@ -31,10 +31,15 @@ class Reader:
     bare_numbers : bool
         Whether a plain number is SI for a dimensional key (scenes built in code) or an error
         (scene files: ``radius = 2`` would silently mean 2 m).
+    kinds : dict, optional
+        ``kind -> parse(reader, raw, path)`` for structured key kinds ("liquid", "isotherm").
     """
 
-    def __init__(self, file, *, bare_numbers=False):
+    def __init__(self, file, *, bare_numbers=False, kinds=None):
         self.file, self.bare_numbers = file, bare_numbers
+        # parsers of the structured kinds ("liquid", "isotherm": scene.liquids), given by the
+        # caller so that this base reader imports no table of its own
+        self.kinds = dict(kinds or {})
         self.errors = []
 
     def fail(self, path, value, expected):
@@ -87,10 +92,8 @@ class Reader:
         """One key's value in SI (or BAD, with its error recorded)."""
         if key.kind == "custom":
             return key.parse(self, raw, path)
-        if key.kind in ("liquid", "isotherm"):
-            from .liquids import read_isotherm, read_liquid
-
-            return (read_liquid if key.kind == "liquid" else read_isotherm)(self, raw, path)
+        if key.kind in self.kinds:
+            return self.kinds[key.kind](self, raw, path)
         if raw is None and default:
             return None
         if key.kind == "choice":

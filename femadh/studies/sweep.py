@@ -80,7 +80,9 @@ def parse_values(spec, key="(value)"):
         if not unit and _is_int(lo_txt) and _is_int(hi_txt) and m.group("log") != "log" \
                 and np.all(vals == np.round(vals)):
             return [int(v) for v in vals]          # an integer key (e.g. solver.nodes)
-        return [f"{v:.12g} {unit}" if unit else float(v) for v in vals]
+        # 12 significant digits: 0.45, not linspace's 0.44999999999999996 (a value a user
+        # reads in the table and types again)
+        return [f"{v:.12g} {unit}" if unit else float(f"{v:.12g}") for v in vals]
     out = []
     for item in spec.split(","):
         item = item.strip()
@@ -128,7 +130,7 @@ def study_points(scene, vary, *, zip_=False):
         combos = list(zip(*lists))
     else:
         combos = list(itertools.product(*lists))
-    from ..runner.contact import scene_id
+    from ..scene import scene_id
 
     points, errors = [], []
     for i, combo in enumerate(combos):
@@ -174,8 +176,15 @@ def run_point(point, root, estimate=True):
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
            "status": "failed", "error": None, "operator_reused": False, "pid": os.getpid()}
+    import warnings
+
+    from ..errors import MeshResolutionWarning
+
     try:
-        with blas_threads():
+        # a point's resolution warnings go into its record (and summary.json), not the
+        # terminal of the study
+        with blas_threads(), warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshResolutionWarning)
             key = _operator_key(point.scene)
             if key is not None:
                 if key in _OPERATORS:
@@ -189,6 +198,7 @@ def run_point(point, root, estimate=True):
                 res = run(point.scene, folder, figures=False, progress=False, overwrite=True,
                           estimate=estimate)
         rec["status"], rec["error"] = res.status, res.error
+        rec["warnings"] = list(getattr(res, "warnings", []))
         rec.update(_numbers(res))
     except FemadhError as exc:
         rec["error"] = f"{type(exc).__name__}: {exc}"
@@ -244,7 +254,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         if progress:
             from ..io.progress import bar as make_bar
 
-            bar = make_bar(len(todo), f"study {scene.name}")
+            bar = make_bar(len(todo), f"study {scene.name}", unit="point")
         t0 = time.perf_counter()
         try:
             for rec in _execute(todo, out, workers, scheduler, estimate):
