@@ -111,7 +111,8 @@ DEFECTS = [
     # -- contact
     D("active_set_never_releases", "active-set rule never releases a contact node",
       "femadh/contact/complementarity.py",
-      (("new_A = (A & (pc > 0)) | (I & (h < sigma))", "new_A = A | (I & (h < sigma))"),)),
+      (("new_A = (A & (pc + adhesion > 0)) | (I & (h < sigma))",
+        "new_A = A | (I & (h < sigma))"),)),
     D("stability_constant", "stability decision replaced by True", "femadh/contact/stability.py",
       (("    return is_positive_definite(H)\n", "    return True\n"),)),
     D("closure_hertz_pressure", "the paper's closure: Hertz contact force 10 % high",
