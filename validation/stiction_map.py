@@ -83,7 +83,8 @@ def figure(sig, rel, F, norm, png):
     a1.set_xlabel(r"asperity gap $\sigma$ (nm)")
     a1.set_ylabel(r"$p/p_\mathrm{sat}$")
     a1.set_title("2-mm slider, LJ + sigma-gap + ethanol meniscus")
-    for j in range(0, len(sig), 3):
+    shown = [j for j in range(len(sig)) if np.isfinite(F[:, j]).any()]
+    for j in shown[::3]:
         a2.plot(rel, F[:, j] / norm, "o-", ms=3, label=rf"$\sigma$ = {s_nm[j]:.2f} nm")
     a2.axhline(1.0, color="k", lw=0.8, ls="--", label=r"$4\pi R\gamma$")
     a2.set_xlabel(r"$p/p_\mathrm{sat}$")
