@@ -224,18 +224,28 @@ def test_guards_refuse_a_contact_beyond_the_analysis_radius():
     assert "analysis_radius" in res.error and len(res.branches["approach"]["d_m"]) > 5
 
 
-def test_accuracy_mode_meets_its_target():
+def test_accuracy_mode_meets_its_target(tmp_path):
     """[solver] accuracy = 3e-3 on the Fig 3 scene: femadh grows the analysis radius (the LJ
     tail beyond the paper's 10-nm disk is 0.9 % of the largest adhesion) and the nodes until
-    its estimate meets the target; the result against a finer reference is within it."""
+    its estimate meets the target; the result against a finer reference is within it. The
+    folder keeps the last trial's files and a summary that records the accuracy steps."""
+    import json
+
     import femadh
+    from femadh.io.writers import read_curve
     from femadh.runner.estimates import variant
 
     sc = femadh.load_scene("validation/scenes/paper1_fig3.toml").replace(
         {"solver.accuracy": 3e-3, "solver.nodes": 100})
-    res = femadh.run(sc, progress=False)
+    out = tmp_path / "out"
+    res = femadh.run(sc, out, progress=False, figures=False)
     assert res.status == "converged" and res.accuracy["met"]
     assert res.accuracy["analysis_radius_m"] > sc.analysis_radius
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "converged" and summary["accuracy"]["met"]
+    assert len(summary["accuracy"]["steps"]) == len(res.accuracy["steps"]) > 1
+    n_states = sum(len(b["d_m"]) for b in res.branches.values())
+    assert len(read_curve(out / "curve.csv")["d_m"]) == n_states
     ref = femadh.run(variant(sc, nodes=400, delta=160e-9), progress=False, estimate="peak")
     for k in ("max_adhesion_N", "F_LJ_deepest_N"):
         assert abs(res.headline[k] / ref.headline[k] - 1) < 3e-3

@@ -164,6 +164,64 @@ def test_arclength_run_interrupted_is_traced_again_on_resume(tmp_path):
     assert_same_as_uninterrupted(scene, out)
 
 
+def test_output_fault_mid_run_is_failed_not_converged_and_resumes(tmp_path, monkeypatch,
+                                                                  capsys):
+    """A fault outside the solver (here the writer failing at state 5, as a full disk does)
+    ends the run "failed" in its summary - never "converged" - and --resume completes it to
+    the uninterrupted curve."""
+    from femadh.errors import OutputError
+    from femadh.io.writers import ContactWriter
+
+    scene, out = long_scene(tmp_path, step="0.2 nm"), tmp_path / "out"
+    real = ContactWriter.write_state
+
+    def failing(self, branch, state):
+        if self.count == 5:
+            raise OutputError("cannot write curve.csv: seeded fault")
+        return real(self, branch, state)
+
+    monkeypatch.setattr(ContactWriter, "write_state", failing)
+    assert main(["run", str(scene), "--out", str(out), "--quiet", "--no-figures",
+                 "--no-estimate"]) == 4
+    assert capsys.readouterr().err.count("femadh: error:") == 1
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and "seeded fault" in summary["error"]
+    assert len(read_curve(out / "curve.csv")["d_m"]) == 5
+    monkeypatch.setattr(ContactWriter, "write_state", real)
+    assert main(["run", str(scene), "--out", str(out), "--quiet", "--no-figures",
+                 "--no-estimate", "--resume"]) == 0
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_resume_of_a_run_stopped_before_its_first_state(tmp_path):
+    """Stopped in the operator build (no csv written yet): --resume simply runs the scene."""
+    from femadh.scene import scene_id
+
+    scene, out = long_scene(tmp_path, step="0.2 nm"), tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text(json.dumps(
+        {"scene_id": scene_id(femadh.load_scene(scene)), "status": "interrupted",
+         "scene": {"name": "long"}}))
+    assert main(["run", str(scene), "--out", str(out), "--quiet", "--no-figures",
+                 "--no-estimate", "--resume"]) == 0
+    assert_same_as_uninterrupted(scene, out)
+
+
+def test_whole_files_get_ordinary_permissions(tmp_path):
+    """Atomically written files (summary, VTK, figures) are readable as a plain open() would
+    make them (mkstemp alone gives owner-only 0600: a ParaView server of another user could
+    not read the .vtu)."""
+    from femadh.io.atomic import save_atomic, write_atomic
+
+    plain = tmp_path / "plain"
+    plain.write_text("x")
+    write_atomic(tmp_path / "a.json", "{}")
+    save_atomic(tmp_path / "b.vtu", lambda p: Path(p).write_text("x"))
+    mode = plain.stat().st_mode & 0o777
+    assert (tmp_path / "a.json").stat().st_mode & 0o777 == mode
+    assert (tmp_path / "b.vtu").stat().st_mode & 0o777 == mode
+
+
 def test_kill_9_loses_no_committed_state_and_resumes(tmp_path):
     scene = long_scene(tmp_path)
     out = tmp_path / "out"

@@ -121,6 +121,25 @@ def test_study_points_over_a_layer_thickness():
     assert len({p.id for p in pts}) == 3
 
 
+def test_study_points_over_a_layer_modulus_each_get_their_own_operator(tmp_path):
+    """A worker keeps one FE operator per distinct body: points that differ in a layer's
+    modulus must not share it (a shared operator would give them the same compliance), while
+    a repeated body is reused. A stiffer overcoat lowers the deepest contact force's
+    displacement, so F_LJ at the deepest d differs between the points."""
+    from femadh.studies.sweep import run_point
+
+    pts = study_points(scene(**{"solver.nodes": 40, "sweep.stop": "-1 nm"}),
+                       {"substrate.layers.0.youngs_modulus": "40 GPa,400 GPa,40 GPa"})
+    recs = [run_point(p, tmp_path, estimate=False) for p in pts]
+    assert [r["status"] for r in recs] == ["converged"] * 3, [r["error"] for r in recs]
+    assert [r["operator_reused"] for r in recs] == [False, False, False]
+    rep = run_point(pts[2], tmp_path, estimate=False)
+    assert rep["operator_reused"]
+    # the same body gives the same numbers; a 10x stiffer layer a different deepest force
+    assert rep["F_LJ_deepest_N"] == recs[0]["F_LJ_deepest_N"]
+    assert recs[1]["F_LJ_deepest_N"] != pytest.approx(recs[0]["F_LJ_deepest_N"], rel=1e-3)
+
+
 def test_layer_of_the_disk_material_is_the_homogeneous_green_solution():
     """The identity: a layer of the disk's own material changes nothing; the layered FE body
     plus the slider's Green compliance reproduces the composite-modulus Green function.
@@ -137,9 +156,10 @@ def test_layer_of_the_disk_material_is_the_homogeneous_green_solution():
 
 def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
     """The same scene on the Hankel-transform operator (no FE) differs only by the FE
-    discretisation; the run's estimated error covers it. Measured (N = 200, soft 5-um layer):
-    true |F_ex(-5 nm) difference| 4.3e-8 N vs estimated total 1.4e-6 N (fe_mesh part alone
-    4.7e-8 N); max adhesion 3.6e-11 N vs 2.7e-7 N."""
+    discretisation; the run's estimated error covers it. Measured (N = 100, soft 5-um layer,
+    the coarser mesh 1.52x coarser by its triangle count): true |F_ex(-3 nm) difference|
+    1.9e-8 N vs estimated total 7.7e-7 N, fe_mesh part alone 7.6e-8 N (4x the true error);
+    max adhesion 1.8e-10 N vs fe_mesh 4.2e-10 N (total 3.7e-7 N: the grid part dominates)."""
     sc = scene()
     fe = quiet_run(sc)
     assert fe.status == "converged", fe.error
@@ -151,8 +171,10 @@ def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
         true = abs(fe.headline[k] - ref.headline[k])
         assert true <= fe.headline[f"{k}_error"], (k, true, fe.headline[f"{k}_error"])
     # and the mesh part alone is of the size of the true FE error (not a blanket bound)
-    true = abs(fe.headline["F_ex_deepest_N"] - ref.headline["F_ex_deepest_N"])
-    assert 0.1 * true < abs(fe.estimates["F_ex_deepest_N"]["fe_mesh"]) < 10 * true
+    # (measured ratios 4.0 for F_ex, 2.4 for max adhesion: an effectivity within [0.5, 10])
+    for k in ("F_ex_deepest_N", "max_adhesion_N"):
+        true = abs(fe.headline[k] - ref.headline[k])
+        assert 0.5 * true < abs(fe.estimates[k]["fe_mesh"]) < 10 * true, k
 
 
 def test_a_softer_coating_lowers_the_contact_stiffness(tmp_path):

@@ -49,7 +49,9 @@ class RunFolder:
     scene_id : str
         Content hash of the resolved scene (a resumed run must be of the same scene).
     scene_name : str
-    mode : {"new", "overwrite", "resume"}
+    mode : {"new", "overwrite", "resume", "amend"}
+        ``amend`` reopens the folder of a run of the same scene that has just written it, to
+        update its summary, and touches none of its outputs.
 
     Raises
     ------
@@ -105,6 +107,10 @@ class RunFolder:
         if self.mode == "overwrite":
             self.clean()
             return None
+        if self.mode == "amend":
+            if prev.get("scene_id") != self.scene_id:
+                raise OutputError(f"{what} of another scene: its summary cannot be amended")
+            return prev
         if self.mode == "resume":
             if prev.get("scene_id") != self.scene_id:
                 raise OutputError(f"{what} of another scene (or of this scene changed): it "

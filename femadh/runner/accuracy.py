@@ -76,8 +76,7 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
         from ..scene import scene_id
         from .result import contact_summary as summary
 
-        with RunFolder(out_dir, scene_id(variant(scene, nodes=steps[-1]["nodes"])),
-                       scene.name, "overwrite") as folder:
-            folder.previous = None
+        # the last trial's outputs stay; only its summary gains the accuracy record
+        with RunFolder(out_dir, scene_id(trial), scene.name, "amend") as folder:
             folder.write_summary(summary(res))
     return res

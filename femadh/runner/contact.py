@@ -131,15 +131,19 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
-    resume = _resume_point(folder) if folder is not None and folder.previous else None
-    if resume and scene.continuation == "arclength":
+    resuming = folder is not None and folder.previous
+    resume = _resume_point(folder) if resuming and scene.continuation != "arclength" else None
+    if resuming and scene.continuation == "arclength":
         # an arclength trace cannot restart mid-curve from the files: its paths are read off
         # the whole curve, whose orientation and fold history are not on disk; it is traced
         # again from its start (the files are rewritten, consistent at every point)
-        eq = folder.path / "equilibrium_curve.csv"
-        n_eq = max(0, len(eq.read_text().splitlines()) - 1) if eq.exists() else 0
+        def rows(name):
+            f = folder.path / name
+            return max(0, len(f.read_text().splitlines()) - 1) if f.exists() else 0
+
         res.warnings.append("resume: the arclength curve was traced again from its start "
-                            f"({n_eq} points of the interrupted trace replaced)")
+                            f"({rows('equilibrium_curve.csv')} curve points and "
+                            f"{rows('curve.csv')} branch states of the previous run replaced)")
         resume = None
     writer = None
     with interrupt.interruptible():
@@ -172,6 +176,11 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
         except Interrupted as exc:
             res.status, res.error = "interrupted", str(exc)
             res.exit_code = exc.exit_code
+        except BaseException as exc:
+            # an output fault, a law error, a bug: the summary must not say "converged"
+            res.status = "failed"
+            res.error = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+            raise
         finally:
             if writer is not None:
                 writer.close()
@@ -386,6 +395,8 @@ def _resume_point(folder):
     their field rows, their jumps."""
     from ..io.writers import committed_counts
 
+    if not (folder.path / "curve.csv").exists():
+        return None             # stopped before its first state (e.g. in the operator build)
     return committed_counts(folder.path)
 
 

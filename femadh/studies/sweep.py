@@ -157,10 +157,16 @@ _OPERATORS = {}
 
 
 def _operator_key(sc):
+    """Everything :func:`femadh.scene.build_operator` reads, as a string (FESettings and the
+    material records are not hashable; repr of a float is exact)."""
     if sc.kind != "contact":
         return None
-    fe = None if sc.fe_settings is None else (sc.fe_settings, sc.fe_poisson_ratio)
-    return (sc.method, sc.nodes, round(sc.analysis_radius, 18), round(sc.e_star, 3), fe)
+    fe = None
+    if sc.method == "fe":
+        fe = (sc.fe_settings, sc.fe_poisson_ratio)
+        if sc.layers:
+            fe += (tuple(sc.layers), sc.disk, sc.slider)
+    return repr((sc.method, sc.nodes, sc.analysis_radius, sc.e_star, fe))
 
 
 def run_point(point, root, estimate=True):
@@ -172,6 +178,7 @@ def run_point(point, root, estimate=True):
     from ..runner.contact import run
     from ..scene import build_operator
 
+    _tune_malloc()
     t0 = time.perf_counter()
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
@@ -320,6 +327,35 @@ def _execute(todo, out, workers, scheduler, estimate=True):
 def _worker_init():
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+
+_MALLOC_TUNED = False
+
+
+def _tune_malloc():
+    """Undo dask's MALLOC_TRIM_THRESHOLD_ for femadh's allocation pattern (once per process).
+
+    A dask nanny starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which also switches
+    off glibc's dynamic mmap threshold: every numpy temporary above 128 KiB is then mmap'ed
+    and unmapped afresh, page faults included. A stiction-map point ran 45 % slower in a Dask
+    worker than in a process of the local pool for that reason (6.0 s -> 8.7-9.4 s with the
+    variable set, 6.1 s with the thresholds below). Raising both thresholds by mallopt works
+    on any worker, also on a cluster femadh did not start. No-op off glibc."""
+    global _MALLOC_TUNED
+    if _MALLOC_TUNED:
+        return
+    _MALLOC_TUNED = True
+    if not os.environ.get("MALLOC_TRIM_THRESHOLD_"):
+        return                      # glibc's dynamic thresholds are in force: keep them
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6")
+    except OSError:
+        return
+    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+    libc.mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024)     # glibc's largest
+    libc.mallopt(M_TRIM_THRESHOLD, 256 * 1024 * 1024)
 
 
 def _execute_dask(todo, out, scheduler, estimate=True):
