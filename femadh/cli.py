@@ -3,7 +3,8 @@
 
 Every user mistake or fault ends in one ``femadh: error:`` line per problem, never a
 traceback. Exit codes: 0 done; 2 the scene or the command line is wrong; 3 a solve failed
-(the states computed before it are kept); 4 an output cannot be written; 5 an optional
+(the states computed before it are kept); 4 an output cannot be written or the output
+folder holds another run (use --resume or --overwrite); 5 an optional
 dependency is missing; 130 / 143 interrupted by SIGINT / SIGTERM (completed states kept,
 ``--resume`` continues); 1 an internal error (a bug: set FEMADH_DEBUG=1 for its traceback).
 """
@@ -27,7 +28,8 @@ def _parser():
                     "the separation d. Scenes are TOML files; see validation/scenes/ for "
                     "examples and `femadh keys` for every key.",
         epilog="exit codes: 0 done, 2 bad scene/arguments, 3 solve failed (states kept), "
-               "4 output not writable, 5 missing dependency, 130/143 interrupted.")
+               "4 output not writable or folder holds a previous run, 5 missing dependency, "
+               "130/143 interrupted.")
     p.add_argument("--version", action="version", version=f"femadh {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     r = sub.add_parser("run", help="solve a scene and write its results and figures",
@@ -254,7 +256,9 @@ def _report(res):
 
     for line in headline_lines(res):
         print(line)
-    print(f"results in {res.out_dir} ({res.wall_time:.2f} s)")
+    figs = res.timings.get("figures_s")
+    print(f"results in {res.out_dir} (run {res.wall_time:.2f} s"
+          + (f", figures {figs:.2f} s)" if figs is not None else ")"))
 
 
 def _study(scene, args):
