@@ -424,7 +424,7 @@ def write_table(points, records, out):
 
 def study_figure(points, records, out, quantity="max_adhesion_N"):
     """One varied key: the quantity against it; two: a heat map over both."""
-    from ..io.plots import _pyplot, force_unit
+    from ..io.plots import _pyplot, force_unit, length_unit
     from ..io.atomic import save_atomic
     from ..units import to_si
 
@@ -433,37 +433,56 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
     if not vals or len(keys) not in (1, 2):
         return None
 
-    def x_of(v):
+    si_unit = {"pressure": "Pa", "energy": "J", "surface_energy": "J/m²",
+               "temperature": "K", "areal_density": "1/m²"}
+
+    def parsed(v):
+        """(SI value, dimension or None) of a study value."""
         if isinstance(v, (int, float)):
-            return float(v)
+            return float(v), None
         for dim in ("length", "pressure", "energy", "surface_energy", "temperature",
                     "areal_density"):
             try:
-                return to_si(v, dim)
+                return to_si(v, dim), dim
             except SceneError:
                 continue
-        return math.nan
+        return math.nan, None
+
+    def axis(key):
+        """{study value: plotted number} and the axis label, in a unit fitting the values."""
+        raw = {repr(p.changes[key]): parsed(p.changes[key]) for p, _ in vals}
+        dims = {d for _, d in raw.values()}
+        scale, unit = 1.0, ""
+        if dims == {"length"}:
+            scale, unit = length_unit([x for x, _ in raw.values()])
+        elif len(dims) == 1 and None not in dims:
+            unit = si_unit[dims.pop()]
+        label = key.split(".")[-1].replace("_", " ") + (f" ({unit})" if unit else "")
+        return {k: x * scale for k, (x, _) in raw.items()}, f"{label}  [{key}]"
 
     plt = _pyplot()
     y = np.array([v for _, v in vals], float)
     fs, fl = force_unit(y[np.isfinite(y)]) if quantity.endswith("_N") else (1.0, "")
+    qlabel = quantity.removesuffix("_N").replace("_", " ") + (f" ({fl})" if fl else "")
     fig, ax = plt.subplots(figsize=(7, 5))
     if len(keys) == 1:
-        x = np.array([x_of(p.changes[keys[0]]) for p, _ in vals])
+        xmap, xl = axis(keys[0])
+        x = np.array([xmap[repr(p.changes[keys[0]])] for p, _ in vals])
         order = np.argsort(x)
         ax.plot(x[order], y[order] * fs, "o-")
-        ax.set(xlabel=f"{keys[0]} (SI)", ylabel=f"{quantity} ({fl})")
+        ax.set(xlabel=xl, ylabel=qlabel)
         ax.grid(alpha=0.3)
     else:
-        xs = sorted({x_of(p.changes[keys[0]]) for p, _ in vals})
-        ys = sorted({x_of(p.changes[keys[1]]) for p, _ in vals})
+        (xmap, xl), (ymap, yl) = axis(keys[0]), axis(keys[1])
+        xs, ys = sorted(set(xmap.values())), sorted(set(ymap.values()))
         Z = np.full((len(ys), len(xs)), np.nan)
         for (p, v) in vals:
-            Z[ys.index(x_of(p.changes[keys[1]])), xs.index(x_of(p.changes[keys[0]]))] = v * fs
+            Z[ys.index(ymap[repr(p.changes[keys[1]])]),
+              xs.index(xmap[repr(p.changes[keys[0]])])] = v * fs
         im = ax.pcolormesh(_edges(xs), _edges(ys), Z, shading="flat", cmap="viridis")
-        fig.colorbar(im, ax=ax, label=f"{quantity} ({fl})")
-        ax.set(xlabel=f"{keys[0]} (SI)", ylabel=f"{keys[1]} (SI)")
-    ax.set_title(f"study: {quantity}")
+        fig.colorbar(im, ax=ax, label=qlabel)
+        ax.set(xlabel=xl, ylabel=yl)
+    ax.set_title("study: " + quantity.removesuffix("_N").replace("_", " "))
     fig.tight_layout()
     path = Path(out) / "study.png"
     save_atomic(path, lambda p: fig.savefig(p, dpi=110))
