@@ -116,7 +116,7 @@ def force_curve(res, path):
                  f"{length_unit([sc.sphere.radius])[1]}, E* = {sc.e_star / 1e9:.3g} GPa"
                  + (f", σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})"
                     if sc.gap else ", smooth sphere"))
-    _adhesion_zoom(ax, res, fs, ls, fl)
+    _adhesion_zoom(ax, res, fs, ls, fl, ll)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     ax.grid(alpha=0.3)
     # a fixed layout (tight_layout draws the figure twice): the legend right of the axes
@@ -126,7 +126,7 @@ def force_curve(res, path):
     return path
 
 
-def _adhesion_zoom(ax, res, fs, ls, fl):
+def _adhesion_zoom(ax, res, fs, ls, fl, ll):
     """An inset around the adhesion peak when the repulsive range dwarfs it."""
     tot = -np.concatenate([c["F_ex_N"] for c in res.branches.values()])
     d = np.concatenate([c["d_m"] for c in res.branches.values()])
@@ -141,13 +141,19 @@ def _adhesion_zoom(ax, res, fs, ls, fl):
                  color="k", lw=1.2)
     ins.axhline(0, color="k", lw=0.5)
     hl = res.headline
+    if hl.get("work_of_adhesion_J_per_m2"):
+        # the DMT/JKR lines of the main axes, readable at this scale
+        for key, st in (("dmt_pull_off_N", "-."), ("jkr_pull_off_N", ":")):
+            ins.axhline(-hl[key] * fs, color="grey", ls=st, lw=0.8)
     if "max_adhesion_N" in hl:
         F, dm = hl["max_adhesion_N"], hl["d_at_max_adhesion_m"]
         err = hl.get("max_adhesion_N_error")
         ins.plot([dm * ls], [-F * fs], "v", color="C3")
         pm = f" ± {err * fs:.2g}" if err is not None else ""
-        ins.set_title(f"largest adhesion {F * fs:.4g}{pm} {fl} at d = {dm * ls:.4g}",
-                      fontsize=7)
+        ins.set_title(f"largest adhesion {F * fs:.4g}{pm} {fl} at d = {dm * ls:.4g} "
+                      f"{ll}", fontsize=7)
+    ins.set_xlabel(f"d ({ll})", fontsize=6, labelpad=1)
+    ins.set_ylabel(f"force ({fl})", fontsize=6, labelpad=1)
     ins.tick_params(labelsize=6)
     ins.set_xlim(np.min(d[near]) * ls, np.max(d[near]) * ls)
     ins.grid(alpha=0.3)
@@ -171,7 +177,7 @@ def paper1_panels(res, path):
     for i in range(n):
         c = cmap(i / max(1, n - 1))
         ax[0].plot(res.nodes * rs, prof["w_m"][i] * 1e9, color=c,
-                   label=f"{prof['d_m'][i] * 1e9:.2f}")
+                   label=f"{round(prof['d_m'][i] * 1e9, 2) + 0.0:.2f}")  # no "-0.00"
         ax[1].plot(res.nodes * rs, prof["P_LJ_Pa"][i] * 1e-6, color=c)
         ax[2].plot(res.nodes * rs, prof["P_el_Pa"][i] * 1e-6, color=c)
     ax[0].set(xlabel=f"r ({rl})", ylabel="w (nm)", title=f"(a) disk deformation, {first}")
@@ -207,7 +213,8 @@ def paper1_panels(res, path):
     ax[4].set(xlabel=f"-F_ex, force on slider ({fl})", ylabel=f"r_c ({rl})",
               title="(e) contact radius")
     ax[4].legend(fontsize=7)
-    ax[5].set(xlabel="d (nm)", title="(f) iterations, -log10 residual")
+    ax[5].set(xlabel="d (nm)", ylabel="iterations; -log10(residual / nm)",
+              title="(f) iterations, -log10 residual")
     ax[5].legend(fontsize=7)
     Rs, Rl = length_unit([sc.sphere.radius])
     fig.suptitle(f"{sc.name}: R = {sc.sphere.radius * Rs:g} {Rl}, E* = {sc.e_star / 1e9:.1f} GPa, "
