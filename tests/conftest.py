@@ -85,3 +85,11 @@ def check_curve_against_fields(out_dir, rel=1e-12):
             total += -f if col in ("F_el_N", "F_ela_N") else f
         assert float(row["F_ex_N"]) == pytest.approx(total, rel=rel, abs=rel * scale)
     return len(curve)
+
+
+def fig3_uniform_text():
+    """The Fig 3 scene file's text with explicit uniform nodes (N = 200, its former default):
+    tests of scene text, faults and resume that need a fixed, fast discretisation."""
+    text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"
+            / "paper1_fig3.toml").read_text()
+    return text.replace("[solver]\n", "[solver]\nnodes = 200\n", 1)

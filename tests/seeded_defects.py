@@ -244,6 +244,26 @@ DEFECTS = [
       "femadh/meniscus/isotherms.py",
       (("return self.monolayer * self.c * kx / ((1 - kx) * (1 - kx + self.c * kx))",
         "return self.monolayer * self.c * kx / ((1 - kx) * (1 + self.c * kx))"),)),
+    # -- the adaptive discretisation
+    D("richardson_ratio", "Richardson on banded members: 2^p - 1 whatever the spacing ratio",
+      "femadh/runner/estimates.py",
+      (("        out[k] = (v - c) / (ratio**p - 1.0)", "        out[k] = (v - c) / (2.0**p - 1.0)"),)),
+    D("envelope_dropped", "oscillating members: the finest difference alone (may cancel)",
+      "femadh/runner/estimates.py",
+      (("math.copysign(max(abs(d1), abs(d2) / ratio**p), d1)", "d1"),)),
+    D("member_spacing", "estimate members: both at r h instead of r h and r^2 h",
+      "femadh/runner/estimates.py", (('h = g["spacing"] * r**k', 'h = g["spacing"] * r'),)),
+    D("tail_share", "analysis radius: the tail allowed the whole target, not its share",
+      "femadh/discretisation/plan.py",
+      (("<= TAIL_SHARE * target * scale", "<= target * scale"),)),
+    D("trap_cap_off", "adaptive grid: the trapping-safe spacing never applied",
+      "femadh/runner/adaptive.py", (("        if spacing <= safe:", "        if True:"),)),
+    D("band_never_widens", "adaptive grid: a contact that left the band is not noticed",
+      "femadh/runner/adaptive.py",
+      (("if edge > BAND_FILL * family.band and", "if edge > 10 * family.band and"),)),
+    D("feature_gap_fraction", "feature gap: |P'| threshold 1e-3 instead of FEATURE_FRACTION",
+      "femadh/discretisation/plan.py",
+      (("stiff >= FEATURE_FRACTION * top", "stiff >= 1e-3 * top"),)),
 ]
 
 

@@ -17,7 +17,7 @@ import femadh
 from femadh.cli import main
 from femadh.io.writers import read_curve
 
-from conftest import check_curve_against_fields
+from conftest import fig3_uniform_text, check_curve_against_fields
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
@@ -26,7 +26,7 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 
 def long_scene(tmp_path, step="0.02 nm", nodes=200, extra=""):
     """The Fig 3 scene with many small steps (350 per branch): long enough to interrupt."""
-    text = FIG3.read_text().replace('step = "0.2 nm"', f'step = "{step}"').replace(
+    text = fig3_uniform_text().replace('step = "0.2 nm"', f'step = "{step}"').replace(
         "nodes = 200", f"nodes = {nodes}") + extra
     p = tmp_path / "long.toml"
     p.write_text(text)

@@ -9,7 +9,7 @@ from femadh.cli import main
 from femadh.errors import SceneError
 from femadh.io.writers import CURVE_HEADER, read_curve
 
-from conftest import check_curve_against_fields
+from conftest import fig3_uniform_text, check_curve_against_fields
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
@@ -22,7 +22,7 @@ def write(tmp_path, text, name="s.toml"):
 
 
 def variant(tmp_path, old, new):
-    text = FIG3.read_text()
+    text = fig3_uniform_text()
     assert old in text
     return write(tmp_path, text.replace(old, new))
 
@@ -59,7 +59,7 @@ def test_bad_scene_names_file_key_value_expectation(tmp_path, old, new, key, exp
 
 
 def test_composite_modulus_alternative(tmp_path):
-    text = FIG3.read_text()
+    text = fig3_uniform_text()
     start = text.index("[materials]")
     end = text.index("[effects.lennard_jones]")
     p = write(tmp_path, text[:start] + '[materials]\ncomposite_modulus = "58.5 GPa"\n\n' + text[end:])

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 import femadh
+from conftest import fig3_uniform_text
 from femadh.errors import DependencyError, SceneError, SceneErrors
 from femadh.scene import Scene, reference_page, scene_from_dict
 from femadh.scene.resources import check_resources, memory_estimate, physical_memory
@@ -23,7 +24,7 @@ def write(tmp_path, text, name="s.toml"):
 
 
 def test_every_error_of_a_scene_at_once(tmp_path):
-    text = (FIG3.read_text().replace("poisson_ratio = 0.3", "poisson_ratio = 0.7")
+    text = (fig3_uniform_text().replace("poisson_ratio = 0.3", "poisson_ratio = 0.7")
             .replace('sigma = "1.0 nm"', 'sigma = "1.0 kg"').replace("nodes = 200", "nodez = 200"))
     p = write(tmp_path, text)
     with pytest.raises(SceneErrors) as e:
@@ -38,17 +39,17 @@ def test_every_error_of_a_scene_at_once(tmp_path):
 
 
 def test_misspelt_table_and_effect_get_suggestions(tmp_path):
-    p = write(tmp_path, FIG3.read_text().replace("[effects.lennard_jones]",
+    p = write(tmp_path, fig3_uniform_text().replace("[effects.lennard_jones]",
                                                  "[effects.lenard_jones]"))
     with pytest.raises(SceneError, match="did you mean 'lennard_jones'"):
         femadh.load_scene(p)
-    p = write(tmp_path, FIG3.read_text().replace("[sweep]", "[swep]"))
+    p = write(tmp_path, fig3_uniform_text().replace("[sweep]", "[swep]"))
     with pytest.raises(SceneError, match="did you mean 'sweep'"):
         femadh.load_scene(p)
 
 
 def test_bare_number_for_a_length_is_refused_in_files_and_si_in_code(tmp_path):
-    p = write(tmp_path, FIG3.read_text().replace('radius = "2 mm"', "radius = 2"))
+    p = write(tmp_path, fig3_uniform_text().replace('radius = "2 mm"', "radius = 2"))
     with pytest.raises(SceneError, match="bare number has no unit") as e:
         femadh.load_scene(p)
     assert e.value.key == "sphere.radius"
@@ -156,7 +157,7 @@ def test_resources_memory_estimate_and_missing_dependency(monkeypatch):
 def test_code_built_scene_matches_the_file():
     import tomllib
 
-    data = tomllib.loads(FIG3.read_text())
+    data = tomllib.loads(fig3_uniform_text())
     a, b = femadh.load_scene(FIG3), scene_from_dict(data, str(FIG3))
     assert a.resolved == b.resolved
 

@@ -77,7 +77,9 @@ class ContactProblem:
         (z0 for LJ alone, ~1 nm with Greenwood-Williamson asperities). With ratio near 1 a
         single node can snap on its own: the answer then depends on the mesh, not the physics.
         """
-        k_node = float(np.min(np.diag(self.K)))
+        # the nodes of the fine band (all, on a uniform grid): a graded far field never comes
+        # close, and its wide annuli are softer by design
+        k_node = float(np.min(np.diag(self.K)[self.grid.fine]))
         if not self.effects:
             return 0.0, math.nan, 0.0, k_node
         if self.sigma is not None:

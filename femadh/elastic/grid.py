@@ -15,10 +15,14 @@ class RadialGrid:
         Node radii (m), increasing, nodes[0] == 0 (the central disk is collocated at its centre).
     edges : ndarray, shape (N+1,)
         Annulus edges (m), edges[0] == 0, edges[-1] == the analysis radius a.
+    fine_radius : float or None
+        Outer radius (m) of the band of finest nodes, where the surfaces come close (a graded
+        grid coarsens beyond it, where the gaps stay large); None: the whole disk.
     """
 
     nodes: np.ndarray
     edges: np.ndarray
+    fine_radius: float | None = None
 
     def __post_init__(self):
         r, e = np.asarray(self.nodes, float), np.asarray(self.edges, float)
@@ -122,14 +126,21 @@ class RadialGrid:
                                  f"{spacing:.3g} m on a radius of {radius:.3g} m)")
         if len(nodes) < 2:
             raise ValueError("the spacing does not fit inside the analysis radius")
-        return cls.from_nodes(np.array(nodes), radius)
+        return cls.from_nodes(np.array(nodes), radius, fine_radius=hi)
 
     @classmethod
-    def from_nodes(cls, nodes, radius):
+    def from_nodes(cls, nodes, radius, fine_radius=None):
         """Annuli with edges half-way between the given nodes (nodes[0] must be 0)."""
         nodes = np.asarray(nodes, float)
         edges = np.concatenate([[0.0], 0.5 * (nodes[1:] + nodes[:-1]), [radius]])
-        return cls(nodes, edges)
+        return cls(nodes, edges, fine_radius)
+
+    @property
+    def fine(self):
+        """Mask of the nodes in the fine band (all nodes without one)."""
+        if self.fine_radius is None:
+            return np.ones(self.nodes.size, bool)
+        return self.nodes <= self.fine_radius
 
     @property
     def n(self):

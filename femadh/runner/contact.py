@@ -31,7 +31,7 @@ PROFILES = 12
 
 
 def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
-        operator=None, estimate=True):
+        operator=None, estimate=True, folder_id=None):
     """Solve a scene.
 
     Parameters
@@ -54,6 +54,9 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         Estimate the error of the headline numbers (a coarser grid's run, the tail beyond the
         analysis radius, the peak between the grid separations; see
         :mod:`femadh.runner.estimates`); "peak": only locate the peak.
+    folder_id : str, optional
+        The scene id the output folder is claimed under (an adaptive run's trials claim it
+        under the user's scene, so that --resume and --overwrite recognise it).
 
     Returns
     -------
@@ -77,6 +80,11 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     if progress is None:
         progress = sys.stderr.isatty()
     with blas_threads():
+        if getattr(scene, "adaptive", False):
+            from .adaptive import run_adaptive
+
+            return run_adaptive(scene, out_dir, run=run, figures=figures, progress=progress,
+                                overwrite=overwrite, resume=resume, estimate=estimate)
         if getattr(scene, "accuracy", None) and estimate is True:
             from .accuracy import run_to_accuracy
 
@@ -87,7 +95,7 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         from ..io.run_folder import RunFolder
 
         mode = "resume" if resume else "overwrite" if overwrite else "new"
-        with RunFolder(out_dir, scene_id(scene), scene.name, mode) as folder:
+        with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
             res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate)
             if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
                 from ..io.plots import contact_figures
@@ -154,6 +162,12 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
             problem = build_problem(scene, operator=operator, progress=say)
             res.timings["operator_s"] = time.perf_counter() - t1
             res.nodes = problem.grid.nodes.copy()
+            g = problem.grid
+            res.grid = {"kind": "uniform" if g.fine_radius is None else "banded", "nodes": g.n,
+                        "analysis_radius_m": g.radius}
+            if g.fine_radius is not None:
+                res.grid.update(band_m=g.fine_radius, spacing_m=float(g.nodes[1]),
+                                grading_m=scene.grid["grading"] if scene.grid else None)
             res.warnings += _stiffness_warning(scene, problem)
             interrupt.check()
             if folder is not None:
@@ -327,7 +341,12 @@ def _stiffness_warning(scene, problem):
     msg = (f"{scene.path or scene.name}: the surface forces' stiffness -dP/dh = {soft:.3g} Pa/m "
            f"at h = {h_at * 1e9:.3g} nm is {ratio:.2f} x the stiffness of one surface node "
            f"({k_node:.3g} Pa/m): single nodes can snap on their own and the result depends on "
-           f"the mesh. Use [solver] nodes >= {int(scene.nodes * ratio / STIFFNESS_WARNING) + 1}.")
+           f"the mesh. " + (f"Use [solver] nodes >= "
+                            f"{int(scene.nodes * ratio / STIFFNESS_WARNING) + 1}."
+                            if problem.grid.fine_radius is None else
+                            f"Use [solver.grid] spacing <= "
+                            f"{float(problem.grid.nodes[1]) * STIFFNESS_WARNING / ratio:.3g} m "
+                            "(or leave the grid to femadh)."))
     warnings.warn(msg, MeshResolutionWarning, stacklevel=4)
     return [msg]
 

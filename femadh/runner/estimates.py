@@ -3,11 +3,11 @@ and accuracy on demand.
 
 Each headline number gets an a-posteriori estimate made of
 - **discretisation**: the same scene on the coarser members of its grid family (N/2 and N/4
-  nodes; FE runs: also the FE body against the exact Green function on the same nodes, or
+  nodes of a uniform grid, spacings r h and r^2 h of a banded one; FE runs: also the FE body against the exact Green function on the same nodes, or
   for a layered body, which has none, against the next coarser mesh of its family with
   Richardson at the P2 body's order 3 and the size ratio the two meshes actually have), the
   fine grid's error estimated by Richardson with the order observed over the three levels
-  (clamped to [1, 3]);
+  (clamped to [1, 2]), or by the envelope of both differences where they oscillate;
 - **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
   the grid separations by a bounded scalar search on fresh states (its bracket is its error);
   a fold is located to 2^-10 of the grid step (the jump's resolution);
@@ -52,11 +52,28 @@ TRAPPING_LIMIT = 1.0
 EDGE_FRACTION = 0.9
 #: assumed order of the discretisation error in the node spacing (conservative, see above)
 ORDER = 1.0
+#: order of the envelope of an oscillating convergence (the contact edge moving between
+#: nodes): the Fig 3 scene's banded family, spacings 175 -> 15.5 nm, shows errors falling
+#: 12-20x per factor 4 in spacing around a sign-changing mean (validation/results/adaptive.md)
+ENVELOPE_ORDER = 2.0
+#: the largest order a monotone sequence of three members may claim: their coarsest member
+#: is often pre-asymptotic (Fig 3 banded, 175/87.5/43.75 nm: apparent order 3.4, true
+#: error of the finest 2x the order-3 estimate), so the family's envelope order caps it
+MAX_ORDER = ENVELOPE_ORDER
 
 
 class GuardError(FemadhError):
     """A state or result outside the model's validity: names the quantity, its value and the
     setting to change."""
+
+
+class TrappingError(GuardError):
+    """Lattice trapping: a node's softening beyond its own stiffness (``ratio``); a trigger
+    for refinement where femadh chooses the grid."""
+
+    def __init__(self, msg, ratio):
+        super().__init__(msg)
+        self.ratio = ratio
 
 
 def check_state(problem, state, scene):
@@ -70,12 +87,20 @@ def check_state(problem, state, scene):
             "sweep earlier")
     ratio = problem.node_softening_ratio(state.h)
     if ratio > TRAPPING_LIMIT:
-        n = problem.grid.n
-        raise GuardError(
+        raise TrappingError(
             f"at d = {state.d * 1e9:.4g} nm a node's surface-force softening -P'(h) is "
             f"{ratio:.2f} x its own stiffness: single nodes snap on their own (lattice "
-            f"trapping) and the result depends on the mesh; use [solver] nodes >= "
-            f"{int(math.ceil(n * ratio / 0.5))}")
+            f"trapping) and the result depends on the mesh; {_finer_advice(problem, ratio)}",
+            ratio=ratio)
+
+
+def _finer_advice(problem, ratio):
+    """What to change for a grid whose band nodes snap alone at this softening ratio."""
+    g = problem.grid
+    if g.fine_radius is None:
+        return f"use [solver] nodes >= {int(math.ceil(g.n * ratio / 0.5))}"
+    return (f"use [solver.grid] spacing <= {float(g.nodes[1]) * 0.5 / ratio:.3g} m "
+            "(or leave the grid to femadh)")
 
 
 def tolerance_force(problem, state, tol):
@@ -125,7 +150,8 @@ def peak_adhesion(problem, prev, best, nxt, scene):
 def variant(scene, **changes):
     """The scene with solver changes, validated: nodes=N, method="green" (drops the FE mesh
     table), coarse_mesh=True (FE element sizes doubled), delta=... (analysis radius by its
-    gap)."""
+    gap), radius=... (analysis radius, m), grid={spacing, band, grading} (a banded member,
+    m)."""
     from ..scene import apply_overrides, scene_from_dict
 
     raw = apply_overrides(scene.raw, {})
@@ -144,6 +170,12 @@ def variant(scene, **changes):
         mesh["surface_fraction"] = min(1.0, 2 * fs.surface_fraction)
     if "delta" in changes:
         solver["analysis_radius"] = {"delta": f"{changes['delta']!r} m"}
+    if "radius" in changes:
+        solver["analysis_radius"] = f"{changes['radius']!r} m"
+    if "grid" in changes:
+        # a banded member (lengths in m): replaces the uniform nodes
+        solver.pop("nodes", None)
+        solver["grid"] = {k: f"{float(v)!r} m" for k, v in changes["grid"].items()}
     solver.pop("accuracy", None)
     raw.pop("study", None)
     return scene_from_dict(raw, scene.path, bare_numbers=True)
@@ -233,18 +265,21 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             res.warnings.append(f"FE mesh estimate: the {'coarser mesh' if layered else 'Green'}"
                                 f" run failed: {g.error}")
     levels = []
-    for n in (scene.nodes // 2, scene.nodes // 4):
-        if n < 8:
-            break
-        r = run(variant(scene, nodes=n, **green), progress=False, estimate="peak")
+    ratio, members = coarser_members(scene, problem, green)
+    for label, member in members:
+        r = run(member, progress=False, estimate="peak")
         if r.status != "converged":
-            res.warnings.append(f"discretisation estimate: the coarse grid (N = {n}) failed: "
+            res.warnings.append(f"discretisation estimate: the coarse grid ({label}) failed: "
                                 f"{r.error}")
             break
         levels.append(dict(r.headline))
+    res.grid["member_ratio"] = ratio
+    res.grid["members"] = [lb for lb, _ in members][:len(levels)]
+    if scene.grid is not None:
+        res.grid["member_spacings_m"] = [m.grid["spacing"] for _, m in members][:len(levels)]
     if levels:
-        for k, v in discretisation(fine_hl, levels[0],
-                                   levels[1] if len(levels) > 1 else None).items():
+        for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
+                                   ratio=ratio).items():
             parts.setdefault(k, {})["grid"] = v
     # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
@@ -295,11 +330,36 @@ def guard_bounds(res, problem):
             "accuracy)")
 
 
-def discretisation(fine, coarse, coarser=None):
+def coarser_members(scene, problem, green=None):
+    """(ratio r, [(label, scene)]) of the two coarser members of the scene's grid family.
+
+    Uniform grids: N/2 and N/4 (r = 2). Banded grids: spacings r h and r^2 h of the same
+    family (same band, grading and radius), with r = 2 where the coarsest member's band
+    nodes stay below the trapping limit, else the largest r >= MIN_MEMBER_RATIO that keeps
+    them there: a lattice-trapped member lands fold after fold and makes the estimate
+    pessimistic (the Fig 4 scene's N = 50 and 100 members: effectivity 9.8)."""
+    green = green or {}
+    if scene.grid is None:
+        return 2.0, [(f"N = {n}", variant(scene, nodes=n, **green))
+                     for n in (scene.nodes // 2, scene.nodes // 4) if n >= 8]
+    from ..discretisation.plan import member_ratio
+
+    r = member_ratio(problem)
+    g = scene.grid
+    out = []
+    for k in (1, 2):
+        h = g["spacing"] * r**k
+        if h > g["band"] / 8:
+            break
+        out.append((f"spacing {h * 1e9:.4g} nm", variant(scene, grid={**g, "spacing": h})))
+    return r, out
+
+
+def discretisation(fine, coarse, coarser=None, ratio=2.0):
     """Signed estimate of each headline number's discretisation error, Q_exact - Q_fine, from
-    the coarser members of its grid family (N/2 and N/4): (Q_N - Q_N/2) / (2^p - 1) with the
-    order p observed over the three levels (clamped to [ORDER, 3]; ORDER = 1 without the
-    third level)."""
+    the coarser members of its grid family (spacings r h and r^2 h; N/2 and N/4 for uniform
+    grids, r = 2): (Q_h - Q_rh) / (r^p - 1) with the order p observed over the three levels
+    (clamped to [ORDER, 3]; ORDER = 1 without the third level)."""
     out = {}
     for k, v in fine.items():
         c = coarse.get(k)
@@ -309,8 +369,17 @@ def discretisation(fine, coarse, coarser=None):
         p = ORDER
         cc = (coarser or {}).get(k)
         if isinstance(cc, float) and math.isfinite(cc) and v != c and cc != c:
-            p = min(3.0, max(ORDER, math.log2(abs(c - cc) / abs(v - c))))
-        out[k] = (v - c) / (2.0**p - 1.0)
+            d1, d2 = v - c, c - cc
+            if d1 * d2 > 0 and abs(d2) > abs(d1):
+                # monotone convergence: the order it shows
+                p = min(MAX_ORDER, max(ORDER, math.log(abs(d2) / abs(d1)) / math.log(ratio)))
+            else:
+                # oscillating (a contact edge hopping between nodes): the two differences
+                # may cancel by chance; the envelope of both at the family's order
+                p = ENVELOPE_ORDER
+                out[k] = math.copysign(max(abs(d1), abs(d2) / ratio**p), d1) / (ratio**p - 1)
+                continue
+        out[k] = (v - c) / (ratio**p - 1.0)
     return out
 
 

@@ -50,6 +50,9 @@ class ContactResult:
         The error breakdown: quantity -> {grid, fe_mesh, resolution, tail, tolerance, total}.
     accuracy : dict
         Accuracy mode: the target, what was chosen (nodes, analysis radius) and the steps.
+    grid : dict
+        The discretisation used: kind (uniform/banded), nodes, analysis radius, band and
+        spacing (banded), the spacing ratio of the estimate's coarser members and their labels.
     timings : dict
         Seconds per phase.
     warnings : list of str
@@ -71,6 +74,7 @@ class ContactResult:
     warnings: list = field(default_factory=list)
     out_dir: str | None = None
     accuracy: dict = field(default_factory=dict)
+    grid: dict = field(default_factory=dict)
 
     kind = "contact"
 
@@ -162,5 +166,5 @@ def contact_summary(res, status=None):
             "status": status or res.status, "error": res.error,
             "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
             "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
-            "accuracy": res.accuracy, "warnings": res.warnings,
+            "accuracy": res.accuracy, "grid": res.grid, "warnings": res.warnings,
             "timings_s": res.timings, "wall_time_s": res.wall_time}

@@ -3,6 +3,18 @@ function or condensed FE) on the scene's grid, and the contact problem with only
 scene names."""
 
 
+def scene_grid(scene):
+    """The scene's radial nodes: its [solver.grid] member, else N uniform nodes."""
+    from ..elastic import RadialGrid
+
+    if scene.grid is not None:
+        from ..discretisation import GridFamily
+
+        g = scene.grid
+        return GridFamily(scene.analysis_radius, g["band"], g["grading"]).member(g["spacing"])
+    return RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+
+
 def build_operator(scene, progress=None, *, grid=None, settings=None):
     """The scene's SurfaceOperator: Green function or condensed FE, on the scene's grid.
 
@@ -10,9 +22,9 @@ def build_operator(scene, progress=None, *, grid=None, settings=None):
     sphere's own compliance added (rigid without a slider material). ``grid`` and
     ``settings`` (FESettings) replace the scene's (convergence studies).
     """
-    from ..elastic import GreenOperator, RadialGrid
+    from ..elastic import GreenOperator
 
-    grid = grid or RadialGrid.uniform(scene.analysis_radius, scene.nodes)
+    grid = grid or scene_grid(scene)
     if scene.method == "fe":
         from ..elastic.fe import FEOperator
 

@@ -16,6 +16,8 @@ from ..schema import Key, Table
 from .reader import BAD, any_bad
 
 METHODS = ("green", "fe")
+#: relative accuracy of the headline numbers an adaptive run meets unless the scene asks
+DEFAULT_ACCURACY = 1e-3
 DIRECTIONS = ("approach", "retract")
 #: the largest number of separations a sweep may list
 MAX_SEPARATIONS = 100000
@@ -91,11 +93,24 @@ MESH = Table("solver.mesh", "FE mesh of the half-space (method = 'fe').", (
         "0.3).", default=None, lo=-1.0, hi=0.5),
 ))
 
+GRID = Table("solver.grid", "A banded radial grid (Green method): uniform spacing on the "
+             "band [0, band] where the surfaces come close, the spacing growing by about "
+             "spacing per grading length beyond it. Without [solver] nodes or [solver.grid], "
+             "femadh plans this grid itself and refines it until the error estimate meets "
+             "[solver] accuracy.", (
+    Key("spacing", "length", "Node spacing h in the band.", lo=0.0),
+    Key("band", "length", "Outer radius of the band of uniform spacing.", lo=0.0),
+    Key("grading", "length", "Length over which the spacing beyond the band grows by h.",
+        lo=0.0),
+))
+
 SOLVER = Table("solver", "Discretisation and solver.", (
     Key("method", "choice", "Elastic half-space: exact Green function or condensed finite "
         "elements.", default="green", choices=METHODS),
-    Key("nodes", "integer", "Radial nodes N on the analysis disk.", default=200, lo=8,
-        lo_closed=True, hi=20000, hi_closed=True),
+    Key("nodes", "integer", "Radial nodes N, uniform on the analysis disk: an explicit "
+        "discretisation that turns the adaptive grid off (without it the Green method plans "
+        "a banded grid and refines it to [solver] accuracy; the FE method and the paper's "
+        "closure use 200).", default=200, lo=8, lo_closed=True, hi=20000, hi_closed=True),
     Key("analysis_radius", "custom", "The analysed disk: a length, or { delta = length } "
         "with delta = a^2/2R.", default={"delta": "10 nm"}, parse=_analysis_radius,
         expect="a length, or a table { delta = length }"),
@@ -106,10 +121,14 @@ SOLVER = Table("solver", "Discretisation and solver.", (
     Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
         "laws only).", default="steps", choices=("steps", "arclength")),
     Key("accuracy", "number", "Relative accuracy asked of the headline numbers (largest "
-        "adhesion, forces at the deepest separation): femadh refines N and the analysis "
-        "radius until its error estimate meets it, or says it cannot. Without it the "
-        "explicit settings are used and the estimate is reported.", default=None, lo=0.0,
+        "adhesion, forces at the deepest separation): femadh refines the grid and the "
+        "analysis radius until its error estimate meets it, or says it cannot. Default "
+        "1e-3 for the adaptive grid; with explicit [solver] nodes and no accuracy, the "
+        "nodes are used as given and the estimate is reported.", default=None, lo=0.0,
         hi=0.1, hi_closed=True),
+    Key("grid", "custom", "An explicit banded grid, see [solver.grid].", default=None,
+        parse=lambda r, raw, path: None if raw is None else r.read(GRID, raw, path),
+        expect="a table (see [solver.grid])"),
     Key("mesh", "custom", "FE mesh settings (method = 'fe'), see [solver.mesh].",
         default=None, parse=lambda r, raw, path: None if raw is None else r.read(MESH, raw, path),
         expect="a table (see [solver.mesh])"),
@@ -234,9 +253,25 @@ class Scene:
     layers: tuple = ()
     study: dict | None = None
     accuracy: float | None = None
+    grid: dict | None = None
+    nodes_explicit: bool = True
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "contact"
+
+    @property
+    def adaptive(self):
+        """Whether femadh chooses the grid (Green method, complementarity or smooth laws,
+        neither [solver] nodes nor [solver.grid] given)."""
+        return (self.method == "green" and self.grid is None and not self.nodes_explicit
+                and (self.gap is None or self.gap.contact_model == "complementarity"))
+
+    @property
+    def target_accuracy(self):
+        """The relative accuracy the run must meet (None: the explicit settings, judged)."""
+        if self.accuracy is not None:
+            return self.accuracy
+        return DEFAULT_ACCURACY if self.adaptive else None
 
     @classmethod
     def from_dict(cls, data, file=None):
@@ -272,7 +307,7 @@ class Scene:
             "asperity_gap": None if self.gap is None else
             {"sigma_m": self.gap.sigma, "contact_model": self.gap.contact_model,
              "adhesion_Pa": self.gap.adhesion},
-            "solver": {"method": self.method, "nodes": self.nodes,
+            "solver": {"method": self.method, "nodes": self.nodes, "grid": self.grid,
                        "analysis_radius_m": self.analysis_radius,
                        "tolerance_m": self.tolerance, "max_iter": self.max_iter,
                        "continuation": self.continuation, "accuracy": self.accuracy,
@@ -352,7 +387,9 @@ def parse_contact(reader, data, file):
                  output_dir=ou["dir"] or f"out/{name}", fe_poisson_ratio=fe_nu, vtk=vtk,
                  continuation=so["continuation"], disk=disk, slider=slider,
                  layers=layers if layers is not BAD else (), study=study,
-                 accuracy=so["accuracy"], raw=copy.deepcopy(data))
+                 accuracy=so["accuracy"], grid=so["grid"],
+                 nodes_explicit="nodes" in (data.get("solver") or {}),
+                 raw=copy.deepcopy(data))
 
 
 def _read_materials(reader, data):
@@ -500,6 +537,21 @@ def _fe_settings(mesh, nu_default):
 
 def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
     """Rules that tie tables together."""
+    grid = so.get("grid")
+    if grid is not None and grid is not BAD and not any_bad(grid):
+        raw_grid = (data.get("solver") or {}).get("grid")
+        if so["method"] != "green":
+            reader.fail("solver.grid", raw_grid, "no [solver.grid] unless method = \"green\" "
+                        "(the FE body takes uniform surface nodes: [solver] nodes)")
+        elif "nodes" in (data.get("solver") or {}):
+            reader.fail("solver.grid", raw_grid, "either [solver] nodes (uniform) or "
+                        "[solver.grid] (banded), not both")
+        elif a is not BAD and grid["band"] > a:
+            reader.fail("solver.grid.band", raw_grid.get("band"), f"a band within the "
+                        f"analysis radius a = {a * 1e6:.4g} um")
+        elif grid["spacing"] > grid["band"]:
+            reader.fail("solver.grid.spacing", raw_grid.get("spacing"), "a spacing at most "
+                        "the band's radius")
     if so["continuation"] == "arclength":
         if gap is not None:
             reader.fail("solver.continuation", "arclength", "'steps' with "

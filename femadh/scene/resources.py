@@ -26,6 +26,11 @@ def physical_memory():
 def memory_estimate(scene):
     """Bytes a contact scene's operator and solver hold (a lower bound), and what dominates."""
     n = scene.nodes
+    if scene.grid is not None:
+        from ..discretisation import GridFamily
+
+        g = scene.grid
+        n = GridFamily(scene.analysis_radius, g["band"], g["grading"]).count(g["spacing"])
     dense = GREEN_ARRAYS * 8.0 * n * n
     if scene.method == "fe":
         fe = 8.0 * FE_DOFS_PER_NODE * n * n * (0.5 / scene.fe_settings.surface_fraction) ** 2
