@@ -154,7 +154,7 @@ DEFECTS = [
     D("force_contact", "contact force integrated 10 % low", "femadh/contact/forces.py",
       (("f_el = g.force(state.p_contact)", "f_el = 0.9 * g.force(state.p_contact)"),)),
     D("regime_tail", "regime map: LJ tail beyond the analysis radius dropped",
-      "femadh/studies/regime.py",
+      "femadh/studies/smooth_sphere.py",
       (("tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))",
         "tail = 0.0"),)),
     D("hysteresis_energy", "hysteresis: half the energy released at a jump", "femadh/studies/regime.py",

@@ -6,7 +6,7 @@ import pytest
 from femadh.contact import trace
 from femadh.contact.arclength import trace_curve
 from femadh.contact.landing import land
-from femadh.studies.regime import _lj_problem
+from femadh.studies.smooth_sphere import lj_sphere_problem
 
 from conftest import check_curve_against_fields
 
@@ -17,7 +17,7 @@ TOL = 1e-19
 @pytest.fixture(scope="module")
 def mu2():
     """Tabor mu = 2: one S-shaped curve (jump-in and jump-out)."""
-    problem, lj, e_star, a, d_min = _lj_problem(2.0, R, A, Z0, 0.4, 120)
+    problem, lj, e_star, a, d_min = lj_sphere_problem(2.0, R, A, Z0, 0.4, 120)
     curve = trace_curve(problem, 12 * Z0, d_min, tol=TOL, scale=Z0, ds=0.2, ds_max=2.0)
     return problem, curve, d_min
 

@@ -13,7 +13,7 @@ from femadh.laws import LennardJones
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.errors import ConvergenceError, LawError
 from femadh.indenter import Sphere
-from femadh.studies.regime import _lj_problem
+from femadh.studies.smooth_sphere import lj_sphere_problem
 
 from conftest import E_STAR, HAMAKER, Z0
 
@@ -63,7 +63,7 @@ def test_wrong_derivative_fails_cleanly_in_stepping_continuation():
 def test_wrong_derivative_fails_cleanly_in_arclength_continuation():
     """Unchecked, the tangent and the corrector disagree; the step budget per point stops
     the trace (measured 0.5 s; before the budget it ran for over 15 minutes)."""
-    problem, lj, *_, d_min = _lj_problem(2.0, 1e-6, HAMAKER, Z0, 0.4, 120)
+    problem, lj, *_, d_min = lj_sphere_problem(2.0, 1e-6, HAMAKER, Z0, 0.4, 120)
     problem = ContactProblem(problem.operator, problem.sphere,
                              {"lj": SteepDerivative(HAMAKER, Z0)}, check_laws=False)
     t0 = time.perf_counter()

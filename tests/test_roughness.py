@@ -115,10 +115,10 @@ def test_regime_force_of_the_undeformed_surface_is_eq14_untruncated():
     eq 14 on the whole plane; the grid's midpoint rule costs at most 1.5e-4 here (measured),
     while the tail alone is 0.3-11 % of it at d = z0 ... 10 z0."""
     from femadh.reference.rigid_lj import rigid_sphere_lj_force
-    from femadh.studies.regime import _lj_problem, lj_force
+    from femadh.studies.smooth_sphere import lj_force, lj_sphere_problem
 
     R, A, z0 = 1e-6, 1e-19, 0.165e-9
-    problem, lj, *_ = _lj_problem(1.0, R, A, z0, 0.4, 120)
+    problem, lj, *_ = lj_sphere_problem(1.0, R, A, z0, 0.4, 120)
     for d in np.array([1.0, 1.5, 3.0, 10.0]) * z0:
         F = lj_force(problem, lj, d, np.zeros(problem.grid.n))
         assert F == pytest.approx(rigid_sphere_lj_force(d, A, z0, R), rel=5e-4)

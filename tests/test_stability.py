@@ -14,7 +14,7 @@ from femadh.contact import solve_state
 from femadh.contact.stability import is_stable
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.indenter import Sphere
-from femadh.studies.regime import _lj_problem
+from femadh.studies.smooth_sphere import lj_sphere_problem
 
 from conftest import HAMAKER, Z0
 
@@ -82,7 +82,7 @@ def test_stability_flag_equals_hessian_eigenvalue_sign_on_random_states():
 
 @pytest.fixture(scope="module")
 def mu2_curve():
-    problem, lj, e_star, a, d_min = _lj_problem(2.0, 1e-6, HAMAKER, Z0, 0.4, 120)
+    problem, lj, e_star, a, d_min = lj_sphere_problem(2.0, 1e-6, HAMAKER, Z0, 0.4, 120)
     curve = trace_curve(problem, 12 * Z0, d_min, tol=TOL, scale=Z0, ds=0.2, ds_max=2.0)
     return problem, curve
 
@@ -123,7 +123,7 @@ def test_lattice_trapping_saddles_with_negative_node_diagonals_are_unstable():
     node's own diagonal K_kk + P'(h_k) is negative. Newton converges to them; the ones the
     Hessian's eigenvalues call saddles must be reported unstable (the old decision called
     most of them stable: 137 of 306 curve points disagreed)."""
-    problem, *_ , d_min = _lj_problem(2.0, 1e-6, HAMAKER, Z0, 2.5, 17)
+    problem, *_ , d_min = lj_sphere_problem(2.0, 1e-6, HAMAKER, Z0, 2.5, 17)
     curve = trace_curve(problem, 12 * Z0, d_min, tol=TOL, scale=Z0, ds=0.2, ds_max=0.5)
     K = np.diag(problem.K)
     checked = 0

@@ -44,7 +44,7 @@ from femadh.materials import IsotropicMaterial, composite_modulus  # noqa: E402
 from femadh.reference.layered import LayeredHalfSpace  # noqa: E402
 from femadh.reference.maugis import lj_dugdale_lambda, maugis_pull_off  # noqa: E402
 from femadh.studies.convergence import FE_LEVELS  # noqa: E402
-from femadh.studies.regime import _lj_problem, lj_force  # noqa: E402
+from femadh.studies.smooth_sphere import lj_force, lj_sphere_problem  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
 OUT = Path("out") / "layered-vtk"
@@ -560,7 +560,7 @@ def part_film():
     import matplotlib.pyplot as plt
 
     A, z0 = film_law()
-    base, lj, e_star, a_an, d_min = _lj_problem(FILM_MU, TIP_R, A, z0, 0.4, 120)
+    base, lj, e_star, a_an, d_min = lj_sphere_problem(FILM_MU, TIP_R, A, z0, 0.4, 120)
     grid = base.grid
     results = []
     for t in FILM_THICKNESSES:
@@ -647,7 +647,7 @@ Tip: fused silica sphere, R = 1 um, E = 73 GPa, nu = 0.17 (its Green compliance 
 Film: PDMS-like, E = 2 MPa, nu = 0.499 (FE mixed formulation), thickness 10 nm ... 10 um,
 bonded to soda-lime glass (E = 70 GPa, nu = 0.22). Smooth LJ sphere (no sigma-gap), traced by
 pseudo-arclength continuation through its folds (`femadh.contact.arclength.trace_curve`), the
-same set-up as `femadh.studies.regime` (graded grid from `_lj_problem`: {grid.n} nodes, finest
+same set-up as `femadh.studies.regime` (graded grid from `lj_sphere_problem`: {grid.n} nodes, finest
 spacing {np.diff(grid.nodes).min() * 1e9:.2f} nm, analysis radius {grid.radius * 1e6:.2f} um;
 force = LJ on the disk + the rigid tail beyond).
 
@@ -746,7 +746,7 @@ def part_render():
 
     pv.OFF_SCREEN = True
     A, z0 = film_law()
-    base, lj, _, _, d_min = _lj_problem(FILM_MU, TIP_R, A, z0, 0.4, 120)
+    base, lj, _, _, d_min = lj_sphere_problem(FILM_MU, TIP_R, A, z0, 0.4, 120)
     grid = base.grid
     t = 300e-9
     op = FEOperator(grid, substrate=GLASS, layers=[Layer(t, FILM.youngs_modulus,

@@ -151,7 +151,10 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             new_A = _restrict_change(A, new_A)
         seen.add(key)
         if not np.array_equal(new_A, A):
-            res = math.inf
+            # a new active set: its first residual is not comparable with the last one, so
+            # the next step is not a stall (a trailing LU that covers the new disk is reused
+            # rather than refactorised: the contact edge moves node by node along a sweep)
+            res, res_prev = math.inf, math.inf
         A = new_A
     h = b - w
     pc = np.zeros(n)

@@ -31,30 +31,37 @@ class GridFamily:
         Outer radius r_b of the band of uniform spacing [0, r_b].
     grading : float
         Length g over which the spacing beyond the band grows by h.
+    inner : float
+        Inner radius of the band (0: the band is the disk [0, band]; > 0: a band around a
+        feature, graded towards the centre as well, :class:`MovingBand`).
     """
 
     radius: float
     band: float
     grading: float
+    inner: float = 0.0
 
     def __post_init__(self):
-        if not (self.radius > 0 and 0 < self.band <= self.radius and self.grading > 0):
-            raise ValueError(f"grid family needs 0 < band ({self.band:.3g} m) <= radius "
-                             f"({self.radius:.3g} m) and grading > 0 ({self.grading:.3g} m)")
+        if not (self.radius > 0 and 0 < self.band <= self.radius and self.grading > 0
+                and self.inner < self.band):
+            raise ValueError(f"grid family needs inner ({self.inner:.3g} m) < band "
+                             f"({self.band:.3g} m) <= radius ({self.radius:.3g} m) and "
+                             f"grading > 0 ({self.grading:.3g} m)")
 
     def member(self, spacing):
         """The member of band spacing h = ``spacing`` (m) as a :class:`RadialGrid`.
 
         Raises ValueError beyond :data:`MAX_NODES` nodes."""
-        return RadialGrid.banded(self.radius, spacing, (0.0, self.band), self.grading,
-                                 max_nodes=MAX_NODES)
+        return RadialGrid.banded(self.radius, spacing, (max(0.0, self.inner), self.band),
+                                 self.grading, max_nodes=MAX_NODES)
 
     def count(self, spacing):
         """Node count of the member of band spacing h (m), from the spacing function
         (within a few nodes of :meth:`member`, without building it)."""
-        far = max(self.radius - self.band, 0.0)
-        return int(math.ceil(self.band / spacing
-                             + self.grading / spacing * math.log1p(far / self.grading)))
+        far, lo = max(self.radius - self.band, 0.0), max(0.0, self.inner)
+        return int(math.ceil((self.band - lo) / spacing
+                             + self.grading / spacing * (math.log1p(far / self.grading)
+                                                         + math.log1p(lo / self.grading))))
 
     def spacing_for(self, nodes):
         """The band spacing h (m) of the member with about ``nodes`` nodes."""

@@ -123,12 +123,21 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                                 family.grading)
             steps[-1]["band_left_m"] = edge
             continue
+        judged = len(res.grid.get("members", ()))
+        if judged == 0:
+            # no coarser member converged (a stalled landing at a meniscus edge, trapping):
+            # the grid error is unknown, so the result cannot be called converged; a finer
+            # family has finer members
+            steps[-1]["members_failed"] = True
+            h *= MAX_FACTOR
+            continue
         err = grid_e + tail_e
         if err <= target:
             break
         factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
         h *= min(MAX_FACTOR, max(MIN_FACTOR, factor))
     met = bool(res is not None and res.status == "converged" and estimate is True and steps
+               and not steps[-1].get("members_failed")
                and steps[-1]["grid_rel_error"] + steps[-1]["tail_rel_error"] <= target)
     if res is None:
         from .result import ContactResult
@@ -143,6 +152,12 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                     "wall_time_s": time.perf_counter() - t0}
     if failure and res.status == "converged" or failure and not steps:
         res.status, res.error = "failed", f"accuracy {target:g} not met: {failure}"
+    elif not met and res.status == "converged" and estimate is True and \
+            last.get("members_failed"):
+        res.status = "failed"
+        res.error = (f"accuracy {target:g} not judged: no coarser member of the grid family "
+                     f"converged after {len(steps)} runs (last: {last['nodes']} nodes, band "
+                     f"spacing {last['spacing_m'] * 1e9:.3g} nm); see the warnings")
     elif not met and res.status == "converged" and estimate is True:
         reached = last["grid_rel_error"] + last["tail_rel_error"]
         need = _nodes_needed(family, last["spacing_m"], reached, target)

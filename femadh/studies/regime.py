@@ -49,25 +49,22 @@ import numpy as np
 
 from ..contact import ContactProblem
 from ..contact.arclength import trace_curve
-from ..elastic import GreenOperator, RadialGrid
+from ..discretisation.moving import MovingBand, contact_edge
+from ..elastic import GreenOperator
 from ..errors import ConvergenceError, MeshResolutionWarning
 from ..indenter import Sphere
 from ..laws import LennardJones
-from ..reference.adhesion import dmt_contact_radius, jkr_contact_radius
-from ..reference.maugis import (jkr_approach, lj_dugdale_lambda, maugis_fixed_grip_pull_off,
+from ..reference.adhesion import jkr_contact_radius
+from ..reference.maugis import (lj_dugdale_lambda, maugis_fixed_grip_pull_off,
                                 maugis_length_units, maugis_pull_off)
+from .smooth_sphere import (FINE_MARGIN, PRELOAD, STIFFNESS_TARGET, deepest_separation,
+                            e_star_length, lateral_length, lj_force, lj_sphere_problem)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
-#: a priori (legacy fixed grids): LJ softening stiffness below this fraction of a node's
-STIFFNESS_TARGET = 0.4
 #: a posteriori: above this local ratio -P'(h_k)/K_kk (on any traced state) a node can snap on
 #: its own (lattice trapping): the point is not a converged result
 TRAPPING_LIMIT = 1.0
-#: compressive load (units pi R dg) at the deepest point of a curve without folds (DMT side)
-PRELOAD = 0.5
-#: legacy fixed grid: uniform spacing up to this multiple of the JKR radius at PRELOAD
-FINE_MARGIN = 1.15
 #: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
 #: it is added to the force exactly); at least sqrt(2 R 20 z0) (the rigid gap there is 20 z0)
 ANALYSIS_RADIUS = 8.0
@@ -129,7 +126,8 @@ class Resolution:
         Largest continuation step (units of z0); None: from the trace's length.
     stiffness_target, min_nodes : float, int or None
         Legacy fixed graded grid (today's explicit settings, no moving band): when either is
-        set the grid is :func:`_lj_problem`'s and its coarser member has twice the spacing.
+        set the grid is :func:`~femadh.studies.smooth_sphere.lj_sphere_problem`'s and its
+        coarser member has twice the spacing.
     """
 
     spacing: float = SPACING
@@ -215,82 +213,6 @@ class RegimePoint:
     hysteresis_error = property(lambda self: self.error("hysteresis"))
 
 
-def lateral_length(law, radius, e_star):
-    """ell (m): the smaller of the elastocohesive length E* z0^2/dg (cohesive-zone width at a
-    JKR-like edge) and sqrt(R z0 / 8) (the gap of the rigid paraboloid grows by z0/16 over it:
-    the DMT side, where the law's range, not the edge, sets the lateral scale)."""
-    return min(e_star_length(law, e_star), math.sqrt(radius * law.z0 / 8))
-
-
-def e_star_length(law, e_star):
-    """Elastocohesive length E* z0^2 / dg (m)."""
-    return e_star * law.z0**2 / law.work_of_adhesion
-
-
-def _lj_problem(mu, radius, hamaker, z0, stiffness_target, min_nodes):
-    """Legacy fixed grid: the smooth-sphere problem at Tabor mu, uniform fine spacing (set by
-    the LJ softening stiffness against a node's) up to where the contact edge travels.
-
-    Returns (problem, lj, e_star, a, d_min): a is the analysis radius (m), d_min the
-    separation (m) of the deepest point, where the JKR load is PRELOAD pi R dg.
-    """
-    lj = LennardJones(hamaker, z0)
-    dg = lj.work_of_adhesion
-    e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
-    a_unit = maugis_length_units(radius, e_star, dg)[0]
-    a = max(4.32 * a_unit, math.sqrt(2 * radius * 20 * z0))
-    a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, e_star, dg)
-    d_min = _deepest(mu, radius, e_star, lj)
-    # node self-stiffness scales like 1/spacing: calibrate it on a coarse uniform probe
-    probe = ContactProblem(GreenOperator(RadialGrid.uniform(a, 60), e_star), Sphere(radius),
-                           {"lj": lj})
-    ratio0, _, _, _ = probe.surface_force_stiffness()
-    dr = a / 59.5 * stiffness_target / ratio0
-    if dr >= a / (min_nodes - 0.5):
-        grid = RadialGrid.uniform(a, min_nodes)
-    else:
-        grid = RadialGrid.graded(a, dr, FINE_MARGIN * a_max)
-    problem = ContactProblem(GreenOperator(grid, e_star), Sphere(radius), {"lj": lj})
-    return problem, lj, e_star, a, d_min
-
-
-def _deepest(mu, radius, e_star, law):
-    """Separation (m) of the deepest point: where the load is PRELOAD pi R dg in the nearer
-    limit (DMT below mu = 1, JKR above), from where the rigid sphere's force vanishes
-    (U(d) = 0: d = z0 / 4^(1/6) for LJ)."""
-    dg, z0 = law.work_of_adhesion, law.z0
-    load = PRELOAD * math.pi * radius * dg
-    if mu < 1:
-        delta = dmt_contact_radius(load, radius, e_star, dg) ** 2 / radius
-    else:
-        delta = jkr_approach(jkr_contact_radius(load, radius, e_star, dg), radius, e_star, dg)
-    return z0 / 4 ** (1 / 6) - delta
-
-
-def lj_force(problem, lj, d, w):
-    """Force on the disk (N, attractive positive) of a state: the law's pressure integrated
-    over the analysis disk plus the tail beyond it, where the surface is undeformed and the
-    paraboloid's force is exactly -2 pi R U(b(a; d)) (Derjaguin is exact for a paraboloid:
-    2 pi r dr = 2 pi R dh)."""
-    a, radius = problem.grid.radius, problem.sphere.radius
-    h = problem.contour(d) - w
-    tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))
-    return problem.grid.force(problem.pressure(h)) + tail
-
-
-def contact_edge(problem, w, d, gap):
-    """Radius (m) of the contact edge: the outermost r where h(r) <= gap (linear between
-    nodes); 0 when no node is that close."""
-    h = problem.contour(d) - w
-    close = np.flatnonzero(h <= gap)
-    if not close.size:
-        return 0.0
-    k, r = int(close[-1]), problem.grid.nodes
-    if k == r.size - 1:
-        return float(r[-1])
-    return float(r[k] + (gap - h[k]) / (h[k + 1] - h[k]) * (r[k + 1] - r[k]))
-
-
 class _Setup:
     """Physical problem of one map point and the grids of one resolution."""
 
@@ -313,7 +235,7 @@ class _Setup:
         # half-width of the moving band (m): wider beyond BAND_MU, where the jump-out fold is
         # so flat that the grids' folds lie apart and exchanges are refused over a window
         self.half = res.band * self.ell * max(1.0, mu / BAND_MU)
-        self.d_end = _deepest(mu, radius, self.e_star, law)
+        self.d_end = deepest_separation(mu, radius, self.e_star, law)
         # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
         # its landing on the approach branch is on the curve
         fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
@@ -321,23 +243,24 @@ class _Setup:
         self.d_start = max(12 * z0, 1.5 * d_out)
         self.ds_max = res.ds_max if res.ds_max else max(0.5, 0.02 * self.d_start / z0)
         self.sphere = Sphere(radius)
-        self.centers = {}
+
+        def build(grid, first):
+            return ContactProblem(GreenOperator(grid, self.e_star), self.sphere,
+                                  {"law": self.law}, check_laws=first)
+        # the grid family of this resolution: a band following the contact edge (one home
+        # for the moving band: femadh.discretisation.moving)
+        self.band = MovingBand(self.a, self.spacing, self.half, res.grading * self.ell, build,
+                               EDGE_GAP * z0, fixed=self.fixed_band)
 
     def problem(self, center=0.0):
         """The problem on a grid fine around the contact edge at ``center`` (m)."""
         if self.res.legacy:
             if not isinstance(self.law, LennardJones):
                 raise ValueError("the legacy fixed grid is defined for LennardJones only")
-            return _lj_problem(self.mu, self.radius, self.law.hamaker, self.z0,
-                               self.res.stiffness_target or STIFFNESS_TARGET,
-                               self.res.min_nodes or 120)[0]
-        half = self.half
-        band = ((0.0, self.fixed_band) if self.fixed_band else (center - half, center + half))
-        grid = RadialGrid.banded(self.a, self.spacing, band, self.res.grading * self.ell)
-        pb = ContactProblem(GreenOperator(grid, self.e_star), self.sphere, {"law": self.law},
-                            check_laws=not self.centers)
-        self.centers[id(pb)] = center
-        return pb
+            return lj_sphere_problem(self.mu, self.radius, self.law.hamaker, self.z0,
+                                     self.res.stiffness_target or STIFFNESS_TARGET,
+                                     self.res.min_nodes or 120)[0]
+        return self.band.problem(center)
 
     def stop(self, curve):
         """End the trace once the stable branch after the folds has passed both the smallest
@@ -356,23 +279,12 @@ class _Setup:
         return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
 
     def band_offset(self, problem, edge):
-        """|edge - band centre| / band half-width on ``problem``'s grid (0 for a fixed band
-        or the legacy grid; above 1 the edge is outside the fine band)."""
-        if self.res.legacy or self.fixed_band:
-            return 0.0
-        return abs(edge - self.centers[id(problem)]) / self.half
+        """|edge - band centre| / band half-width (0 for a fixed band or the legacy grid)."""
+        return 0.0 if self.res.legacy else self.band.band_offset(problem, edge)
 
     def regrid(self, problem, w, d):
-        """A grid whose band leads the edge, once the edge has left the band's middle half."""
-        if self.res.legacy or self.fixed_band:
-            return None
-        center = self.centers[id(problem)]
-        edge = contact_edge(problem, w, d, EDGE_GAP * self.z0)
-        half = self.half
-        if abs(edge - center) <= 0.5 * half:
-            return None
-        # lead the moving edge: it crosses the whole band before the next exchange
-        return self.problem(edge + math.copysign(0.5 * half, edge - center))
+        """A grid whose band leads the edge (:meth:`MovingBand.regrid`)."""
+        return None if self.res.legacy else self.band.regrid(problem, w, d)
 
 
 def _trace(setup, tol, progress):

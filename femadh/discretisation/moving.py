@@ -1,0 +1,84 @@
+"""A band that follows a moving feature: the contact or cohesive-zone edge of a trace.
+
+On the JKR side of the smooth-sphere problem the law acts in a cohesive zone ~ell wide at an
+edge that travels hundreds of ell (mu = 20: ~1 z0 at a contact of ~800 z0); a static fine band
+over the whole travel would cost nodes like mu^2. A :class:`MovingBand` is the member of the
+banded family (:class:`~femadh.discretisation.family.GridFamily`) centred on the feature's
+current position; the trace asks :meth:`MovingBand.regrid` after each point and gets a new
+problem, leading the feature, once the feature has left the middle half of the band (the
+state is carried over by the continuation, :func:`femadh.contact.arclength.trace_curve`).
+"""
+import math
+
+import numpy as np
+
+from .family import GridFamily
+
+
+def contact_edge(problem, w, d, gap):
+    """Radius (m) of the contact edge: the outermost r where h(r) <= gap (linear between
+    nodes); 0 when no node is that close."""
+    h = problem.contour(d) - w
+    close = np.flatnonzero(h <= gap)
+    if not close.size:
+        return 0.0
+    k, r = int(close[-1]), problem.grid.nodes
+    if k == r.size - 1:
+        return float(r[-1])
+    return float(r[k] + (gap - h[k]) / (h[k + 1] - h[k]) * (r[k + 1] - r[k]))
+
+
+class MovingBand:
+    """Problems on banded grids that follow a feature (all lengths in m).
+
+    Parameters
+    ----------
+    radius, spacing, half, grading : float
+        Analysis radius a, band spacing h (the family parameter), half-width of the band and
+        grading length g (:class:`GridFamily`).
+    build : callable(RadialGrid, first) -> ContactProblem
+        The problem on a grid (``first``: the first grid of the trace, where the laws are
+        checked).
+    edge_gap : float
+        The gap that marks the feature: the outermost r with h <= edge_gap
+        (:func:`contact_edge`).
+    fixed : float or None
+        A fixed band [0, fixed] instead (the DMT side, where the edge travels less than the
+        cohesive zone is wide): :meth:`regrid` never moves it.
+    """
+
+    def __init__(self, radius, spacing, half, grading, build, edge_gap, fixed=None):
+        self.radius, self.spacing, self.half, self.grading = radius, spacing, half, grading
+        self.build, self.edge_gap, self.fixed = build, edge_gap, fixed
+        self.centers = {}
+
+    def family(self, center):
+        if self.fixed:
+            return GridFamily(self.radius, self.fixed, self.grading)
+        return GridFamily(self.radius, min(self.radius, center + self.half), self.grading,
+                          inner=center - self.half)
+
+    def problem(self, center=0.0):
+        """The problem on the member whose band is centred on ``center``."""
+        pb = self.build(self.family(center).member(self.spacing), not self.centers)
+        self.centers[id(pb)] = center
+        return pb
+
+    def band_offset(self, problem, edge):
+        """|edge - band centre| / band half-width on ``problem``'s grid (0 for a fixed band;
+        above 1 the edge is outside the fine band)."""
+        if self.fixed:
+            return 0.0
+        return abs(edge - self.centers[id(problem)]) / self.half
+
+    def regrid(self, problem, w, d):
+        """A grid whose band leads the edge, once the edge has left the band's middle half;
+        None while it is inside."""
+        if self.fixed:
+            return None
+        center = self.centers[id(problem)]
+        edge = contact_edge(problem, w, d, self.edge_gap)
+        if abs(edge - center) <= 0.5 * self.half:
+            return None
+        # lead the moving edge: it crosses the whole band before the next exchange
+        return self.problem(edge + math.copysign(0.5 * self.half, edge - center))
