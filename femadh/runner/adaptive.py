@@ -27,11 +27,13 @@ from ..discretisation.plan import safe_spacing
 MAX_TRIALS = 5
 #: the refined spacing aims at this fraction of the target (the order is only estimated)
 SAFETY = 0.6
-#: assumed convergence order of the headline numbers in the band spacing (observed 2-3.4 on
-#: the Fig 3/4 scenes; the smaller value refines more, never too little)
-ORDER = 2.0
+#: assumed convergence order of the headline numbers in the band spacing (local orders
+#: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order)
+ORDER = 1.5
 #: limits of one refinement factor of h
 MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
+#: the accuracy the plan's BAND_NODES are sized for; the fewest nodes across any band
+REFERENCE_ACCURACY, MIN_BAND_NODES = 1e-3, 48
 #: a feature beyond this fraction of the band radius widens the band
 BAND_FILL = 0.97
 
@@ -88,7 +90,10 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
                      scene.sphere, scene.analysis_radius,
                      scene.d_values, target)
-    family, h = plan.family, plan.spacing
+    # the first member: BAND_NODES across the band at 1e-3, coarser for a looser request
+    family = plan.family
+    h = min(plan.spacing * (target / REFERENCE_ACCURACY) ** (1.0 / ORDER),
+            family.band / MIN_BAND_NODES)
     mode = {"overwrite": overwrite, "resume": resume}
     steps, res, trial = [], None, None
     failure = None
