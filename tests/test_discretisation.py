@@ -112,7 +112,13 @@ def test_adaptive_run_meets_its_target_against_a_finer_member(fig3_adaptive):
         true = abs(res.headline[q] - ref.headline[q])
         est = res.headline[q + "_error"]
         assert est <= 3e-3 * abs(res.headline[q])
-        assert 0.3 * true <= est <= 5 * true + 1e-3 * 3e-3 * abs(ref.headline[q]), q
+        # never optimistic beyond 0.3x (measured 0.51-4.8 on this scene, adaptive.md)
+        assert est >= 0.3 * true, q
+    # the largest adhesion converges steadily: not pessimistic beyond 5x (measured 1.36 at
+    # 3e-3). F_LJ at the deepest state oscillates with the edge's node (its envelope is
+    # judged, and a lucky spacing can land far inside it: 14-21x measured at 1e-2..3e-3)
+    q = "max_adhesion_N"
+    assert res.headline[q + "_error"] <= 5 * abs(res.headline[q] - ref.headline[q])
 
 
 def test_adaptive_grid_is_much_smaller_than_the_uniform_it_beats(fig3_adaptive):
@@ -128,13 +134,13 @@ def test_trapping_caps_the_spacing_before_the_solve(monkeypatch):
     the trapping-safe spacing before anything is solved, not refused: the run converges and
     its band nodes stay below TRAP_SAFE / MIN_MEMBER_RATIO^2 of their stiffness."""
     monkeypatch.setattr(plan_mod, "BAND_NODES", 20)
-    monkeypatch.setattr(adaptive, "MAX_TRIALS", 1)
+    monkeypatch.setattr(adaptive, "MIN_BAND_NODES", 20)
     sc = adaptive_scene(accuracy=0.1).replace({"effects.asperity_gap.sigma": "0.5 nm",
                                                "sweep.start": "1.2 nm",
                                                "sweep.stop": "0.6 nm"})
     res = femadh.run(sc, progress=False)
     assert res.status == "converged", res.error
-    step = res.accuracy["steps"][0]
+    step = res.accuracy["steps"][-1]
     plan = plan_mod.plan_grid(sc.effects, 0.5e-9, sc.sphere, sc.analysis_radius, sc.d_values,
                               0.1, nodes=20)
     assert step["spacing_m"] < 0.5 * plan.spacing
@@ -177,3 +183,19 @@ def test_grid_table_errors_are_one_line():
     raw["solver"]["grid"]["band"] = "1 mm"
     with pytest.raises(SceneError, match="solver.grid.band"):
         scene_from_dict(raw, "s.toml", bare_numbers=False)
+
+
+def test_a_failed_landing_refines_instead_of_refusing():
+    """The sigma = 0.5 nm slider's jump-out on a coarse member (the first member of a 0.1
+    request, 24 nm band spacing): Newton cannot polish the landing after the fold (the
+    'landing after the fold, Newton 200 iterations' failure of the stiction map). The
+    adaptive run records the failure and traces again on a member of half the spacing,
+    which lands: converged, and the request met by its own estimate."""
+    sc = adaptive_scene(accuracy=0.1).replace({"effects.asperity_gap.sigma": "0.5 nm",
+                                               "sweep.start": "1.2 nm",
+                                               "sweep.stop": "0.6 nm"})
+    res = femadh.run(sc, progress=False)
+    steps = res.accuracy["steps"]
+    assert steps[0]["status"] == "failed" and "landing" in steps[0]["refined_after"]
+    assert steps[1]["spacing_m"] == pytest.approx(0.5 * steps[0]["spacing_m"], rel=1e-12)
+    assert res.status == "converged" and res.accuracy["met"], res.error

@@ -9,8 +9,10 @@ until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
 
     h <- h * clamp((SAFETY * target / error)^(1/ORDER), MIN_FACTOR, MAX_FACTOR)
 
-A node snapping on its own (lattice trapping) halves h; a feature that left the band widens
-it; both while the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. The result says what was
+A failed solve (a node snapping on its own, a stalled continuation, a landing after a fold
+that Newton cannot polish) halves h, a contact reaching the analysis radius doubles it, a
+feature that left the band widens the band, and members that all fail refine h: each while
+the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. The result says what was
 chosen and every trial (``result.accuracy``), or fails naming the accuracy reached, the nodes
 it used and about how many the request would need.
 """
@@ -117,10 +119,16 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         if res.status == "interrupted" or estimate is not True:
             break
         if res.status != "converged":
-            if "snap on their own" in (res.error or ""):
-                h *= 0.5                            # lattice trapping: refine
-                continue
-            break                                   # a failure refinement does not address
+            err_text = res.error or ""
+            if "analysis radius" in err_text:
+                # the contact reached the disk's edge: a larger disk, the same band spacing
+                family = GridFamily(2 * family.radius, family.band, family.grading)
+            else:
+                # lattice trapping, a stalled continuation, a landing Newton could not polish
+                # after a fold: the discretisation's failures, which a finer member resolves
+                h *= 0.5
+            steps[-1]["refined_after"] = err_text
+            continue
         edge = _feature_radius(res, trial.sphere.shape(res.nodes), plan.feature_gap)
         if edge > BAND_FILL * family.band and family.band < family.radius:
             # the feature left the band: widen it (the spacing stays)
