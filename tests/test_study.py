@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import femadh
+from conftest import fig3_uniform_text
 from femadh.cli import main
 from femadh.studies.sweep import parse_values, run_study, study_points
 
@@ -64,7 +65,7 @@ def test_dask_local_cluster_matches_the_process_pool_and_resumes(tmp_path):
 
 def test_killed_study_loses_no_completed_point(tmp_path):
     scene = tmp_path / "s.toml"
-    scene.write_text(FIG3.read_text().replace("nodes = 200", "nodes = 60"))
+    scene.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60"))
     out = tmp_path / "study"
     cmd = [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary",
            "effects.asperity_gap.sigma=0.4 nm..2 nm:6", "--out", str(out), "--workers", "1",

@@ -34,8 +34,11 @@ def headline_lines(res):
                    f"{_force(hl['F_LJ_deepest_N'], hl.get('F_LJ_deepest_N_error'))}")
     if res.accuracy:
         a = res.accuracy
-        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: N = "
-                   f"{a['nodes']}, analysis radius {a['analysis_radius_m'] * 1e6:.4g} um after "
+        grid = (f"{a['nodes']} nodes, band spacing {a['spacing_m'] * 1e9:.3g} nm to "
+                f"{a['band_m'] * 1e6:.3g} um" if a.get("adaptive") and a.get("spacing_m")
+                else f"N = {a['nodes']}")
+        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}, "
+                   f"analysis radius {a['analysis_radius_m'] * 1e6:.4g} um after "
                    f"{len(a['steps'])} run(s)")
     for j in res.jumps:
         where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else

@@ -207,7 +207,7 @@ STUDY = Table("study", "A parameter study over this scene (femadh study sweep SC
 TOP = ("scene", "sphere", "materials", "substrate", "effects", "solver", "sweep", "output",
        "study")
 #: every table description, for the reference page (femadh keys)
-TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, SUBSTRATE, LAYER, GAP, SOLVER, DELTA, MESH,
+TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, SUBSTRATE, LAYER, GAP, SOLVER, DELTA, GRID, MESH,
           SWEEP, OUTPUT, STUDY)
 
 

@@ -159,14 +159,15 @@ _OPERATORS = {}
 def _operator_key(sc):
     """Everything :func:`femadh.scene.build_operator` reads, as a string (FESettings and the
     material records are not hashable; repr of a float is exact)."""
-    if sc.kind != "contact":
-        return None
+    if sc.kind != "contact" or sc.adaptive:
+        return None                 # an adaptive run builds the members it chooses
     fe = None
     if sc.method == "fe":
         fe = (sc.fe_settings, sc.fe_poisson_ratio)
         if sc.layers:
             fe += (tuple(sc.layers), sc.disk, sc.slider)
-    return repr((sc.method, sc.nodes, sc.analysis_radius, sc.e_star, fe))
+    grid = None if sc.grid is None else sorted(sc.grid.items())
+    return repr((sc.method, sc.nodes, grid, sc.analysis_radius, sc.e_star, fe))
 
 
 def run_point(point, root, estimate=True):
