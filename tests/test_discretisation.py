@@ -165,7 +165,7 @@ def test_band_widens_when_the_contact_leaves_it(monkeypatch):
 
 
 def test_explicit_nodes_turn_adaptivity_off():
-    sc = femadh.load_scene("validation/scenes/paper1_fig4.toml")      # nodes = 200
+    sc = femadh.load_scene("validation/scenes/paper1_slider_gw.toml")  # nodes given
     assert not sc.adaptive and sc.target_accuracy is None
     assert femadh.load_scene(FIG3).adaptive                           # no nodes
     assert adaptive_scene().target_accuracy == 1e-3
