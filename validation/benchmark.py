@@ -70,7 +70,9 @@ def main():
              "(one BLAS thread). The split is what the run records in summary.json "
              "(operator = Green function or FE mesh + assembly + condensation; solve includes "
              "writing every state's csv/VTK rows; estimates = the coarser grids, the peak "
-             "search and the FE-vs-Green run).", "",
+             "search and the FE-vs-Green run). Adaptive scenes (no `nodes`): the grid femadh "
+             "chose for the scene's accuracy, every trial included. 1-minute load average at "
+             f"the start: {os.getloadavg()[0]:.2f}.", "",
              "| scene | flags | wall (s) | operator | solve | estimates | figures | "
              "headline ± estimated error |", "|---|---|---|---|---|---|---|---|"]
     # the first run of a scene warms the mesh cache and the file system; not counted
