@@ -109,10 +109,13 @@ class EquilibriumCurve:
         run = next(r for r in runs if r[0] <= start <= r[1])
         lo, hi, i = run[0], run[1], start
         visited = set()
+        forced = None       # after a landing: the index direction toward the travel side
         while True:
             visited.add(run)
-            # direction along the run in which d moves the right way
-            step = 1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1
+            # direction along the run in which d moves the right way (after a landing in
+            # the first interval of a run, lo == hi: only the landing knows the direction)
+            step = forced if forced is not None else (
+                1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1)
             end = hi if step == 1 else lo
             out.append(("run", i, end))
             # what lies beyond the run's end: a fold (then jump) or the curve's end
@@ -160,9 +163,9 @@ class EquilibriumCurve:
             out.append(("land", a, bracket))
             # continue from the landing toward the travel direction
             if sign * dd > 0:
-                lo, hi, i = last, run[1], last
+                lo, hi, i, forced = last, run[1], last, 1
             else:
-                lo, hi, i = run[0], first, first
+                lo, hi, i, forced = run[0], first, first, -1
 
     def _dist(self, p, q):
         tr = self.tracers[p.seg]

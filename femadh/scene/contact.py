@@ -553,10 +553,11 @@ def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
             reader.fail("solver.grid.spacing", raw_grid.get("spacing"), "a spacing at most "
                         "the band's radius")
     if so["continuation"] == "arclength":
-        if gap is not None:
-            reader.fail("solver.continuation", "arclength", "'steps' with "
-                        "[effects.asperity_gap]: arclength continuation traces smooth laws "
-                        "only (the hard sigma-gap is not smooth)")
+        if gap is not None and gap.contact_model != "complementarity":
+            reader.fail("solver.continuation", "arclength", "'steps' with the "
+                        "hertz-closure sigma-gap: arclength continuation traces smooth laws "
+                        "and the complementarity sigma-gap only (the closure's contact "
+                        "radius is not traced through folds)")
         if not any_bad(sw) and "approach" not in sw["directions"]:
             reader.fail("sweep.directions", list(sw["directions"]), "a list with 'approach' "
                         "for [solver] continuation = 'arclength' (the curve is traced from "
