@@ -35,11 +35,11 @@ import math
 import time
 
 import numpy as np
-from scipy import linalg
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
+from .linalg import disk_size
 from .stability import is_stable
 from .state import State
 
@@ -63,6 +63,11 @@ MAX_ATTEMPTS_PER_POINT = 40
 #: events at one and the same state in a row (several nodes at their constraint at once);
 #: more means the active set cycles
 MAX_EVENTS_AT_ONE_STATE = 8
+#: the energy Hessian's inertia is computed at every this many points and next to every
+#: fold; between, stability is carried by fold parity (it changes exactly where d turns
+#: back, smoothly or at an event: measured on the Fig 3/4 scenes at every point, 14 of 14
+#: changes at folds, none elsewhere); a computed value always overrides the carried one
+HESSIAN_EVERY = 8
 #: a constraint counts as met when violated by less than this many times the tolerance
 #: (gap: tol in m; multiplier: tol times the mean diagonal stiffness, Pa)
 SLACK = 10.0
@@ -90,6 +95,12 @@ class _Piece:
         # lambda_j = P(sigma) + P_LJa - (K w)_j on a contact node (Pa)
         self.lam0 = float(problem.pressure(np.array([self.sigma]))[0]) + adh
         self.seg = None
+        # the active set of a sphere-flat contact is a disk, nodes 0..m-1: the free blocks
+        # of K and C are then slices (views), not copies (m None: general index arrays)
+        m = disk_size(self.active)
+        self.free = slice(m, None) if m is not None else self.I
+        self._KIA1 = None
+        self.lu = None          # (lu, piv, w, d): the last bordered factorisation
 
     def register(self):
         self.seg = len(self.curve.tracers)
@@ -108,14 +119,20 @@ class _Piece:
         """lambda = p_c + P_LJa (Pa) on the active nodes (>= 0 where they hold)."""
         return self.lam0 - self.problem.K[self.A] @ w
 
+    def _rows(self, M):
+        """Rows of the free nodes of a matrix (a view for a disk active set)."""
+        return M[self.free]
+
     def _jacobian(self, h):
         """[K_II + diag(D_I) | K_IA 1 - D_I] (Pa/m), D = P'(h)."""
-        K, I = self.problem.K, self.I
-        D = self.problem.dpressure(h[I])
+        K, I, f = self.problem.K, self.I, self.free
+        D = self.problem.dpressure(h[f])
+        if self._KIA1 is None:
+            self._KIA1 = K[np.ix_(I, self.A)].sum(axis=1)
         J = np.empty((I.size, I.size + 1))
-        J[:, :-1] = K[np.ix_(I, I)]
+        J[:, :-1] = K[f, f] if isinstance(f, slice) else K[np.ix_(I, I)]
         J[np.arange(I.size), np.arange(I.size)] += D
-        J[:, -1] = K[np.ix_(I, self.A)].sum(axis=1) - D
+        J[:, -1] = self._KIA1 - D
         return J
 
     def _plane_row(self, t):
@@ -130,8 +147,8 @@ class _Piece:
         """max |w - C (P - p_c)| (m), the residual of eq (6)/(10): C applied to the free
         nodes' imbalance (p_c on A absorbs theirs)."""
         h = self.problem.contour(d) - w
-        F = self.problem.K[self.I] @ w - self.problem.pressure(h[self.I])
-        return float(np.max(np.abs(self.problem.C[:, self.I] @ F))) if self.I.size else 0.0
+        F = self._rows(self.problem.K) @ w - self.problem.pressure(h[self.free])
+        return float(np.max(np.abs(self.problem.C[:, self.free] @ F))) if self.I.size else 0.0
 
     # -- Newton on the bordered system ----------------------------------------------------
     def _newton(self, w, d, border):
@@ -139,18 +156,19 @@ class _Piece:
         (row in (w_I, d), value the condition's current value in the row's units).
 
         Returns (w, d, iterations, residual m, converged)."""
-        problem, I = self.problem, self.I
+        problem, I, f = self.problem, self.I, self.free
         self.curve.n_solves += 1
+        self.lu = None
         res_first = math.inf
         res = math.inf
         for it in range(1, MAX_ITER + 1):
             h = problem.contour(d) - w
-            if np.any(h[I] <= 0):
+            if np.any(h[f] <= 0):
                 return w, d, it, math.inf, False
-            P_I = problem.pressure(h[I])
-            F = problem.K[I] @ w - P_I
+            P_I = problem.pressure(h[f])
+            F = self._rows(problem.K) @ w - P_I
             row, value = border(w, d)
-            res = float(np.max(np.abs(problem.C[:, I] @ F))) if I.size else 0.0
+            res = float(np.max(np.abs(problem.C[:, f] @ F))) if I.size else 0.0
             if not math.isfinite(res):
                 raise ConvergenceError("sigma-gap arclength corrector: non-finite residual",
                                        d=d, residual=res, n_iter=it)
@@ -167,12 +185,13 @@ class _Piece:
             self.curve.n_factor += 1
             if info > 0:
                 return w, d, it, res, False
+            self.lu = (lu, piv)
             dx = -lapack.dgetrs(lu, piv, np.r_[F, value])[0]
             dw_I, dd = dx[:-1], dx[-1]
             closing = dw_I - dd                    # a free gap's decrease
             alpha = 1.0
             if np.any(closing > 0):
-                hI = h[I] - self.sigma
+                hI = h[f] - self.sigma
                 c = closing > 0
                 alpha = min(1.0, float(np.min(GAP_CLOSURE * np.maximum(hI[c], 0.0)
                                               / closing[c]))) if np.all(hI[c] > 0) else 1.0
@@ -220,27 +239,37 @@ class _Piece:
                 return row, self.kappa * (d - j)
         return self._newton(self.full_w(w0[self.I], d0), d0, cond)
 
-    def tangent(self, w, d, t_ref):
+    def tangent(self, w, d, t_ref, reuse=False):
         """Unit tangent (scaled; dw_A/ds = dd/ds) of this piece at (w, d), with t . t_ref > 0
-        in the arclength norm (the bordered solve normalises t . t_ref = 1)."""
-        h = self.problem.contour(d) - w
-        M = np.empty((self.I.size + 1, self.I.size + 1))
-        M[:-1] = self._jacobian(h)
-        M[-1] = self._plane_row(t_ref)
+        in the arclength norm.
+
+        The tangent spans the null space of the piece's Jacobian [J_w | J_d]; any border row
+        not orthogonal to it makes the bordered matrix regular, so with ``reuse`` the
+        factorisation of the corrector's last Newton iteration (its own border row, at the
+        previous iterate: an O(last Newton step) error, ~1e-12 relative) serves."""
         rhs = np.zeros(self.I.size + 1)
         rhs[-1] = self.kappa
-        try:
-            x = linalg.solve(M, rhs, check_finite=False)
-        except linalg.LinAlgError:
-            raise ConvergenceError("sigma-gap arclength: the bordered Jacobian is singular",
-                                   d=d, residual=math.nan, n_iter=0) from None
-        self.curve.n_factor += 1
+        if reuse and self.lu is not None:
+            x = lapack.dgetrs(*self.lu, rhs)[0]
+        else:
+            h = self.problem.contour(d) - w
+            M = np.empty((self.I.size + 1, self.I.size + 1))
+            M[:-1] = self._jacobian(h)
+            M[-1] = self._plane_row(t_ref)
+            lu, piv, info = lapack.dgetrf(M, overwrite_a=True)
+            self.curve.n_factor += 1
+            if info > 0:
+                raise ConvergenceError("sigma-gap arclength: the bordered Jacobian is "
+                                       "singular", d=d, residual=math.nan, n_iter=0)
+            x = lapack.dgetrs(lu, piv, rhs)[0]
         t = np.empty(self.n + 1)
         t[self.I], t[self.A], t[-1] = x[:-1], x[-1], x[-1]
         norm = math.sqrt(self.omega * (t[:-1] @ t[:-1]) + t[-1] ** 2)
         if not (norm > 0 and math.isfinite(norm)):
             raise ConvergenceError("sigma-gap arclength: no finite tangent", d=d,
                                    residual=math.nan, n_iter=0)
+        if self.omega * (t[:-1] @ t_ref[:-1]) + t[-1] * t_ref[-1] < 0:
+            norm = -norm
         return t / norm
 
     def stable(self, w, d):
@@ -251,12 +280,12 @@ class _Piece:
     def constraints(self, w, d):
         """(free gaps above sigma (m), multipliers (Pa)) of a state on this piece."""
         h = self.problem.contour(d) - w
-        return h[self.I] - self.sigma, self.multipliers(w)
+        return h[self.free] - self.sigma, self.multipliers(w)
 
     def rates(self, t):
         """d/ds of :meth:`constraints` along the scaled tangent t (m and Pa per unit s)."""
         s = self.scale
-        return ((t[-1] - t[:-1][self.I]) * s,
+        return ((t[-1] - t[:-1][self.free]) * s,
                 -(self.problem.K[self.A] @ t[:-1]) * s)
 
 
@@ -355,6 +384,7 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
     step, ds_min = ds, ds * MIN_STEP_FRACTION
     ceiling = math.inf
     attempts, events_here = 0, 0
+    after_fold = True          # the first points' stability is computed
     while True:
         p = pts[-1]
         x = np.r_[p.w, p.d] / scale
@@ -408,7 +438,7 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
             why = f"the corrector did not converge (residual {res:.3g} m, {it} iterations)"
             ceiling = 0.8 * step
         else:
-            t_new = pc.tangent(w, d, p.t)
+            t_new = pc.tangent(w, d, p.t, reuse=True)
             dx = np.r_[w, d] / scale - x
             ahead = pc.omega * (p.t[:-1] @ dx[:-1]) + p.t[-1] * dx[-1]
             gaps_c, lams_c = pc.constraints(w, d)
@@ -446,8 +476,13 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
             step = 0.5 * min(step, s_used) if s_used > 0 else 0.5 * step
             continue
         attempts = 0
-        stable = pc.stable(w, d)
-        if p.t_d * t_new[-1] < 0:
+        event_lu = pc.lu        # (before a fold search refactorises with other borders)
+        folded = p.t_d * t_new[-1] < 0
+        stable = p.stable != folded
+        if folded or after_fold or len(pts) % HESSIAN_EVERY == 0:
+            stable = pc.stable(w, d)
+        after_fold = folded
+        if folded:
             fold = _locate_fold(pc, p, s_used, len(pts) - 1)
             fold.seg = pc.seg
             curve.folds.append(fold)
@@ -472,7 +507,18 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
         active = pc.active.copy()
         active[j] = kind == "gap"
         new = _Piece(problem, active, scale, tol, curve)
-        t2 = new.tangent(w, d, q.t)
+        if kind == "gap" and event_lu is not None:
+            # the event corrector's bordered matrix [J; h_j = sigma] already is the new
+            # piece's: [J; g_j] x = e_j leaves equation j (now carried by p_c,j) free and
+            # ties w_j to d, so x is the new tangent (no factorisation)
+            e = np.zeros(pc.I.size + 1)
+            e[np.searchsorted(pc.I, j)] = pc.kappa
+            x2 = lapack.dgetrs(*event_lu, e)[0]
+            t2 = np.empty(n + 1)
+            t2[pc.I], t2[pc.A], t2[-1] = x2[:-1], x2[-1], x2[-1]
+            t2 /= math.sqrt(new.omega * (t2[:-1] @ t2[:-1]) + t2[-1] ** 2)
+        else:
+            t2 = new.tangent(w, d, q.t)
         if kind == "gap":        # node j now held: its multiplier must grow
             grow = -(problem.K[j] @ t2[:-1])
         else:                    # node j released: its gap must open
@@ -480,8 +526,13 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
         if grow < 0:
             t2 = -t2
         new.register()
-        r = CurvePoint(d, w, t2, new.stable(w, d), it, res, new.seg)
-        if q.t_d * t2[-1] < 0:
+        corner_fold = q.t_d * t2[-1] < 0
+        stable = q.stable != corner_fold
+        if corner_fold or after_fold:
+            stable = new.stable(w, d)
+        after_fold = corner_fold
+        r = CurvePoint(d, w, t2, stable, it, res, new.seg)
+        if corner_fold:
             # a corner fold: d turns back at the event state (the discrete jump-out)
             curve.folds.append(Fold(len(pts) - 1, d, w.copy(), 0.0, pc.seg))
         pc = new
