@@ -119,7 +119,8 @@ SOLVER = Table("solver", "Discretisation and solver.", (
     Key("max_iter", "integer", "Newton iterations per solve.", default=40, lo=1,
         lo_closed=True, hi=10000, hi_closed=True),
     Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
-        "laws only).", default="steps", choices=("steps", "arclength")),
+        "laws and the complementarity sigma-gap).", default="steps",
+        choices=("steps", "arclength")),
     Key("accuracy", "number", "Relative accuracy asked of the headline numbers (largest "
         "adhesion, forces at the deepest separation): femadh refines the grid and the "
         "analysis radius until its error estimate meets it, or says it cannot. Default "
