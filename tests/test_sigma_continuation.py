@@ -170,3 +170,14 @@ def test_scene_with_sigma_gap_runs_arclength(tmp_path):
         femadh.load_scene(p)
     assert "solver.continuation" in str(e.value) and "hertz-closure" in str(e.value)
     assert len(str(e.value).splitlines()) == 1
+    # eq 20 on the contact set: a node joins with lambda = P_LJa and leaves at lambda = 0,
+    # so approach and retract part at every node (no single curve): refused
+    adhesive = text + ('\n[effects.asperity_adhesion]\nasperity_radius = "0.94 um"\n'
+                       'surface_energy = "0.06 J/m^2"\ndensity = "179 um^-2"\n'
+                       'contact_probability = 0.5\n')
+    p.write_text(adhesive)
+    with pytest.raises(SceneError) as e:
+        femadh.load_scene(p)
+    assert "asperity_adhesion" in str(e.value) and len(str(e.value).splitlines()) == 1
+    p.write_text(adhesive + 'model = "smoothed"\n')
+    assert femadh.load_scene(p).continuation == "arclength"

@@ -348,6 +348,12 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
     if problem.sigma is None or problem.contact_model not in (None, "complementarity"):
         raise ValueError("sigma-gap arclength continuation needs the complementarity "
                          "sigma-gap (paper 1 eq 8)")
+    if problem.gap.adhesion:
+        # a node reaching sigma joins the contact with lambda = P_LJa > 0, feasible both
+        # ways along the new piece: the equilibria branch at every activation (approach and
+        # retract part), a network no single curve represents
+        raise ValueError("sigma-gap arclength continuation: eq 20 adhesion on the contact "
+                         "set makes the equilibria branch at every contact node (not traced)")
     t0 = time.perf_counter()
     n = problem.grid.n
     ds_max = 20 * ds if ds_max is None else ds_max

@@ -559,6 +559,12 @@ def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
                         "hertz-closure sigma-gap: arclength continuation traces smooth laws "
                         "and the complementarity sigma-gap only (the closure's contact "
                         "radius is not traced through folds)")
+        elif gap is not None and gap.adhesion:
+            reader.fail("solver.continuation", "arclength", "'steps' with "
+                        "[effects.asperity_adhesion] on the contact set: its range-less "
+                        "adhesion holds a node that reached sigma until its pressure falls to "
+                        "-P_LJa, so approach and retract part at every node and the "
+                        "equilibria are no single curve (model = 'smoothed' can be traced)")
         if not any_bad(sw) and "approach" not in sw["directions"]:
             reader.fail("sweep.directions", list(sw["directions"]), "a list with 'approach' "
                         "for [solver] continuation = 'arclength' (the curve is traced from "
