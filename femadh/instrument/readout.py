@@ -1,8 +1,10 @@
 """What the instrument sees: its force-z curve read off the contact's equilibrium states.
 
 The spring (stiffness k, base at z) holds the sphere at d; equilibrium is k (z - d) = F_ex(d),
-so every contact equilibrium is an instrument equilibrium at z = d + F_ex / k, and the
-instrument reads F_instrument = k (z - d) = F_ex.
+so every contact equilibrium is an instrument equilibrium at z = d + F / k, and the
+instrument reads F_instrument = k (z - d) = F. The spring holds the whole sphere: F is F_ex
+plus the laws' force beyond the analysis radius (F_tail, curve.csv), which a truncated disk
+would otherwise drop from what the instrument reads.
 
 Which of them the instrument can hold. With the spring the energy is E = U(w, d) + k (z - d)^2
 / 2; its Hessian in (w, d) holds the Hessian at fixed d as a principal block, so a state the
@@ -139,21 +141,34 @@ def stable_pieces(branches, jumps):
         d, F = np.asarray(cols["d_m"], float), np.asarray(cols["F_ex_N"], float)
         if not len(d):
             continue
+        tail = _tail(cols, d)
+        F_ex, F = F, F + tail(d)
         sign = -1.0 if b == "approach" else 1.0
         js = [j for j in jumps if j["branch"] == b]
         cur, k, fold_start = [], 0, False
         for i in range(len(d)):
-            while k < len(js) and cur and _jumped_before(d[i], F[i], js[k], sign):
+            while k < len(js) and cur and _jumped_before(d[i], F_ex[i], js[k], sign):
                 j = js[k]
-                cur.append((j["d_fold_m"], j["F_ex_before_N"]))
+                cur.append((j["d_fold_m"], j["F_ex_before_N"] + tail(j["d_fold_m"])))
                 pieces.append(_piece(cur, b, sign, fold_start, True))
-                cur, fold_start, k = [(j["d_land_m"], j["F_ex_after_N"])], False, k + 1
+                cur, fold_start, k = ([(j["d_land_m"], j["F_ex_after_N"] + tail(j["d_land_m"]))],
+                                      False, k + 1)
             if cur and abs(d[i] - cur[-1][0]) <= SAME_STATE * max(abs(d[i]), 1e-12) \
                     and _close(F[i], cur[-1][1]):
                 continue          # the landing state, already there
             cur.append((d[i], F[i]))
         pieces.append(_piece(cur, b, sign, fold_start, False))
     return pieces
+
+
+def _tail(cols, d):
+    """F_tail(d) (N): the laws' force beyond the analysis radius on the undeformed sphere, a
+    smooth function of d alone, interpolated between the branch's states (0 without it)."""
+    if "F_tail_N" not in cols:
+        return lambda x: 0.0 * np.asarray(x, float)
+    order = np.argsort(d)
+    dd, ft = d[order], np.asarray(cols["F_tail_N"], float)[order]
+    return lambda x: np.interp(x, dd, ft)
 
 
 def _close(a, b):
@@ -203,9 +218,10 @@ def read_instrument(branches, jumps, stiffness, directions=("approach", "retract
 
 def _walk(pieces, k, branch, cols):
     s = -1 if branch == "approach" else 1
-    d0, F0 = float(cols["d_m"][0]), float(cols["F_ex_N"][0])
+    d0 = float(cols["d_m"][0])
     p = next(q for q in pieces if q.branch == branch and np.any(q.d == d0))
     i = int(np.flatnonzero(p.d == d0)[0 if s > 0 else -1])
+    F0 = float(p.F[i])
     z_of = lambda q: q.d + q.F / k                               # noqa: E731
     rows, jumps, incomplete = [(d0 + F0 / k, d0, F0, "point")], [], None
     budget = MAX_EVENTS_PER_PIECE * len(pieces) + 4
@@ -244,8 +260,8 @@ def _walk(pieces, k, branch, cols):
             end = "start" if s > 0 else "stop"
             incomplete = (f"the instrument's {branch} jump at z = {zJ * 1e9:.6g} nm (d = "
                           f"{dJ * 1e9:.6g} nm, F = {FJ:.4g} N) lands beyond the traced "
-                          f"separations: extend [sweep] {end} past z = {zJ * 1e9:.4g} nm to "
-                          "see where (its hysteresis is not reported)")
+                          f"separations: extend [sweep] {end} to see where (the instrument's "
+                          "hysteresis is not reported)")
             break
         if kind == "fold":
             # the landing's interpolation error: the line against the parabola through the
