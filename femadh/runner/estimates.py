@@ -110,35 +110,43 @@ def tolerance_force(problem, state, tol):
     return float(problem.areas @ np.abs(problem.dpressure(state.h)) * tol)
 
 
+def state_between(problem, a, b, d, scene):
+    """A fresh equilibrium at separation d between two states a and b of one branch, solved
+    from the displacements interpolated between them, or None unless it converged, is stable
+    and stayed on that branch (every gap within a quarter of the interpolation's)."""
+    from ..contact import solve_state
+
+    t = (d - a.d) / (b.d - a.d)
+    w0, near = (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
+    kw = {}
+    if problem.contact_model == "hertz-closure":
+        kw["r_c0"] = near.r_c or None
+    elif problem.sigma is not None:
+        kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
+    st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
+    h_pred = problem.contour(d) - w0
+    if not (st.converged and st.stable) or np.any(
+            np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+        return None
+    return st
+
+
 def peak_adhesion(problem, prev, best, nxt, scene):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). Returns (F, d, half-width of
     the final d bracket)."""
-    from ..contact import solve_state
     from ..contact.forces import state_forces
 
     f_best = state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
     found = {}
 
-    def interp(d):
-        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
-        t = (d - a.d) / (b.d - a.d)
-        return (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
-
     def neg(d):
-        w0, near = interp(d)
-        kw = {}
-        if problem.contact_model == "hertz-closure":
-            kw["r_c0"] = near.r_c or None
-        elif problem.sigma is not None:
-            kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
-        st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
-        h_pred = problem.contour(d) - w0
-        if not (st.converged and st.stable) or np.any(
-                np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
+        st = state_between(problem, a, b, d, scene)
+        if st is None:
             return -f_best
         found[d] = state_forces(problem, st)[2]
         return -found[d]
@@ -298,6 +306,11 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             parts[name]["tolerance"] = float(problem.areas.sum() * scene.tolerance
                                              * np.max(np.abs(problem.dpressure(
                                                  np.full(1, _contact_gap(problem))))))
+    # the instrument's readout between the computed states (femadh.instrument.readout)
+    if res.instrument is not None:
+        for name, v in res.instrument["resolution"].items():
+            if f"instrument_{name}" in hl:
+                parts.setdefault(f"instrument_{name}", {})["resolution"] = float(v)
     parts = {k: v for k, v in parts.items() if k in QUANTITIES and k in hl}
     for k, comp in parts.items():
         # the parts are signed estimates of Q_exact - Q (grid, fe_mesh, tail) or bounds
@@ -388,4 +401,7 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0):
 
 QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",
               "jump_out_d_m", "hysteresis_J", "r_c_at_zero_force_approach_m",
-              "r_c_at_zero_force_retract_m", "d_at_max_adhesion_m")
+              "r_c_at_zero_force_retract_m", "d_at_max_adhesion_m",
+              "instrument_pull_off_N", "instrument_snap_off_N", "instrument_jump_in_d_m",
+              "instrument_jump_in_z_m", "instrument_jump_out_d_m", "instrument_jump_out_z_m",
+              "instrument_hysteresis_J")

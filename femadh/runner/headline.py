@@ -61,6 +61,11 @@ def headline(res, problem):
     released = [j["energy_released_J"] for j in res.jumps]
     if released and all(math.isfinite(x) for x in released):
         out["hysteresis_J"] = float(sum(released))
+    spring = getattr(res.scene, "instrument", None)
+    if spring is not None and res.branches:
+        from .instrument import instrument_numbers
+
+        out.update(instrument_numbers(res, spring))
     if problem is not None:
         W = work_of_adhesion(problem)
         R = problem.sphere.radius
@@ -68,3 +73,4 @@ def headline(res, problem):
         out["dmt_pull_off_N"] = dmt_pull_off(R, W)
         out["jkr_pull_off_N"] = jkr_pull_off(R, W)
     return out
+
