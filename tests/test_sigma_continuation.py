@@ -181,3 +181,23 @@ def test_scene_with_sigma_gap_runs_arclength(tmp_path):
     assert "asperity_adhesion" in str(e.value) and len(str(e.value).splitlines()) == 1
     p.write_text(adhesive + 'model = "smoothed"\n')
     assert femadh.load_scene(p).continuation == "arclength"
+
+
+def test_a_stalled_trace_names_where_it_stopped(monkeypatch):
+    """A corrector that cannot converge (one Newton iteration allowed) stops the trace with
+    a ConvergenceError naming the separation, residual and iterations, the partial curve
+    attached (from the converged start state to where it stopped)."""
+    import femadh.contact.sigma_arclength as sa
+    from femadh.errors import ConvergenceError
+
+    sc = scene_from_dict(tomllib.loads(small_text(nodes=40, stop="1 nm")))
+    problem = build_problem(sc)
+    monkeypatch.setattr(sa, "MAX_ITER", 1)
+    with pytest.raises(ConvergenceError) as e:
+        trace_sigma_curve(problem, 2e-9, 1e-9, tol=sc.tolerance, scale=0.2e-9, ds=1.0)
+    exc = e.value
+    # (tiny steps whose prediction already meets the tolerance still pass: a few points)
+    assert "stalled after d = " in str(exc) and "residual" in str(exc)
+    assert 1e-9 < exc.d <= 2e-9 and np.isfinite(exc.residual) and exc.n_iter == 1
+    assert exc.curve.points[0].d == 2e-9 and exc.curve.points[0].residual <= sc.tolerance
+    assert abs(exc.curve.points[-1].d - exc.d) < 0.01e-9
