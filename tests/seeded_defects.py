@@ -288,6 +288,17 @@ DEFECTS = [
       (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),
     D("jkr_spring_sign", "JKR with a spring: instability at dP/dD = +k",
       "femadh/reference/maugis.py", (("return dP + k_tilde * dD", "return dP - k_tilde * dD"),)),
+    # -- sigma-gap continuation
+    D("sigma_arc_orientation", "sigma-gap arclength: a new contact node's piece followed "
+      "against the complementarity (its pressure falling)", "femadh/contact/sigma_arclength.py",
+      (("        if grow < 0:\n            t2 = -t2", "        if grow > 0:\n            t2 = -t2"),)),
+    D("sigma_arc_jacobian_d", "sigma-gap arclength: dF/dd of the free nodes with +P' for -P'",
+      "femadh/contact/sigma_arclength.py",
+      (("J[:, -1] = self._KIA1 - D", "J[:, -1] = self._KIA1 + D"),)),
+    D("sigma_arc_multiplier", "sigma-gap arclength: contact pressure without the LJ pressure "
+      "at sigma (lambda = P_LJa - (K w)_j)", "femadh/contact/sigma_arclength.py",
+      (("self.lam0 = float(problem.pressure(np.array([self.sigma]))[0]) + adh",
+        "self.lam0 = adh"),)),
 ]
 
 
