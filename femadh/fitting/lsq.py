@@ -128,9 +128,10 @@ def check_keys(scene, keys):
     for k in keys:
         try:
             v = scene_value(scene, k)
-        except SceneError:
-            # an unknown key: the scene reader's message (with its did-you-mean) says more
-            scene.replace({k: 1.0})
+        except SceneError as exc:
+            if exc.value == "(not set)":
+                # an unknown key: the scene reader's message (with its did-you-mean) says more
+                scene.replace({k: 1.0})
             raise
         if not (math.isfinite(v) and v > 0):
             raise SceneError(scene.path, k, v, "a positive value to fit (relative steps)")
