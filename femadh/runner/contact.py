@@ -185,6 +185,10 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
             res.timings["solve_s"] = time.perf_counter() - t1
             if res.status == "converged":
                 _finish(scene, res, problem, sink, estimate)
+                if folder is not None and res.instrument is not None:
+                    from ..io.writers import write_instrument
+
+                    write_instrument(folder.path, res)
         except (ConvergenceError, GuardError) as exc:
             res.status, res.error = "failed", str(exc)
         except Interrupted as exc:
