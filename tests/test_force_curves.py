@@ -130,6 +130,13 @@ def test_sign_and_jump_conventions():
     s = sim_curve(res)
     assert s.x_kind == "z"
     np.testing.assert_allclose(s.force_at(np.array([3.0e-9]), br[:1], 0.0), [-1.0])
+    # a run's own instrument paths (drive order, a jump as fold + land at one z)
+    res.instrument = {"paths": {"approach": {
+        "z_m": np.array([3.0, 2.0, 2.0, 1.0]) * 1e-9, "d_m": np.zeros(4),
+        "F_N": np.array([1.0, 2.0, 7.0, 5.0]), "kind": ["point", "fold", "land", "point"]}}}
+    s = sim_curve(res)
+    assert s.x_kind == "z" and s.jumps == [("approach", 2e-9, -2.0, -7.0)]
+    np.testing.assert_allclose(s.force_at(np.array([2.5e-9, 1.5e-9]), br, 0.0), [-1.5, -6.0])
 
 
 def test_lj_attraction_is_a_negative_measured_force(fig3):

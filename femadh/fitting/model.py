@@ -46,15 +46,19 @@ class SimCurve:
 
 def sim_curve(res):
     """The :class:`SimCurve` of a ContactResult (or any object with ``branches`` and
-    ``jumps``)."""
+    ``jumps``). A run with an [instrument] (``res.instrument["paths"]``, or z_m and
+    F_instrument_N columns) gives the model in the drive position z, which a measured piezo
+    height compares with; otherwise in the separation d."""
     out = SimCurve()
+    paths = (getattr(res, "instrument", None) or {}).get("paths")
+    if paths:
+        return _instrument_curve(paths)
     for b, cols in res.branches.items():
         if not len(cols["d_m"]):
             continue
-        # hook for the instrument (a cantilever spring in series): when the run carries the
-        # piezo position z_m and the force the cantilever measures, the measured curve is
-        # compared in z; F_instrument_N is taken in curve.csv's sign (adhesion positive, as
-        # F_ex), hence the minus for the AFM convention
+        # the instrument's columns as curve.csv carries them (a result read back from
+        # disk): the measured curve is compared in the drive z; F_instrument_N = k (z - d)
+        # has F_ex's sign (adhesion positive), hence the minus for the AFM convention
         if "z_m" in cols and "F_instrument_N" in cols:
             out.x_kind = "z"
             x, f = np.asarray(cols["z_m"], float), -np.asarray(cols["F_instrument_N"], float)
@@ -71,6 +75,26 @@ def sim_curve(res):
         if x[0] > x[-1]:                # approach runs towards smaller d: make x ascending
             x, f = x[::-1], f[::-1]
         if np.any(np.diff(x) < 0):     # a path that is not monotone in x (never seen)
+            k = np.argsort(x, kind="stable")
+            x, f = x[k], f[k]
+        out.x[b], out.f[b] = x, f
+    return out
+
+
+def _instrument_curve(paths):
+    """The model in the drive position z of an [instrument] run: its paths (branch -> z_m,
+    d_m, F_N, kind in drive order) already hold each jump as a fold and a landing at the same
+    z. F_N = k (z - d) has F_ex's sign (adhesion positive): minus for the AFM convention."""
+    out = SimCurve(x_kind="z")
+    for b, p in paths.items():
+        x, f = np.asarray(p["z_m"], float), -np.asarray(p["F_N"], float)
+        kind = list(p["kind"])
+        for i in range(len(kind) - 1):
+            if kind[i] == "fold":
+                out.jumps.append((b, float(x[i]), float(f[i]), float(f[i + 1])))
+        if len(x) and x[0] > x[-1]:
+            x, f = x[::-1], f[::-1]
+        if np.any(np.diff(x) < 0):
             k = np.argsort(x, kind="stable")
             x, f = x[k], f[k]
         out.x[b], out.f[b] = x, f
