@@ -83,6 +83,12 @@ def dispatch(args):
     if scene.kind != "contact":
         raise SceneError(scene.path, "meniscus", "(a meniscus scene)",
                          f"a contact scene: `femadh {args.command}` compares force curves")
+    if curve.columns.get("z", "").startswith("height (") and scene.instrument is None:
+        # afmformats' heights are the piezo's: they include the cantilever's deflection, which
+        # only a scene with the spring in series models; the tip position is the separation
+        _note(f"the curve's z is its {curve.columns['z']}, compared with the separation d of a "
+              "scene without [instrument]: add the cantilever's [instrument] or use the tip "
+              "position (height minus deflection)")
     if args.command == "compare":
         return _compare(scene, curve, offset, args)
     if args.workers is not None and args.workers < 1:

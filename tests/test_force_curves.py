@@ -139,6 +139,24 @@ def test_sign_and_jump_conventions():
     np.testing.assert_allclose(s.force_at(np.array([2.5e-9, 1.5e-9]), br, 0.0), [-1.5, -6.0])
 
 
+def test_measured_contact_point_and_jump():
+    """The measured contact point is where the force, repulsive from the lowest z up, turns
+    attractive (a noise crossing far out is not one); a step of more than 5 x the median
+    step is the measured jump."""
+    from femadh.fitting.compare import measured_contact, measured_jumps
+
+    z = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0]) * 1e-9
+    f = np.array([3.0, 1.0, -1.0, -1.2, 0.1, -0.1])
+    br = np.array(["approach"] * 6)
+    assert measured_contact(ForceCurve(z, f, br)) == pytest.approx(2.5e-9)
+    assert np.isnan(measured_contact(ForceCurve(z, -f, br)))
+    f = np.array([-0.1, -0.2, -0.3, -5.0, -5.1, -5.2])
+    (jump,) = measured_jumps(ForceCurve(z, f, br))
+    assert jump[0] == "approach" and jump[2:] == (-0.3, -5.0)
+    assert jump[1] == pytest.approx(3.5e-9, rel=1e-12)
+    assert measured_jumps(ForceCurve(z, np.linspace(0, 1, 6), br)) == []
+
+
 def test_lj_attraction_is_a_negative_measured_force(fig3):
     """Far from contact (d = 1.94 nm) only LJ attraction acts: F_ex > 0 in femadh, so the
     simulated measured force is negative; in the sigma-gap contact (d < 1.2 nm) it is

@@ -70,19 +70,20 @@ def compare(res_or_sim, curve, offset=None):
 
 
 def measured_contact(curve):
-    """The measured contact point (m): the lowest-z crossing of the approach force from
-    attraction (<= 0) to repulsion (> 0), interpolated; nan when the approach never repels."""
+    """The measured contact point (m): where the approach force, repulsive (> 0) at every
+    point from the lowest z up, first turns attractive (<= 0), interpolated; nan when the
+    lowest point does not repel (noise crossings far out are not contact)."""
     sel = curve.branch == "approach"
     if not sel.any():
         sel = curve.branch == "retract"
     z, f = curve.z[sel], curve.force[sel]
     k = np.argsort(z)
     z, f = z[k], f[k]
-    # scanning from far to near: the last sign change into repulsion is the contact
-    idx = [i for i in range(len(z) - 1) if f[i] > 0 >= f[i + 1]]
-    if not idx:
+    if not len(f) or f[0] <= 0:
         return math.nan
-    i = idx[-1]
+    i = int(np.argmax(f <= 0)) - 1          # the last point of the repulsive run from below
+    if i < 0:
+        return math.nan                     # repulsive everywhere: contact beyond the data
     return float(z[i] + (z[i + 1] - z[i]) * f[i] / (f[i] - f[i + 1]))
 
 
