@@ -316,9 +316,10 @@ def fit_curve(scene, curve, keys, *, workers=1, max_nfev=30, rel_step=1e-3, offs
                 # d r / d x_k with x_k = theta_k / theta0_k: the step in x is rel_step x_k
                 J[:, k] = (sims[k + 1].force_at(curve.z, curve.branch, off) - base) \
                     / (rel_step * x[k])
-                # a point that a fold moved across has the whole jump in its difference: not
-                # a derivative (it was 1e3 x the smooth entries and made the standard errors
-                # too small); such a point carries no slope information for this key
+                # a point that a fold moved across has the whole jump in its difference, not
+                # a derivative (in the mu = 2 LJ scene such a difference was 11x the smooth
+                # ones of the same point, and it grows as 1/rel_step): it would shrink the
+                # standard errors; such a point carries no slope information for this key
                 J[crossed(sims[0], sims[k + 1], off), k] = 0.0
             J[:, q] = sims[0].slope_at(curve.z, curve.branch, off, 1e-3 * OFFSET_SCALE) \
                 * OFFSET_SCALE
