@@ -299,6 +299,18 @@ DEFECTS = [
       "at sigma (lambda = P_LJa - (K w)_j)", "femadh/contact/sigma_arclength.py",
       (("self.lam0 = float(problem.pressure(np.array([self.sigma]))[0]) + adh",
         "self.lam0 = adh"),)),
+    # -- force curves and fits
+    D("fc_afm_sign", "measured-curve model: F_AFM = +F_ex (the AFM sign not reversed)",
+      "femadh/fitting/model.py",
+      (('x, f = np.asarray(cols["d_m"], float), -np.asarray(cols["F_ex_N"], float)',
+        'x, f = np.asarray(cols["d_m"], float), np.asarray(cols["F_ex_N"], float)'),)),
+    D("fit_stderr_no_s2", "fit: covariance (J^T J)^-1 without s^2 = RSS/(n - p)",
+      "femadh/fitting/lsq.py",
+      (("cov_n = s2 * np.linalg.inv(A)", "cov_n = np.linalg.inv(A)"),)),
+    D("fit_offset_frozen", "fit: the contact-point offset not fitted (the residual keeps the "
+      "starting offset)", "femadh/fitting/lsq.py",
+      (("r = sim.force_at(curve.z, curve.branch, x[q] * OFFSET_SCALE) - curve.force",
+        "r = sim.force_at(curve.z, curve.branch, x0[q] * OFFSET_SCALE) - curve.force"),)),
 ]
 
 
