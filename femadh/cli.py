@@ -121,6 +121,9 @@ def _parser():
     rg.add_argument("--z0", default="0.165 nm", help="LJ equilibrium distance (default "
                                                      "'0.165 nm')")
     rg.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
+    from . import cli_topography
+
+    cli_topography.add_parser(sub)
     return p
 
 
@@ -177,6 +180,10 @@ def _dispatch(args):
         return _regime(args)
     if args.command == "render":
         return _render(args)
+    if args.command == "topography":
+        from . import cli_topography
+
+        return cli_topography.main(args)
     from .scene import load_scene
     from .scene.resources import check_resources
 

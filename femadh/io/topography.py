@@ -77,9 +77,9 @@ def read_topography(path, *, key=FILE_KEY, file=None):
     channel = reader.channels[0]
     sizes, unit = channel.physical_sizes, channel.unit
     if sizes is None or unit is None:
-        missing = " and ".join(w for w, v in (("a physical size", sizes), ("a length unit", unit))
-                               if v is None)
-        raise bad(f"a topography with a physical size and a length unit; this file has no "
+        missing = ("neither a physical size nor a length unit" if sizes is None and unit is None
+                   else "no physical size" if sizes is None else "no length unit")
+        raise bad(f"a topography with a physical size and a length unit; this file has "
                   f"{missing} (write it in a format that stores them, e.g. SurfaceTopography's "
                   "NetCDF)")
     try:
