@@ -75,6 +75,11 @@ def _registration():
             default="contact-set", choices=("contact-set", "smoothed")),
         Key("smoothing", "number", "Step width as a fraction of sigma (model = 'smoothed').",
             default=0.02, lo=0.0, hi=0.2, hi_closed=True),
+        Key("topography", "string", "A measured surface (path relative to the scene file; "
+            "needs the 'data' extra) whose McCool statistics replace the summit numbers "
+            "(femadh topography FILE shows them).", default=None),
+        Key("topography_cutoff", "length", "Short-wavelength cutoff of the topography's "
+            "spectral moments (default: the pixel scale).", default=None, lo=0.0),
     ))
     return Registration(table, _build, (Output("asperity_adhesion", "F_LJa_N", "P_LJa_Pa", 1.0,
                                                "asperity adhesion (eq 20)"),))

@@ -153,6 +153,11 @@ def _registration():
         Key("density", "areal_density", "Summit density rho.", lo=0.0),
         Key("surface_energy", "surface_energy", "Surface energy of a summit contact (eq 24); "
             "0 for no asperity adhesion.", default=0.0, lo=0.0, lo_closed=True),
+        Key("topography", "string", "A measured surface (path relative to the scene file; "
+            "needs the 'data' extra) whose McCool statistics replace the summit numbers "
+            "(femadh topography FILE shows them).", default=None),
+        Key("topography_cutoff", "length", "Short-wavelength cutoff of the topography's "
+            "spectral moments (default: the pixel scale).", default=None, lo=0.0),
     ))
     return Registration(table, _build, (
         Output("asperity_elastic", "F_ela_N", "P_ela_Pa", -1.0, "asperity elasticity (eq 23)"),
