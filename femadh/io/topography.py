@@ -55,6 +55,17 @@ def read_topography(path, *, key=FILE_KEY, file=None):
         The file is missing or unreadable, its format unknown, it has no physical size or
         length unit, it holds undefined (NaN) points, or it is flat.
     """
+    import warnings
+
+    # SurfaceTopography's NetCDF reader warns when its memory map is closed while arrays
+    # still refer to it (an error path that raises before the heights are copied);
+    # the accepted topography is squeezed into memory before the file is closed
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _read(path, key, file)
+
+
+def _read(path, key, file):
     open_topography = _surface_topography()
     path = Path(path)
     where = file if file is not None else str(path)
@@ -72,6 +83,15 @@ def read_topography(path, *, key=FILE_KEY, file=None):
                else _first_line(exc))
         raise bad("a topography file in a format SurfaceTopography reads (NetCDF, Gwyddion, "
                   f"x3p, Digital Instruments, ...): {why}") from None
+    try:
+        return _check(reader, bad)
+    finally:
+        if hasattr(reader, "close"):
+            reader.close()
+
+
+def _check(reader, bad):
+    """The checks of :func:`read_topography` on an open reader."""
     if not reader.channels:
         raise bad("a topography file with at least one data channel")
     channel = reader.channels[0]
@@ -104,7 +124,7 @@ def read_topography(path, *, key=FILE_KEY, file=None):
     if min(topo.nb_grid_pts) < 8:
         raise bad(f"a topography of at least 8 points along each side (it has "
                   f"{'x'.join(str(n) for n in topo.nb_grid_pts)})")
-    topo = topo.detrend("center" if topo.is_periodic else "height")
+    topo = topo.detrend("center" if topo.is_periodic else "height").squeeze()
     if not topo.rms_height_from_profile() > 0:
         raise bad("a rough topography (this one is flat: every height equal after "
                   "detrending)")
