@@ -12,6 +12,8 @@ problem is one :class:`~femadh.errors.SceneError` naming the file and what was e
 import math
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import DependencyError, SceneError
 
 #: the key under which file-level problems are reported (as femadh.scene does for "(file)")
@@ -115,8 +117,6 @@ def _check(reader, bad):
         raise bad(f"a topography whose unit is a length (it is {unit!r}: "
                   f"{_first_line(exc)})") from None
     if topo.has_undefined_data:
-        import numpy as np
-
         n_bad = int(np.ma.count_masked(np.ma.masked_invalid(topo.heights())))
         raise bad(f"a topography without undefined (NaN) points; {n_bad} of "
                   f"{int(np.prod(topo.nb_grid_pts))} are undefined (fill or crop them first: "
@@ -124,8 +124,10 @@ def _check(reader, bad):
     if min(topo.nb_grid_pts) < 8:
         raise bad(f"a topography of at least 8 points along each side (it has "
                   f"{'x'.join(str(n) for n in topo.nb_grid_pts)})")
+    scale = float(np.max(np.abs(topo.heights())))
     topo = topo.detrend("center" if topo.is_periodic else "height").squeeze()
-    if not topo.rms_height_from_profile() > 0:
+    # flat: nothing left after detrending but the rounding of the plane fit
+    if not float(np.sqrt(np.mean(topo.heights() ** 2))) > 1e-10 * scale:
         raise bad("a rough topography (this one is flat: every height equal after "
                   "detrending)")
     return topo

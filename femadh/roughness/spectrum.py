@@ -1,9 +1,9 @@
 """Where a measured spectrum stops being the surface's: the short-wavelength end of the power
 spectral density, where the instrument (tip radius, pixel size, noise, filters) shows.
 
-Criterion (stated, simple): fit a power law C ~ q^s by least squares in log-log over the mid
-range q in [4 q_L, q_N / 4] (q_L = 2 pi / L the longest wavevector, q_N = pi / pixel the
-Nyquist one) and compare the measured PSD over the top octave [q_N / 2, q_N] with the power
+Criterion (stated, simple): fit a power law C ~ q^s by least squares in log-log over the two
+octaves q in [q_N / 16, q_N / 4] below the tail (q_N = pi / pixel the Nyquist wavevector;
+a lower start would reach into the long-wavelength roll-off most surfaces have) and compare the measured PSD over the top octave [q_N / 2, q_N] with the power
 law extrapolated there. If the geometric mean of measured / extrapolated over that octave
 is above 2, the tail *flattens* (a noise floor, or pixel-level artefacts: m2 and m4 at the
 pixel scale are then inflated); below 1/2, it *drops steeply* (the tip radius or a filter
@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-#: the tail is judged over the top octave below Nyquist, against a fit over [4 q_L, q_N / 4]
-MID_LOW, MID_HIGH, TAIL_LOW = 4.0, 0.25, 0.5
+#: the tail is judged over the top octave below Nyquist, against a fit over [q_N / 16, q_N / 4]
+MID_LOW, MID_HIGH, TAIL_LOW = 1.0 / 16, 0.25, 0.5
 #: geometric-mean ratio of the tail to the extrapolated power law beyond which it is flagged
 TAIL_FACTOR = 2.0
 #: a power-law fit needs this many PSD points in the mid range
@@ -77,10 +77,9 @@ def tail_check(topography):
     q, c = np.ma.filled(np.ma.asarray(q, float), np.nan), np.ma.filled(np.ma.asarray(c, float),
                                                                        np.nan)
     pixel = max(s / n for s, n in zip(topography.physical_sizes, topography.nb_grid_pts))
-    q_l = 2 * math.pi / min(topography.physical_sizes)
     q_n = math.pi / pixel
     ok = np.isfinite(q) & np.isfinite(c) & (c > 0)
-    mid = ok & (q >= MID_LOW * q_l) & (q <= MID_HIGH * q_n)
+    mid = ok & (q >= MID_LOW * q_n) & (q <= MID_HIGH * q_n)
     tail = ok & (q >= TAIL_LOW * q_n) & (q <= q_n)
     if mid.sum() < MIN_POINTS or tail.sum() < 1:
         return TailCheck(math.nan, math.nan, "not judged")
