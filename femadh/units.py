@@ -26,6 +26,7 @@ DIMENSIONS = {
     "areal_density": ("1 / [length] ** 2", "1/m^2", "an areal density such as '100 um^-2'"),
     "temperature": ("[temperature]", "K", "a temperature such as '298.15 K'"),
     "molar_volume": ("[length] ** 3 / [substance]", "m^3/mol", "a molar volume such as '58.7 cm^3/mol'"),
+    "stiffness": ("[mass] / [time] ** 2", "N/m", "a stiffness such as '0.5 N/m'"),
     "dimensionless": ("", "", "a plain number"),
 }
 
@@ -66,7 +67,8 @@ def _fast(text, dimension):
     if mag is None or not unit:
         return None
     hit = _FAST.get(unit.replace("**", "^").replace(" ", ""))
-    if hit is None or hit[0] != dimension:
+    # a stiffness (N/m) shares its dimension with a surface energy: same table entry
+    if hit is None or DIMENSIONS[hit[0]][0] != DIMENSIONS[dimension][0]:
         return None
     return float(mag) * hit[1]
 

@@ -298,6 +298,11 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             parts[name]["tolerance"] = float(problem.areas.sum() * scene.tolerance
                                              * np.max(np.abs(problem.dpressure(
                                                  np.full(1, _contact_gap(problem))))))
+    # the instrument's readout between the computed states (femadh.instrument.readout)
+    if res.instrument is not None:
+        for name, v in res.instrument["resolution"].items():
+            if f"instrument_{name}" in hl:
+                parts.setdefault(f"instrument_{name}", {})["resolution"] = float(v)
     parts = {k: v for k, v in parts.items() if k in QUANTITIES and k in hl}
     for k, comp in parts.items():
         # the parts are signed estimates of Q_exact - Q (grid, fe_mesh, tail) or bounds
@@ -388,4 +393,7 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0):
 
 QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",
               "jump_out_d_m", "hysteresis_J", "r_c_at_zero_force_approach_m",
-              "r_c_at_zero_force_retract_m", "d_at_max_adhesion_m")
+              "r_c_at_zero_force_retract_m", "d_at_max_adhesion_m",
+              "instrument_pull_off_N", "instrument_snap_off_N", "instrument_jump_in_d_m",
+              "instrument_jump_in_z_m", "instrument_jump_out_d_m", "instrument_jump_out_z_m",
+              "instrument_hysteresis_J")

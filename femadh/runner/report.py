@@ -46,6 +46,34 @@ def headline_lines(res):
         out.append(f"jump ({j['branch']}): branch folds at d = {j['d_fold_m'] * 1e9:.4f} nm "
                    f"({where}), h0 {j['h0_before_m'] * 1e9:.3f} -> {j['h0_after_m'] * 1e9:.3f} "
                    "nm")
+    if res.instrument is not None:
+        out += _instrument_lines(res)
     for w in res.warnings:
         out.append(f"warning: {w}")
+    return out
+
+
+def _instrument_lines(res):
+    """What the instrument records: its pull-off and snap-off, where it jumps (d and z)."""
+    hl, k = res.headline, res.instrument["spring"]["stiffness_N_per_m"]
+
+    def nm(name):
+        v, e = hl[name] * 1e9, hl.get(f"{name}_error")
+        return f"{v:.4f} ± {e * 1e9:.1g} nm" if e is not None else f"{v:.4f} nm"
+    line = f"instrument k = {k:.4g} N/m:"
+    if "instrument_pull_off_N" in hl:
+        line += (f" pull-off {_force(hl['instrument_pull_off_N'], hl.get('instrument_pull_off_N_error'))}")
+    if "instrument_snap_off_N" in hl:
+        line += (f", snaps off at {_force(hl['instrument_snap_off_N'], hl.get('instrument_snap_off_N_error'))}")
+    out = [line]
+    if "instrument_jump_in_z_m" in hl:
+        out.append(f"instrument jumps in at z = {nm('instrument_jump_in_z_m')} (d = "
+                   f"{nm('instrument_jump_in_d_m')})")
+    if "instrument_jump_out_z_m" in hl:
+        out.append(f"instrument jumps out at z = {nm('instrument_jump_out_z_m')} (d = "
+                   f"{nm('instrument_jump_out_d_m')})")
+    if "instrument_hysteresis_J" in hl:
+        e = hl.get("instrument_hysteresis_J_error")
+        out.append(f"instrument hysteresis {hl['instrument_hysteresis_J']:.4g}"
+                   + (f" ± {e:.1g}" if e is not None else "") + " J")
     return out

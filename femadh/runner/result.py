@@ -50,6 +50,10 @@ class ContactResult:
         The error breakdown: quantity -> {grid, fe_mesh, resolution, tail, tolerance, total}.
     accuracy : dict
         Accuracy mode: the target, what was chosen (nodes, analysis radius) and the steps.
+    instrument : dict or None
+        Scenes with an [instrument]: its spring, the paths it drives (branch -> z_m, d_m,
+        F_N, kind), its jumps and the readout's resolution of each headline number
+        (:mod:`femadh.instrument.readout`).
     grid : dict
         The discretisation used: kind (uniform/banded), nodes, analysis radius, band and
         spacing (banded), the spacing ratio of the estimate's coarser members and their labels.
@@ -75,6 +79,7 @@ class ContactResult:
     out_dir: str | None = None
     accuracy: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
+    instrument: dict | None = None
 
     kind = "contact"
 
@@ -166,5 +171,26 @@ def contact_summary(res, status=None):
             "status": status or res.status, "error": res.error,
             "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
             "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
+            "instrument": instrument_summary(res),
             "accuracy": res.accuracy, "grid": res.grid, "warnings": res.warnings,
             "timings_s": res.timings, "wall_time_s": res.wall_time}
+
+
+def instrument_summary(res):
+    """summary.json's "instrument": the spring and what it records (the headline's
+    ``instrument_<name>`` numbers under their own names, each with its ``_error``), the jumps,
+    and why a path stops short (``incomplete``); None without an instrument."""
+    if res.instrument is None:
+        return None
+    from .headline import INSTRUMENT_NUMBERS
+
+    out = dict(res.instrument["spring"])
+    for name in INSTRUMENT_NUMBERS:
+        key = f"instrument_{name}"
+        if key in res.headline:
+            out[name] = res.headline[key]
+            if f"{key}_error" in res.headline:
+                out[f"{name}_error"] = res.headline[f"{key}_error"]
+    out["jumps"] = res.instrument["jumps"]
+    out["incomplete"] = res.instrument["incomplete"]
+    return out

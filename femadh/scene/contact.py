@@ -13,6 +13,7 @@ from ..indenter import PROFILES, Sphere
 from ..laws.registry import BuildContext, registry
 from ..materials import IsotropicMaterial, composite_modulus
 from ..schema import Key, Table
+from .instrument import BEAM, INSTRUMENT, read_instrument
 from .reader import BAD, any_bad
 from .topography import resolve as resolve_topography
 
@@ -206,10 +207,10 @@ STUDY = Table("study", "A parameter study over this scene (femadh study sweep SC
 
 #: the tables of a contact scene file
 TOP = ("scene", "sphere", "materials", "substrate", "effects", "solver", "sweep", "output",
-       "study")
+       "study", "instrument")
 #: every table description, for the reference page (femadh keys)
 TABLES = (SCENE, SPHERE, MATERIALS, MATERIAL, SUBSTRATE, LAYER, GAP, SOLVER, DELTA, GRID, MESH,
-          SWEEP, OUTPUT, STUDY)
+          SWEEP, OUTPUT, STUDY, INSTRUMENT, BEAM)
 
 
 def _material(reader, raw, path):
@@ -257,6 +258,7 @@ class Scene:
     grid: dict | None = None
     nodes_explicit: bool = True
     topography: dict | None = None
+    instrument: object = None        # femadh.instrument.Spring, or None (a rigid drive)
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "contact"
@@ -316,6 +318,7 @@ class Scene:
                        "mesh": None if self.fe_settings is None else {
                            **asdict(self.fe_settings), "poisson_ratio": self.fe_poisson_ratio}},
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
+            "instrument": None if self.instrument is None else self.instrument.as_dict(),
             "output_dir": self.output_dir,
             # (only when used: the ids of scenes without it stay as they were)
             **({"topography": self.topography} if self.topography else {}),
@@ -354,6 +357,7 @@ def parse_contact(reader, data, file):
     d_values = _separations(reader, sw, data.get("sweep") or {})
     ou = reader.read(OUTPUT, data.get("output"), "output")
     study = reader.read(STUDY, data["study"], "study") if "study" in data else None
+    instrument = read_instrument(reader, data.get("instrument"))
 
     method = so["method"]
     fe_settings, fe_nu = None, (disk.poisson_ratio if isinstance(disk, IsotropicMaterial)
@@ -394,7 +398,8 @@ def parse_contact(reader, data, file):
                  layers=layers if layers is not BAD else (), study=study,
                  accuracy=so["accuracy"], grid=so["grid"],
                  nodes_explicit="nodes" in (data.get("solver") or {}),
-                 topography=topography or None, raw=copy.deepcopy(data))
+                 instrument=instrument, topography=topography or None,
+                 raw=copy.deepcopy(data))
 
 
 def _read_materials(reader, data):

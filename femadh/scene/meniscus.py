@@ -165,8 +165,13 @@ def parse_meniscus(reader, data, file):
 
     from .contact import STUDY
 
+    if "instrument" in data:
+        reader.fail("instrument", data["instrument"], "no [instrument] in a meniscus scene: it "
+                    "computes the meniscus force at fixed geometry, with no contact curve for a "
+                    "spring to follow (give the contact scene an [effects.capillary] and the "
+                    "instrument there)")
     for name in data:
-        if name not in ("scene", "meniscus", "output", "study"):
+        if name not in ("scene", "meniscus", "output", "study", "instrument"):
             reader.unknown("", name, data[name], ["meniscus", "output", "scene", "study"])
     sc = reader.read(SCENE, data.get("scene"), "scene")
     m = reader.read(MENISCUS, data.get("meniscus"), "meniscus")
