@@ -321,7 +321,7 @@ def test_scene_topography_resolves_into_the_run_summary(surface_file, tmp_path, 
     assert main(["run", str(path), "--no-estimate", "--no-figures", "--quiet"]) == 0
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     t = summary["scene"]["topography"]["effects.asperity_contact"]
-    assert t["file"] == str(tmp_path / "surf.nc")
+    assert t["files"] == [str(tmp_path / "surf.nc")]
     assert t["cutoff_m"] == pytest.approx(50e-9, rel=1e-15)
     assert (t["eta_per_m2"], t["beta_m"], t["sigma_s_m"], t["z_m_m"]) == (
         s.density, s.radius, s.sigma_a, s.z_m)
@@ -346,3 +346,28 @@ def test_scene_topography_errors_name_file_and_key(surface_file, tmp_path, capsy
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and str(missing) in err and "no such file" in err
     assert "effects.asperity_contact.topography" in err
+
+
+def test_scene_takes_the_table2_composite_of_slider_and_disk(surface_file, tmp_path, capsys):
+    """topography = [slider, disk]: the section's numbers are the CLI's composite (Table 2 rule
+    of the two McCool statistics, rho from the summed moments); a malformed value is one line."""
+    import shutil
+
+    import femadh
+
+    shutil.copy(surface_file, tmp_path / "slider.nc")
+    synthetic(128, long_frac=4).to_netcdf(str(tmp_path / "disk.nc"))
+    path = tmp_path / "pair.toml"
+    path.write_text(_scene_text('[effects.asperity_contact]\nmodel = "greenwood-williamson"\n'
+                                'topography = ["slider.nc", "disk.nc"]\n'))
+    t2, _, _ = composite(profile_moments(read_topography(tmp_path / "slider.nc")),
+                         profile_moments(read_topography(tmp_path / "disk.nc")))
+    scene = femadh.load_scene(path)
+    assert scene.effects["asperity_elastic"].summits == t2
+    assert scene.resolved["topography"]["effects.asperity_contact"]["files"] == [
+        str(tmp_path / "slider.nc"), str(tmp_path / "disk.nc")]
+    path.write_text(_scene_text('[effects.asperity_contact]\nmodel = "greenwood-williamson"\n'
+                                'topography = 3\n'))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "a list of two (slider, disk)" in err

@@ -1,7 +1,8 @@
 """``topography = "file"`` in an asperity section: the GW numbers of the section computed
-from a measured surface (:mod:`femadh.roughness.report`) instead of written by hand.
+from a measured surface (:mod:`femadh.roughness.report`) instead of written by hand;
+``topography = ["slider", "disk"]`` takes paper 1's Table 2 composite of two.
 
-The file's path is relative to the scene file (to the working folder for scenes built in
+The files' paths are relative to the scene file (to the working folder for scenes built in
 code); ``topography_cutoff`` sets the short-wavelength cutoff (default: the pixel scale).
 The section's numeric keys that the topography provides must then be absent. The numbers are
 put into the section as SI strings (exact round-trip) before the section is read, so they
@@ -42,8 +43,9 @@ def resolve(reader, raw, path, table, resolved):
     from ..roughness.report import scene_values, statistics
 
     name, key = raw["topography"], f"{path}.topography"
-    if not isinstance(name, str) or not name:
-        return reader.fail(key, name, "a topography file name (a string)")
+    names = reader.value(table.key("topography"), name, key)
+    if names is BAD:
+        return BAD
     fills = [k for k in PROVIDES if table.key(k) is not None]
     given = [k for k in fills if k in raw]
     if given:
@@ -56,14 +58,15 @@ def resolve(reader, raw, path, table, resolved):
         if cutoff is BAD:
             return BAD
     base = Path(reader.file).parent if reader.file else Path.cwd()
-    file = base / name
+    files = [base / n for n in names]
     try:
-        report = statistics([file], cutoff, key=key, file=reader.file)
+        report = statistics(files, cutoff, key=key, file=reader.file)
     except SceneError as exc:
         reader.errors.append(exc)
         return BAD
     values = scene_values(report)
-    resolved[path] = {"file": str(file), "cutoff_m": report["cutoff_m"],
+    resolved[path] = {"files": [str(f) for f in files], "rule": report["rule"],
+                      "cutoff_m": report["cutoff_m"],
                       "cutoff_source": report["cutoff_source"],
                       **{k: report[k] for k in ("m0", "m2", "m4", "alpha", "eta_per_m2",
                                                 "beta_m", "sigma_s_m", "z_m_m")},
