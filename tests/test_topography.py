@@ -83,17 +83,20 @@ def test_pixel_scale_moments_match_the_analytic_spectrum(surface_file):
     assert m.anisotropy == pytest.approx(1.0, abs=1e-12)        # float32: 2.5e-9 relative
 
 
-def test_moments_at_a_cutoff_match_the_band_limited_integral(surface_file):
-    """The profile cutoff |q_x| <= 2 pi / lambda_c against the band-limited integral. The
-    lattice resolves a cutoff only to 2 pi / L, so lambda_c is put half-way between lattice
-    lines (L / 16.5). Measured: m4 +0.01 %, m2 +0.07 %, m0 -0.17 %. Tolerances: 3x (m0, m2),
-    m4 1e-3 (10x: its measured error is at the level of the quadrature's breakpoints)."""
-    lam = SIDE / 16.5
+@pytest.mark.parametrize("lines", [16.5, 16.0, 16.25])
+def test_moments_at_a_cutoff_match_the_band_limited_integral(surface_file, lines):
+    """The profile cutoff |q_x| <= q_c = 2 pi / lambda_c against the band-limited integral,
+    lambda_c = L / 16.5 (half-way between lattice lines), L / 16 (on a line: a sharp mask
+    |q_x| <= q_c is off by half a line there, +8.3 % or -7.9 % in m4 as rounding puts the
+    line in or out) and L / 16.25. Measured: m4 +0.01 %, +0.19 %, +0.14 %; m2 +0.07 %,
+    +0.05 %, +0.05 %; m0 -0.17 %, -0.19 %, -0.19 %. Tolerances: 3x the largest (m4 6e-3,
+    m2 3e-3, m0 6e-3)."""
+    lam = SIDE / lines
     m = profile_moments(read_topography(surface_file), lam)
     q_s, q_l, q_c = math.pi * 256 / SIDE, 2 * math.pi * 8 / SIDE, 2 * math.pi / lam
-    assert m.m4 == pytest.approx(analytic_moment(4, q_s, q_l, q_c), rel=1e-3)
-    assert m.m2 == pytest.approx(analytic_moment(2, q_s, q_l, q_c), rel=2e-3)
-    assert m.m0 == pytest.approx(analytic_moment(0, q_s, q_l, q_c), rel=5e-3)
+    assert m.m4 == pytest.approx(analytic_moment(4, q_s, q_l, q_c), rel=6e-3)
+    assert m.m2 == pytest.approx(analytic_moment(2, q_s, q_l, q_c), rel=3e-3)
+    assert m.m0 == pytest.approx(analytic_moment(0, q_s, q_l, q_c), rel=6e-3)
     assert m.cutoff == lam
     # and the dependence on the cutoff is the spectrum's: m4 falls by orders of magnitude
     pixel = profile_moments(read_topography(surface_file))

@@ -95,8 +95,10 @@ def profile_moments(topography, cutoff=None):
         are Hann-windowed before the transform (SurfaceTopography's default; it keeps the
         mean square), periodic data are not.
     cutoff : float, optional
-        Short-wavelength cutoff lambda_c (m): only wavevectors |q| <= 2 pi / lambda_c of each
-        profile are kept. None: the pixel scale (every wavevector up to Nyquist).
+        Short-wavelength cutoff lambda_c (m): only wavevectors |q| <= q_c = 2 pi / lambda_c
+        of each profile are kept (the lattice line nearest q_c weighted by the part of its
+        cell below q_c: the band-limited integral by the midpoint rule). None: the pixel
+        scale (every wavevector up to Nyquist).
 
     Returns
     -------
@@ -107,9 +109,19 @@ def profile_moments(topography, cutoff=None):
     q_c = None if cutoff is None else 2.0 * math.pi / cutoff
 
     def moments(t):
-        # one weight per moment; the sharp mask is the cutoff (nothing tapers it)
-        keep = (lambda q: np.ones_like(q, dtype=bool)) if q_c is None else (
-            lambda q: np.abs(q) <= q_c)
+        if q_c is None:
+            def keep(q):
+                return 1.0
+        else:
+            # the lattice's wavevectors are dq = 2 pi / L apart: the line nearest the cutoff
+            # is weighted by the fraction of its cell [q - dq/2, q + dq/2] below q_c (1/2 for
+            # a line on the cutoff), so that the sum is the midpoint rule of the band-limited
+            # integral for any q_c; a sharp |q| <= q_c would jump by one whole line as q_c
+            # crosses it (6 % of m4 for a cutoff of L/20 on a self-affine surface)
+            dq = 2.0 * math.pi / t.physical_sizes[0]
+
+            def keep(q):
+                return np.clip((q_c - np.abs(q)) / dq + 0.5, 0.0, 1.0)
         return [t.integrate_psd_from_profile(lambda q, n=n: np.abs(q) ** n * keep(q),
                                              reliable=False) for n in (0, 2, 4)]
 
