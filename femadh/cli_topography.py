@@ -79,8 +79,10 @@ def table(report):
     if report["cutoff_source"] == "user":
         cols.append(("cutoff", report))
     head = f"{'':24s}" + "".join(f"{n + ' ' + _nm(v['cutoff_m']):>22s}" for n, v in cols)
-    lines = [", ".join(report["files"]) + (" (composite: " + report["rule"] + ")"
-                                           if len(report["files"]) == 2 else ""), head]
+    lines = [", ".join(report["files"])]
+    if len(report["files"]) == 2:
+        lines.append("composite: " + report["rule"])
+    lines.append(head)
     for i, (label, _) in enumerate(_rows(report["pixel"])):
         lines.append(f"{label:24s}" + "".join(f"{_rows(v)[i][1]:22.4g}" for _, v in cols))
     return "\n".join(lines)

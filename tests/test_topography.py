@@ -25,6 +25,8 @@ from femadh.roughness.spectrum import tail_check  # noqa: E402
 
 #: the synthetic self-affine surface: Hurst exponent, side, prefactor of C2D = C0 q^(-2-2H)
 HURST, SIDE, C0 = 0.8, 1e-6, 1e-30
+#: "50 nm" as femadh parses it (50 x 1e-9, one ulp above 5e-8): the same float everywhere
+CUT = 50 * 1e-9
 
 
 def psd(q, q_l):
@@ -196,9 +198,9 @@ def test_cli_json_and_scene_fragment(surface_file, tmp_path, capsys):
                           "--scene-fragment", frag)
     assert code == 0 and err == ""
     r = json.loads(out)
-    m = profile_moments(read_topography(surface_file), 50e-9)
+    m = profile_moments(read_topography(surface_file), CUT)
     s = mccool(m)
-    assert r["cutoff_m"] == pytest.approx(50e-9, rel=1e-15) and r["cutoff_source"] == "user" and r["warnings"] == []
+    assert r["cutoff_m"] == CUT and r["cutoff_source"] == "user" and r["warnings"] == []
     assert (r["m0"], r["m2"], r["m4"], r["alpha"]) == (m.m0, m.m2, m.m4, m.alpha)
     assert (r["eta_per_m2"], r["beta_m"], r["sigma_s_m"], r["z_m_m"]) == (
         s.density, s.radius, s.sigma_a, s.z_m)
@@ -317,7 +319,7 @@ def test_scene_topography_resolves_into_the_run_summary(surface_file, tmp_path, 
     path.write_text(_scene_text('[effects.asperity_contact]\nmodel = "greenwood-williamson"\n'
                                 'topography = "surf.nc"\ntopography_cutoff = "50 nm"\n'
                                 'surface_energy = "0.06 J/m^2"\n', out=tmp_path / "run"))
-    s = mccool(profile_moments(read_topography(surface_file), 50e-9))
+    s = mccool(profile_moments(read_topography(surface_file), CUT))
     scene = femadh.load_scene(path)
     assert scene.effects["asperity_elastic"].summits == s
     assert scene.effects["asperity_adhesion"].summits == s
@@ -325,7 +327,7 @@ def test_scene_topography_resolves_into_the_run_summary(surface_file, tmp_path, 
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     t = summary["scene"]["topography"]["effects.asperity_contact"]
     assert t["files"] == [str(tmp_path / "surf.nc")]
-    assert t["cutoff_m"] == pytest.approx(50e-9, rel=1e-15)
+    assert t["cutoff_m"] == CUT
     assert (t["eta_per_m2"], t["beta_m"], t["sigma_s_m"], t["z_m_m"]) == (
         s.density, s.radius, s.sigma_a, s.z_m)
 

@@ -133,8 +133,8 @@ def statistics(paths, cutoff=None, *, key="FILE", file=None):
         out["pixel"] = info["pixel"]
     else:
         (_, p1, c1), (_, p2, c2) = surfaces
-        rule = ("paper 1 Table 2 (sigma_a quadrature sum, z_m sum, R_a harmonic) of each "
-                "surface's McCool statistics; rho from the summed moments")
+        rule = ("paper 1 Table 2 rule (sigma_a in quadrature, z_m summed, R_a harmonic) on "
+                "each surface's McCool numbers; rho from the summed moments")
         t_pix, s_pix, m_pix = composite(p1, p2)
         out["pixel"] = _summits_values(t_pix, m_pix, rule)
         t, s, m = composite(c1 or p1, c2 or p2)
