@@ -268,6 +268,26 @@ DEFECTS = [
     D("feature_gap_fraction", "feature gap: |P'| threshold 1e-3 instead of FEATURE_FRACTION",
       "femadh/discretisation/plan.py",
       (("stiff >= FEATURE_FRACTION * top", "stiff >= 1e-3 * top"),)),
+    # -- the instrument in series with the contact
+    D("instrument_z_sign", "instrument: drive z = d - F/k (the spring's force reversed)",
+      "femadh/instrument/readout.py",
+      (("z_of = lambda q: q.d + q.F / k", "z_of = lambda q: q.d - q.F / k"),)),
+    D("instrument_no_tail", "instrument: the force beyond the analysis radius dropped",
+      "femadh/instrument/readout.py",
+      (("F_ex, F = F, F + tail(d)", "F_ex, F = F, F + 0 * tail(d)"),)),
+    D("instrument_walks_through_turn", "instrument: held past z's turning point (stability "
+      "dF/dd > -k ignored)", "femadh/instrument/readout.py",
+      (("while 0 <= nxt < len(p.d) and s * (z[nxt] - z[i]) > 0 and",
+        "while 0 <= nxt < len(p.d) and True and"),)),
+    D("instrument_landing_force", "instrument: the landing's force taken at the state before "
+      "it, not interpolated", "femadh/instrument/readout.py",
+      (("best = (gap, q, a, dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))",
+        "best = (gap, q, a, dL, q.F[a])"),)),
+    D("bridge_factor", "fixed-fixed bridge: 12 E w t^3 / L^3 instead of 16",
+      "femadh/instrument/spring.py",
+      (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),
+    D("jkr_spring_sign", "JKR with a spring: instability at dP/dD = +k",
+      "femadh/reference/maugis.py", (("return dP + k_tilde * dD", "return dP - k_tilde * dD"),)),
     # -- topography statistics
     D("topo_mccool_radius", "McCool summit radius from the sum of the principal curvatures "
       "(0.375 -> 0.1875)", "femadh/roughness/moments.py",
@@ -314,7 +334,7 @@ def _first_failure(output):
     return m.group(1) if m else None
 
 
-def run_one(defect, root):
+def run_one(defect, root, tests=()):
     original, problem = _apply(root, defect)
     if problem:
         return {"defect": defect, "caught": None, "test": problem, "seconds": 0.0}
@@ -322,7 +342,7 @@ def run_one(defect, root):
     t0 = time.perf_counter()
     try:
         out = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
-                              "-W", "ignore"], cwd=root, env=env, capture_output=True,
+                              "-W", "ignore", *tests], cwd=root, env=env, capture_output=True,
                              text=True, timeout=TIMEOUT_S)
         text, code = out.stdout + out.stderr, out.returncode
     except subprocess.TimeoutExpired:
@@ -345,6 +365,9 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2, help="suites in parallel (default 2)")
     ap.add_argument("--list", action="store_true", help="list the defects and exit")
     ap.add_argument("--no-report", action="store_true", help="do not write the report")
+    ap.add_argument("--tests", nargs="+", default=(), metavar="PATH",
+                    help="run only these test files on each defect (a quick check of new "
+                         "code; a defect they catch is caught by the whole suite too)")
     args = ap.parse_args(argv)
     wanted = [w for w in (args.only or "").split(",") if w]
     todo = [d for d in DEFECTS if not wanted or any(w in d.name for w in wanted)]
@@ -369,7 +392,7 @@ def main(argv=None):
             with lock:
                 root = free.pop()
             try:
-                res = run_one(defect, root)
+                res = run_one(defect, root, args.tests)
             finally:
                 with lock:
                     free.append(root)
@@ -395,7 +418,9 @@ def main(argv=None):
             lines.append(f"| {d.name} | {d.what} | `{d.path}` | {test} | {r['seconds']:.1f} |")
         report = REPORT.with_name("seeded_defects_partial.md") if args.only else REPORT
         if args.only:
-            lines[2] = (f"Partial run (--only {args.only}): " + lines[2])
+            lines[2] = (f"Partial run (--only {args.only}"
+                        + (f" --tests {' '.join(args.tests)}" if args.tests else "")
+                        + "): " + lines[2])
         report.write_text("\n".join(lines) + "\n")
         print(f"report: {report}")
     return 0 if caught == len(results) else 1

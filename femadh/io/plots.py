@@ -54,7 +54,69 @@ def contact_figures(res, folder):
     sc = res.scene
     if "lj" in sc.effects and sc.gap is not None and res.profiles:
         paths.append(paper1_panels(res, folder / "fig3_panels.png"))
+    if getattr(res, "instrument", None) is not None:
+        paths.append(instrument_figure(res, folder / "instrument.png"))
     return paths
+
+
+def instrument_figure(res, path):
+    """What the instrument records beside what the contact does: left, the force the spring
+    reads against the drive z, approach and retract, each jump an arrow at fixed z; right, the
+    contact's own F(d) (the traced equilibrium curve where there is one, its unstable parts
+    dashed; else the displacement-controlled branches) with the instrument's states on it."""
+    plt = _pyplot()
+    ins = res.instrument
+    paths = ins["paths"]
+    allF = np.concatenate([p["F_N"] for p in paths.values()])
+    fs, fl = force_unit(allF)
+    alld = np.concatenate([p["d_m"] for p in paths.values()] + [p["z_m"] for p in
+                                                                 paths.values()])
+    ls, ll = length_unit(alld)
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    colors = {"approach": "tab:blue", "retract": "tab:red"}
+    for b, p in paths.items():
+        z, F, kind = p["z_m"], p["F_N"], p["kind"]
+        start = 0
+        for i in range(1, len(z) + 1):     # one line per run between jumps
+            if i == len(z) or kind[i] == "land":
+                ax[0].plot(z[start:i] * ls, F[start:i] * fs, color=colors[b],
+                           label=b if start == 0 else None)
+                start = i
+    for j in ins["jumps"]:
+        if not np.isfinite(j["F_after_N"]):
+            continue
+        ax[0].annotate("", xy=(j["z_m"] * ls, j["F_after_N"] * fs),
+                       xytext=(j["z_m"] * ls, j["F_before_N"] * fs),
+                       arrowprops={"arrowstyle": "->", "color": colors[j["branch"]]})
+    k = ins["spring"]["stiffness_N_per_m"]
+    ax[0].axhline(0, color="0.7", lw=0.8)
+    ax[0].set(xlabel=f"drive z = d + F/k ({ll})", ylabel=f"force the instrument reads ({fl}, "
+              "tension +)", title=f"instrument, k = {k:.3g} N/m")
+    ax[0].legend()
+    eq = res.equilibrium_curve
+    if eq is not None and len(eq["d_m"]):
+        d, F, st = eq["d_m"], eq["F_ex_N"], np.asarray(eq["stable"], bool)
+        ax[1].plot(np.where(st, d, np.nan) * ls, np.where(st, F, np.nan) * fs, color="0.3",
+                   label="contact F_ex(d), stable")
+        ax[1].plot(np.where(~st, d, np.nan) * ls, np.where(~st, F, np.nan) * fs, "--",
+                   color="0.3", label="unstable")
+    else:
+        for b, c in res.branches.items():
+            ax[1].plot(c["d_m"] * ls, c["F_ex_N"] * fs, color="0.3", lw=1,
+                       label="contact F_ex(d), displacement-controlled" if b == "approach"
+                       else None)
+    for b, p in paths.items():
+        pts = np.array([kd == "point" for kd in p["kind"]])
+        ax[1].plot(p["d_m"][pts] * ls, p["F_N"][pts] * fs, ".", ms=3, color=colors[b],
+                   label=f"held by the instrument ({b})")
+    ax[1].axhline(0, color="0.7", lw=0.8)
+    ax[1].set(xlabel=f"separation d ({ll})", ylabel=f"F ({fl})",
+              title="the contact's own curve")
+    ax[1].legend(fontsize=8)
+    fig.tight_layout()
+    _save(fig, path)
+    plt.close(fig)
+    return path
 
 
 def _effect_lines(res):

@@ -231,3 +231,42 @@ def read_fields_state(folder, branch):
             elif w:
                 break
     return d, np.array(w)
+
+
+INSTRUMENT_HEADER = ["branch", "z_m", "d_m", "F_instrument_N", "kind"]
+
+
+def write_instrument(folder, res):
+    """The instrument's outputs of a finished run: ``instrument.csv`` (its approach and
+    retract paths in drive order: z, d, the force it reads, and kind point / fold / land /
+    seam), and two columns appended to ``curve.csv``: ``z_m`` (the drive at which the
+    spring holds that state, d + F/k) and ``F_instrument_N`` (the force the instrument reads
+    there, k (z - d); nan for a state its path does not visit). Both files are replaced
+    atomically."""
+    from .atomic import csv_text, write_atomic
+
+    folder = Path(folder)
+    ins = res.instrument
+    k = ins["spring"]["stiffness_N_per_m"]
+    rows = [INSTRUMENT_HEADER]
+    visited = {}
+    for b, p in ins["paths"].items():
+        for z, d, F, kind in zip(p["z_m"], p["d_m"], p["F_N"], p["kind"]):
+            rows.append([b, _g(z), _g(d), _g(F), kind])
+            if kind == "point":
+                visited[(b, float(d))] = float(F)
+    write_atomic(folder / "instrument.csv", csv_text(rows))
+    path = folder / "curve.csv"
+    with open(path, newline="") as f:
+        table = list(csv.reader(f))
+    if not table or "z_m" in table[0]:
+        return
+    head = table[0]
+    ib, idd, iF = head.index("branch"), head.index("d_m"), head.index("F_ex_N")
+    it = head.index("F_tail_N") if "F_tail_N" in head else None
+    out = [head + ["z_m", "F_instrument_N"]]
+    for r in table[1:]:
+        d = float(r[idd])
+        F = float(r[iF]) + (float(r[it]) if it is not None else 0.0)
+        out.append(r + [_g(d + F / k), _g(visited.get((r[ib], d), math.nan))])
+    write_atomic(path, csv_text(out))

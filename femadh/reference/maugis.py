@@ -138,3 +138,28 @@ def lj_dugdale_lambda(tabor_mu):
     (Johnson & Greenwood 1997)."""
     sigma0_factor = 16.0 / (9.0 * math.sqrt(3.0))
     return 2 * sigma0_factor * (9.0 / (16.0 * math.pi)) ** (1.0 / 3.0) * tabor_mu
+
+
+def jkr_snap_off_with_spring(k_tilde):
+    """JKR pull-off tension recorded by an instrument of stiffness k in series (in units of
+    pi dg R), k_tilde = k delta_unit / (pi dg R) (Maugis units, :func:`maugis_length_units`).
+
+    Along the JKR curve (:func:`jkr_curve`; P the load, compressive positive, D the approach)
+    a spring of stiffness k holds the contact while dP/dD > -k; it snaps off where
+    dP/dD = P'(A)/D'(A) = -k, on the part between the load-controlled pull-off (P' = 0,
+    A^3 = 3/2, tension 3/2) and the displacement-controlled one (D' = 0, A^3 = 1/6, tension
+    5/6). k -> 0 gives 3/2, k -> infinity 5/6.
+    """
+    from scipy import optimize
+
+    def slope_plus_k(A):
+        dP = 3 * A * A - 1.5 * math.sqrt(6 * A)
+        dD = 2 * A - math.sqrt(6 / A) / 3
+        return dP + k_tilde * dD
+    a_lo, a_hi = (1 / 6) ** (1 / 3), 1.5 ** (1 / 3)
+    if k_tilde <= 0:
+        A = a_hi
+    else:
+        A = optimize.brentq(slope_plus_k, a_lo * (1 + 1e-12), a_hi, xtol=1e-14, maxiter=200)
+    P, _ = jkr_curve(A)
+    return float(-P)

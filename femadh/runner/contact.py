@@ -185,6 +185,10 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
             res.timings["solve_s"] = time.perf_counter() - t1
             if res.status == "converged":
                 _finish(scene, res, problem, sink, estimate)
+                if folder is not None and res.instrument is not None:
+                    from ..io.writers import write_instrument
+
+                    write_instrument(folder.path, res)
         except (ConvergenceError, GuardError) as exc:
             res.status, res.error = "failed", str(exc)
         except Interrupted as exc:
@@ -213,6 +217,12 @@ def _finish(scene, res, problem, sink, estimate):
     res.headline = headline(res, problem)
     if estimate:
         half = refine_peak(scene, res, problem, sink)
+        if getattr(scene, "instrument", None) is not None and res.instrument is not None:
+            from .instrument import refine_instrument
+
+            t2 = time.perf_counter()
+            res.instrument["fresh_states"] = refine_instrument(scene, res, problem, sink)
+            res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
             res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
         guard_bounds(res, problem)
@@ -239,6 +249,9 @@ class Sink:
         self.scene = result.scene
         # the state of largest F_ex and its neighbours (the peak search needs them)
         self.peak, self._prev, self._need_next = None, None, False
+        # an instrument's readout solves fresh states between the branch's own
+        self.states, self.jump_states = {}, []
+        self._keep = getattr(self.scene, "instrument", None) is not None
 
     def plan(self, branch, n):
         """A branch of n states begins: which of them keep their surface profile."""
@@ -256,6 +269,8 @@ class Sink:
 
         check_state(self.problem, st, self.scene)
         self._track_peak(branch, st)
+        if self._keep:
+            self.states.setdefault(branch, []).append(st)
         rows = self.rows.setdefault(branch, [])
         if branch in self.profile_picks and len(rows) in self.profile_picks[branch]:
             prof = self.result.profiles.setdefault(
@@ -285,6 +300,8 @@ class Sink:
 
     def jump(self, jump):
         p = self.problem
+        if self._keep:
+            self.jump_states.append((jump.branch, jump.before, jump.after))
         # hysteresis: the energy released by the snap, both states at the landing separation
         # (the closure has no energy: nan)
         released = (math.nan if p.contact_model == "hertz-closure" else

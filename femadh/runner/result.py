@@ -182,7 +182,7 @@ def instrument_summary(res):
     and why a path stops short (``incomplete``); None without an instrument."""
     if res.instrument is None:
         return None
-    from .headline import INSTRUMENT_NUMBERS
+    from .instrument import INSTRUMENT_NUMBERS
 
     out = dict(res.instrument["spring"])
     for name in INSTRUMENT_NUMBERS:
