@@ -51,7 +51,8 @@ def _surface(path, stamp, cutoff, key, file):
 
     topo = read_topography(path, key=key, file=file)
     if cutoff is not None:
-        _check_cutoff(topo, cutoff, path, f"{key} cutoff" if file else "--cutoff", file)
+        # (a scene's key is "<section>.topography": its cutoff is "<section>.topography_cutoff")
+        _check_cutoff(topo, cutoff, path, f"{key}_cutoff" if file else "--cutoff", file)
     name = Path(path).name
     pixel = profile_moments(topo)
     at_cut = None if cutoff is None else profile_moments(topo, cutoff)
