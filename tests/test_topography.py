@@ -282,6 +282,17 @@ def test_cli_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, case):
     assert str(path) in err and not frag.exists()
 
 
+def test_cli_small_map_json_says_its_tail_was_not_judged(tmp_path, capsys):
+    """12 x 12 points leave no mid range for the tail's power law: the JSON says so (no nan)."""
+    path = tmp_path / "small.nc"
+    Topography(np.random.default_rng(0).normal(size=(12, 12)) * 1e-9, (1e-6, 1e-6), unit="m",
+               periodic=False).to_netcdf(str(path))
+    code, out, err = _run(capsys, path, "--json")
+    assert code == 0 and "too few spectrum points" in err
+    assert json.loads(out)["surfaces"][0]["tail"] == {"slope": None, "ratio": None,
+                                                      "verdict": "not judged"}
+
+
 def test_cli_bad_cutoff(surface_file, capsys):
     code, _, err = _run(capsys, surface_file, "--cutoff", "1 nm")     # below 2 pixels
     assert code == 2 and "Nyquist" in err and err.count("\n") == 1

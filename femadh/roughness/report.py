@@ -82,7 +82,10 @@ def _surface(path, stamp, cutoff, key, file):
             "physical_sizes_m": [float(s) for s in topo.physical_sizes],
             "periodic": bool(topo.is_periodic), "pixel": _values(pixel),
             "at_cutoff": None if at_cut is None else _values(at_cut),
-            "tail": {"slope": tail.slope, "ratio": tail.ratio, "verdict": tail.verdict},
+            # (None, not nan, where the tail was not judged: JSON has no nan)
+            "tail": {"slope": tail.slope if math.isfinite(tail.slope) else None,
+                     "ratio": tail.ratio if math.isfinite(tail.ratio) else None,
+                     "verdict": tail.verdict},
             "warnings": warnings}
     return info, pixel, at_cut
 
