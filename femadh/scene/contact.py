@@ -15,6 +15,7 @@ from ..materials import IsotropicMaterial, composite_modulus
 from ..schema import Key, Table
 from .instrument import BEAM, INSTRUMENT, read_instrument
 from .reader import BAD, any_bad
+from .topography import resolve as resolve_topography
 
 METHODS = ("green", "fe")
 #: relative accuracy of the headline numbers an adaptive run meets unless the scene asks
@@ -257,6 +258,7 @@ class Scene:
     accuracy: float | None = None
     grid: dict | None = None
     nodes_explicit: bool = True
+    topography: dict | None = None
     instrument: object = None        # femadh.instrument.Spring, or None (a rigid drive)
     raw: dict = field(repr=False, default_factory=dict)
 
@@ -319,6 +321,8 @@ class Scene:
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
             "instrument": None if self.instrument is None else self.instrument.as_dict(),
             "output_dir": self.output_dir,
+            # (only when used: the ids of scenes without it stay as they were)
+            **({"topography": self.topography} if self.topography else {}),
         }
 
 
@@ -343,7 +347,8 @@ def parse_contact(reader, data, file):
 
     e_star, disk, slider = _read_materials(reader, data)
     layers = _read_layers(reader, data, disk)
-    gap, effects = _read_effects(reader, data.get("effects"), e_star)
+    topography = {}
+    gap, effects = _read_effects(reader, data.get("effects"), e_star, topography)
 
     so = reader.read(SOLVER, data.get("solver"), "solver")
     a = _analysis_radius_m(reader, so, sphere)
@@ -394,7 +399,7 @@ def parse_contact(reader, data, file):
                  layers=layers if layers is not BAD else (), study=study,
                  accuracy=so["accuracy"], grid=so["grid"],
                  nodes_explicit="nodes" in (data.get("solver") or {}),
-                 instrument=instrument,
+                 instrument=instrument, topography=topography or None,
                  raw=copy.deepcopy(data))
 
 
@@ -438,8 +443,9 @@ def _read_layers(reader, data, disk):
     return layers
 
 
-def _read_effects(reader, table, e_star):
-    """The sigma-gap and the laws the [effects.*] tables name (through the law registry)."""
+def _read_effects(reader, table, e_star, topography):
+    """The sigma-gap and the laws the [effects.*] tables name (through the law registry);
+    an asperity section's ``topography`` is resolved into ``topography`` (scene/topography)."""
     if table is None or not isinstance(table, dict) or not table:
         reader.fail("effects", table, "at least one surface force effect, e.g. "
                     "[effects.lennard_jones]")
@@ -469,7 +475,11 @@ def _read_effects(reader, table, e_star):
     for name, entry in reg.items():
         if name not in table:
             continue
-        values = reader.read(entry.table, table[name], f"effects.{name}")
+        raw = resolve_topography(reader, table[name], f"effects.{name}", entry.table,
+                                 topography)
+        if raw is BAD:
+            continue
+        values = reader.read(entry.table, raw, f"effects.{name}")
         if any_bad(values) or e_star is BAD:
             continue
         built = entry.build(values, ctx)
