@@ -283,6 +283,10 @@ DEFECTS = [
       "it, not interpolated", "femadh/instrument/readout.py",
       (("best = (gap, q, a, dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))",
         "best = (gap, q, a, dL, q.F[a])"),)),
+    D("instrument_lands_on_its_branch", "instrument: a landing allowed on another trace of "
+      "the branch it just left", "femadh/instrument/readout.py",
+      (("abs(np.interp(dJ, q.d, q.F) - FJ) <= step_F:", "abs(np.interp(dJ, q.d, q.F) - FJ) "
+        "<= -1.0:"),)),
     D("bridge_factor", "fixed-fixed bridge: 12 E w t^3 / L^3 instead of 16",
       "femadh/instrument/spring.py",
       (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),

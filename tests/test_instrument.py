@@ -85,8 +85,15 @@ def test_a_soft_spring_reads_the_load_controlled_pull_off(mu2):
     assert soft["pull_off_N"] >= largest
     assert soft["pull_off_N"] == pytest.approx(largest, rel=5e-4)
     snaps = []
-    for k in (1e9, 1e5, 1e4, 3e3, 1e3, 1.0):
-        hl = read_instrument(mu2.branches, mu2.jumps, k).headline()
+    # 300 N/m: z turns on the retract's trace of the contact branch 1.5 pm below where the
+    # approach's trace of that branch begins (its landing): that trace is no landing
+    for k in (1e9, 1e5, 1e4, 3e3, 1e3, 300.0, 1.0):
+        ip = read_instrument(mu2.branches, mu2.jumps, k)
+        hl = ip.headline()
+        # one jump each way, as the contact's S-shaped curve has one fold each way
+        assert [j["branch"] for j in ip.jumps] == ["approach", "retract"], k
+        # and lands off the contact branch it left (the free surface: a small tension)
+        assert ip.jumps[1]["F_after_N"] < 0.5 * ip.jumps[1]["F_before_N"], k
         assert hl["pull_off_N"] == pytest.approx(soft["pull_off_N"], rel=5e-4)
         snaps.append(hl["snap_off_N"])
     # the softer the spring, the later it lets go

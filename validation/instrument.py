@@ -79,14 +79,16 @@ def stiffness_sweep():
     stiff = read_instrument(res.branches, res.jumps, 1e9).headline()["snap_off_N"]
     rows = []
     for k in (1e9, 1e5, 3e4, 1e4, 3e3, 1e3, 3e2, 1e2, 10.0, 1.0):
+        res.warnings = []
         hl = instrument_numbers(res, Spring(k))
         kt = k * du / unit
-        ours = (hl["instrument_snap_off_N"] - stiff) / (largest - stiff)
+        snap = hl.get("instrument_snap_off_N")
+        ours = None if snap is None else (snap - stiff) / (largest - stiff)
         jkr = (jkr_snap_off_with_spring(kt) - 5 / 6) / (1.5 - 5 / 6)
-        rows.append((k, kt, hl["instrument_snap_off_N"] / unit,
+        rows.append((k, kt, None if snap is None else snap / unit,
                      hl["instrument_pull_off_N"] / unit, hl.get("instrument_jump_in_d_m"),
                      hl.get("instrument_jump_out_z_m"), hl.get("instrument_hysteresis_J"),
-                     ours, jkr))
+                     ours, jkr, "; ".join(res.warnings)))
     released = sum(j["energy_released_J"] for j in res.jumps)
     return rows, stiff / unit, largest / unit, released
 
@@ -118,12 +120,12 @@ def main(argv=None):
               "toward the largest tension, femadh against JKR with a compliant drive at the "
               "same k_tilde = k delta_unit / (pi dg R).", "",
               "| k (N/m) | k_tilde | snap-off | largest recorded | jump-in d (nm) | "
-              "jump-out z (nm) | hysteresis (J) | fraction | JKR fraction |",
-              "|---|---|---|---|---|---|---|---|---|"]
-    for k, kt, so, po, jin, jout, hy, ours, jkr in rows:
-        f = (lambda x, s=1e9: "-" if x is None else f"{x * s:.4f}")
-        lines.append(f"| {k:.3g} | {kt:.3g} | {so:.4f} | {po:.4f} | {f(jin)} | {f(jout)} | "
-                     f"{'-' if hy is None else f'{hy:.4g}'} | {ours:.3f} | {jkr:.3f} |")
+              "jump-out z (nm) | hysteresis (J) | fraction | JKR fraction | note |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+    for k, kt, so, po, jin, jout, hy, ours, jkr, note in rows:
+        f = (lambda x, s=1e9, fmt=".4f": "-" if x is None else f"{x * s:{fmt}}")
+        lines.append(f"| {k:.3g} | {kt:.3g} | {f(so, 1)} | {po:.4f} | {f(jin)} | {f(jout)} | "
+                     f"{f(hy, 1, '.4g')} | {f(ours, 1, '.3f')} | {jkr:.3f} | {note} |")
     lines += ["", "A soft spring's loop reaches beyond the traced separations (the jump-out "
               "lands ~F/k above the sweep's start): its hysteresis is not reported (a warning "
               "says which [sweep] end to extend)."]

@@ -272,7 +272,8 @@ def _walk(pieces, k, branch, cols):
             raise ValueError(f"the instrument's {branch} path exceeds its budget of "
                              f"{MAX_EVENTS_PER_PIECE} jumps per piece of branch at z = "
                              f"{zJ * 1e9:.6g} nm, d = {dJ * 1e9:.6g} nm")
-        q, a, dL, FL = _landing(pieces, k, zJ, dJ, s, seam=kind == "seam", scale=_spacing(p))
+        q, a, dL, FL = _landing(pieces, k, zJ, dJ, s, seam=kind == "seam", scale=_spacing(p),
+                                origin=(p, FJ))
         if q is None:
             if kind == "seam":
                 break                        # no other trace goes on: the path ends here
@@ -350,13 +351,23 @@ def _turning_point(p, z, i, s):
     return zv, dv, Fv, abs(zv - z[i]), abs(dv - p.d[i]), abs(Fv - p.F[i])
 
 
-def _landing(pieces, k, zJ, dJ, s, *, seam, scale):
+def _landing(pieces, k, zJ, dJ, s, *, seam, scale, origin):
     """The nearest state in direction s from dJ with z = zJ and dz/dd > 0: (piece, segment
     index a, d, F), or (None, ...). A seam (another trace of the same branch, going on where
     this one stopped) is a state within half the local spacing of dJ on either side: the two
     traces' interpolations differ by their interpolation error, not more."""
     best, tol = None, (SEAM_FRACTION if seam else SAME_STATE) * max(scale, 1e-300)
+    p, FJ = origin
+    step_F = float(np.max(np.abs(np.diff(p.F)))) if len(p.F) > 1 else 0.0
     for q in pieces:
+        if q is p and seam:
+            continue                 # a seam goes on along another trace
+        if not seam and q is not p and q.d[0] <= dJ <= q.d[-1] and \
+                abs(np.interp(dJ, q.d, q.F) - FJ) <= step_F:
+            # another trace of the departing branch (it passes through the departing state
+            # within one state's change of force): its linear interpolation across z's turn
+            # would offer a landing on the branch the instrument has just left
+            continue
         z = q.d + q.F / k
         for a in range(len(q.d) - 1):
             dz, dd = z[a + 1] - z[a], q.d[a + 1] - q.d[a]

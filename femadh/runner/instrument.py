@@ -40,6 +40,10 @@ def instrument_numbers(res, spring, branches=None):
     if ip.incomplete:
         res.warnings.append(f"instrument: {ip.incomplete}")
     app = ip.paths.get("approach")
+    if app is not None and len(app["kind"]) > 1 and app["kind"][1] == "fold":
+        res.warnings.append("instrument: the spring is already softer than the contact at the "
+                            f"sweep's start (d = {app['d_m'][0] * 1e9:.4g} nm): it jumps in "
+                            "from farther out; extend [sweep] start")
     if app is not None and not any(j["branch"] == "approach" for j in ip.jumps) \
             and app["F_N"][-1] > 0:
         res.warnings.append("instrument: the drive never presses the contact (its deepest "
