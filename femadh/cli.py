@@ -123,6 +123,9 @@ def _parser():
     rg.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
     from .cli_data import add_parsers   # compare, fit: measured force curves
     add_parsers(sub)
+    from . import cli_topography
+
+    cli_topography.add_parser(sub)
     return p
 
 
@@ -182,6 +185,10 @@ def _dispatch(args):
         return _regime(args)
     if args.command == "render":
         return _render(args)
+    if args.command == "topography":
+        from . import cli_topography
+
+        return cli_topography.main(args)
     from .scene import load_scene
     from .scene.resources import check_resources
 

@@ -81,6 +81,22 @@ class InstrumentPath:
         separations), or None."""
         return next((p["incomplete"] for p in self.paths.values() if p["incomplete"]), None)
 
+    def brackets(self):
+        """The intervals between computed states (branch, d_lo, d_hi) where the readout
+        interpolates a headline number: z's turning points, the landings, and the largest
+        tension of the retract path. Fresh states there sharpen it
+        (:func:`femadh.runner.instrument.refine_instrument`)."""
+        out = [b for j in self.jumps for b in j.get("brackets", ())]
+        ret = self.paths.get("retract")
+        if ret is not None and len(ret["F_N"]) > 2:
+            i = int(np.argmax(ret["F_N"]))
+            nb = [m for m in (i - 1, i, i + 1) if 0 <= m < len(ret["F_N"])
+                  and ret["kind"][m] == "point" and ret["branch_of"][m] == ret["branch_of"][i]]
+            if len(nb) > 1 and ret["kind"][i] == "point":
+                ds = ret["d_m"][nb]
+                out.append((ret["branch_of"][i], float(ds.min()), float(ds.max())))
+        return out
+
     def headline(self):
         """The numbers the instrument records (SI), and their readout resolution as
         ``<name>_resolution``: pull_off_N (the largest tension of the retract path),
@@ -114,11 +130,14 @@ class InstrumentPath:
                 value, res = outs[-1]["F_before_N"], outs[-1]["resolution_F_N"]
             out.update(pull_off_N=float(value), pull_off_N_resolution=float(abs(res)))
         if "approach" in self.paths and "retract" in self.paths and not self.incomplete:
-            w, w_half = (sum(_loop_integral(self.paths[b], step) for b in ("approach",
-                                                                             "retract"))
-                         for step in (1, 2))
-            # trapezoid in z, second order: Richardson's difference to every other state
-            out.update(hysteresis_J=float(w), hysteresis_J_resolution=abs(w - w_half) / 3.0)
+            parts = {b: (_loop_integral(self.paths[b], 1), _loop_integral(self.paths[b], 2))
+                     for b in ("approach", "retract")}
+            w = sum(v[0] for v in parts.values())
+            # trapezoid in z, second order: Richardson's difference to every other state, per
+            # path in magnitude (the two paths' errors need not cancel where their states
+            # differ, e.g. fresh states on one of them)
+            out.update(hysteresis_J=float(w), hysteresis_J_resolution=sum(
+                abs(a - h) for a, h in parts.values()) / 3.0)
         return out
 
 
@@ -223,13 +242,13 @@ def _walk(pieces, k, branch, cols):
     i = int(np.flatnonzero(p.d == d0)[0 if s > 0 else -1])
     F0 = float(p.F[i])
     z_of = lambda q: q.d + q.F / k                               # noqa: E731
-    rows, jumps, incomplete = [(d0 + F0 / k, d0, F0, "point")], [], None
+    rows, jumps, incomplete = [(d0 + F0 / k, d0, F0, "point", p.branch)], [], None
     budget = MAX_EVENTS_PER_PIECE * len(pieces) + 4
     while True:
         z = z_of(p)
         nxt = i + s
         while 0 <= nxt < len(p.d) and s * (z[nxt] - z[i]) > 0 and s * (p.d[nxt] - p.d[i]) > 0:
-            rows.append((z[nxt], p.d[nxt], p.F[nxt], "point"))
+            rows.append((z[nxt], p.d[nxt], p.F[nxt], "point", p.branch))
             i, nxt = nxt, nxt + s
         at_end = not 0 <= nxt < len(p.d)
         if at_end and not (p.fold_hi if s > 0 else p.fold_lo):
@@ -242,9 +261,12 @@ def _walk(pieces, k, branch, cols):
             zJ, dJ, FJ = z[i], p.d[i], p.F[i]
             j0 = i - s if 0 <= i - s < len(p.d) else i
             rz, rd, rF = abs(z[i] - z[j0]), abs(p.d[i] - p.d[j0]), abs(p.F[i] - p.F[j0])
+            turn = (p.branch, *sorted((p.d[j0], p.d[i])))
         else:
             kind = "fold"                    # z turns between states i and nxt
             zJ, dJ, FJ, rz, rd, rF = _turning_point(p, z, i, s)
+            lo, hi = max(min(i, nxt) - 1, 0), min(max(i, nxt) + 1, len(p.d) - 1)
+            turn = (p.branch, p.d[lo], p.d[hi])
         budget -= 1
         if budget < 0:
             raise ValueError(f"the instrument's {branch} path exceeds its budget of "
@@ -255,8 +277,9 @@ def _walk(pieces, k, branch, cols):
             if kind == "seam":
                 break                        # no other trace goes on: the path ends here
             # the jump is read; where it lands lies beyond the traced separations
-            rows.append((zJ, dJ, FJ, "fold"))
+            rows.append((zJ, dJ, FJ, "fold", p.branch))
             jumps.append(_jump(branch, zJ, dJ, math.nan, FJ, math.nan, rz, rd, rF, 0.0))
+            jumps[-1]["brackets"] = [turn]
             end = "start" if s > 0 else "stop"
             incomplete = (f"the instrument's {branch} jump at z = {zJ * 1e9:.6g} nm (d = "
                           f"{dJ * 1e9:.6g} nm, F = {FJ:.4g} N) lands beyond the traced "
@@ -266,18 +289,19 @@ def _walk(pieces, k, branch, cols):
         if kind == "fold":
             # the landing's interpolation error: the line against the parabola through the
             # landing segment and its neighbour
-            rows.append((zJ, dJ, FJ, "fold"))
-            rows.append((zJ, dL, FL, "land"))
+            rows.append((zJ, dJ, FJ, "fold", p.branch))
+            rows.append((zJ, dL, FL, "land", q.branch))
             jumps.append(_jump(branch, zJ, dJ, dL, FJ, FL, rz, rd, rF,
                                _landing_error(q, a, dL)))
+            jumps[-1]["brackets"] = [turn, (q.branch, q.d[a], q.d[a + 1])]
         else:
-            rows.append((zJ, dL, FL, "seam"))
+            rows.append((zJ, dL, FL, "seam", q.branch))
         # go on from the landing, on segment [a, a+1] of piece q, toward the drive's direction
         p, i = q, (a + 1 if s > 0 else a)
-        rows.append((p.d[i] + p.F[i] / k, p.d[i], p.F[i], "point"))
-    z, d, F, kinds = zip(*rows)
+        rows.append((p.d[i] + p.F[i] / k, p.d[i], p.F[i], "point", p.branch))
+    z, d, F, kinds, of = zip(*rows)
     return {"z_m": np.array(z), "d_m": np.array(d), "F_N": np.array(F),
-            "kind": list(kinds), "incomplete": incomplete}, jumps
+            "kind": list(kinds), "branch_of": list(of), "incomplete": incomplete}, jumps
 
 
 def _jump(branch, z, d_fold, d_land, F_before, F_after, rz, rd, rF, r_land):

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import math
 
 from ..schema import Key, Table
+from .gw import TOPOGRAPHY_KEYS
 from .step import SmoothStepLaw
 
 
@@ -75,7 +76,7 @@ def _registration():
             default="contact-set", choices=("contact-set", "smoothed")),
         Key("smoothing", "number", "Step width as a fraction of sigma (model = 'smoothed').",
             default=0.02, lo=0.0, hi=0.2, hi_closed=True),
-    ))
+    ) + TOPOGRAPHY_KEYS)
     return Registration(table, _build, (Output("asperity_adhesion", "F_LJa_N", "P_LJa_Pa", 1.0,
                                                "asperity adhesion (eq 20)"),))
 

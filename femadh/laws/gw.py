@@ -139,6 +139,30 @@ def _build(values, ctx):
     return Built(laws)
 
 
+def _topography_files(reader, raw, path):
+    """``topography``: one file, or [slider, disk] for paper 1's composite (Table 2)."""
+    files = [raw] if isinstance(raw, str) else raw
+    if (not isinstance(files, list) or not 1 <= len(files) <= 2
+            or not all(isinstance(f, str) and f for f in files)):
+        return reader.fail(path, raw, "a topography file name, or a list of two (slider, "
+                           "disk) for the composite")
+    return tuple(files)
+
+
+#: the keys by which an asperity section takes its summit numbers from measured surfaces
+#: (femadh.scene.topography resolves them)
+TOPOGRAPHY_KEYS = (
+    Key("topography", "custom", "A measured surface (path relative to the scene file; needs "
+        "the 'data' extra), or [slider, disk] for paper 1's Table 2 composite, whose McCool "
+        "statistics replace the summit numbers (femadh topography FILE shows them).",
+        default=None, parse=lambda r, raw, path: None if raw is None else
+        _topography_files(r, raw, path),
+        expect="a topography file name, or a list of two (slider, disk)"),
+    Key("topography_cutoff", "length", "Short-wavelength cutoff of the topography's "
+        "spectral moments (default: the pixel scale).", default=None, lo=0.0),
+)
+
+
 def _registration():
     from .registration import Output, Registration
 
@@ -153,7 +177,7 @@ def _registration():
         Key("density", "areal_density", "Summit density rho.", lo=0.0),
         Key("surface_energy", "surface_energy", "Surface energy of a summit contact (eq 24); "
             "0 for no asperity adhesion.", default=0.0, lo=0.0, lo_closed=True),
-    ))
+    ) + TOPOGRAPHY_KEYS)
     return Registration(table, _build, (
         Output("asperity_elastic", "F_ela_N", "P_ela_Pa", -1.0, "asperity elasticity (eq 23)"),
         Output("asperity_adhesion", "F_LJa_N", "P_LJa_Pa", 1.0, "asperity adhesion (eq 24)")))

@@ -217,6 +217,12 @@ def _finish(scene, res, problem, sink, estimate):
     res.headline = headline(res, problem)
     if estimate:
         half = refine_peak(scene, res, problem, sink)
+        if getattr(scene, "instrument", None) is not None and res.instrument is not None:
+            from .instrument import refine_instrument
+
+            t2 = time.perf_counter()
+            res.instrument["fresh_states"] = refine_instrument(scene, res, problem, sink)
+            res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
             res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
         guard_bounds(res, problem)
@@ -243,6 +249,9 @@ class Sink:
         self.scene = result.scene
         # the state of largest F_ex and its neighbours (the peak search needs them)
         self.peak, self._prev, self._need_next = None, None, False
+        # an instrument's readout solves fresh states between the branch's own
+        self.states, self.jump_states = {}, []
+        self._keep = getattr(self.scene, "instrument", None) is not None
 
     def plan(self, branch, n):
         """A branch of n states begins: which of them keep their surface profile."""
@@ -260,6 +269,8 @@ class Sink:
 
         check_state(self.problem, st, self.scene)
         self._track_peak(branch, st)
+        if self._keep:
+            self.states.setdefault(branch, []).append(st)
         rows = self.rows.setdefault(branch, [])
         if branch in self.profile_picks and len(rows) in self.profile_picks[branch]:
             prof = self.result.profiles.setdefault(
@@ -289,6 +300,8 @@ class Sink:
 
     def jump(self, jump):
         p = self.problem
+        if self._keep:
+            self.jump_states.append((jump.branch, jump.before, jump.after))
         # hysteresis: the energy released by the snap, both states at the landing separation
         # (the closure has no energy: nan)
         released = (math.nan if p.contact_model == "hertz-closure" else
@@ -437,12 +450,16 @@ def _trace_arclength(scene, problem, sink):
     equilibrium_curve.csv), then its displacement-controlled paths as branches."""
     from ..contact.arclength import trace_curve
 
+    make_state = _curve_state
+    if problem.sigma is not None:     # the sigma-gap's piecewise curve (its own states)
+        from ..contact.sigma_arclength import curve_state as make_state
+        from ..contact.sigma_arclength import trace_sigma_curve as trace_curve
     d = scene.d_values
     step = abs(d[1] - d[0])
     curve_rows = []
 
     def on_point(i, point):
-        st = _curve_state(problem, point.d, point.w, point.stable)
+        st = make_state(problem, point.d, point.w, point.stable)
         curve_rows.append((i, point, st))
         if sink.writer:
             sink.writer.write_curve_point(i, point, st)
@@ -458,11 +475,13 @@ def _trace_arclength(scene, problem, sink):
             "stable": np.array([p.stable for _, p, _ in curve_rows], bool),
             "dd_ds": np.array([p.t_d for _, p, _ in curve_rows])}
     for branch in scene.directions:
-        path = curve.branch(branch)
+        # a sigma-gap event state is on the curve twice (end and start of two pieces of the
+        # active set, at one d): it is one state of the path
+        path = _once(curve.branch(branch))
         sink.plan(branch, sum(kind != "fold" for kind, _, _ in path))
         before = None
         for kind, dk, wk in path:
-            st = _curve_state(problem, dk, wk, True)
+            st = make_state(problem, dk, wk, True)
             if kind == "fold":
                 before = st
                 continue        # the fold state is the jump's 'before', not a grid state
@@ -470,3 +489,14 @@ def _trace_arclength(scene, problem, sink):
             if kind == "land":
                 sink.jump(Jump(branch, dk, dk, 0.0, before, st))
     sink.close()
+
+
+def _once(path):
+    """A path without repeated consecutive points at the same d and w (a sigma-gap event)."""
+    out = []
+    for e in path:
+        if out and e[0] == out[-1][0] == "point" and e[1] == out[-1][1] \
+                and np.array_equal(e[2], out[-1][2]):
+            continue
+        out.append(e)
+    return out

@@ -110,35 +110,43 @@ def tolerance_force(problem, state, tol):
     return float(problem.areas @ np.abs(problem.dpressure(state.h)) * tol)
 
 
+def state_between(problem, a, b, d, scene):
+    """A fresh equilibrium at separation d between two states a and b of one branch, solved
+    from the displacements interpolated between them, or None unless it converged, is stable
+    and stayed on that branch (every gap within a quarter of the interpolation's)."""
+    from ..contact import solve_state
+
+    t = (d - a.d) / (b.d - a.d)
+    w0, near = (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
+    kw = {}
+    if problem.contact_model == "hertz-closure":
+        kw["r_c0"] = near.r_c or None
+    elif problem.sigma is not None:
+        kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
+    st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
+    h_pred = problem.contour(d) - w0
+    if not (st.converged and st.stable) or np.any(
+            np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+        return None
+    return st
+
+
 def peak_adhesion(problem, prev, best, nxt, scene):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). Returns (F, d, half-width of
     the final d bracket)."""
-    from ..contact import solve_state
     from ..contact.forces import state_forces
 
     f_best = state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
     found = {}
 
-    def interp(d):
-        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
-        t = (d - a.d) / (b.d - a.d)
-        return (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
-
     def neg(d):
-        w0, near = interp(d)
-        kw = {}
-        if problem.contact_model == "hertz-closure":
-            kw["r_c0"] = near.r_c or None
-        elif problem.sigma is not None:
-            kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
-        st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
-        h_pred = problem.contour(d) - w0
-        if not (st.converged and st.stable) or np.any(
-                np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
+        st = state_between(problem, a, b, d, scene)
+        if st is None:
             return -f_best
         found[d] = state_forces(problem, st)[2]
         return -found[d]

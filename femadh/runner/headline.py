@@ -63,6 +63,8 @@ def headline(res, problem):
         out["hysteresis_J"] = float(sum(released))
     spring = getattr(res.scene, "instrument", None)
     if spring is not None and res.branches:
+        from .instrument import instrument_numbers
+
         out.update(instrument_numbers(res, spring))
     if problem is not None:
         W = work_of_adhesion(problem)
@@ -72,36 +74,3 @@ def headline(res, problem):
         out["jkr_pull_off_N"] = jkr_pull_off(R, W)
     return out
 
-
-#: the instrument's headline numbers (summary.json "instrument" drops the prefix)
-INSTRUMENT_NUMBERS = ("pull_off_N", "snap_off_N", "jump_in_d_m", "jump_in_z_m",
-                      "jump_out_d_m", "jump_out_z_m", "hysteresis_J")
-
-
-def instrument_numbers(res, spring):
-    """The instrument's headline numbers, ``instrument_<name>`` (see
-    :meth:`femadh.instrument.InstrumentPath.headline`); its paths, jumps and readout
-    resolutions go to ``res.instrument``. What the instrument cannot read (a jump landing
-    beyond the traced separations, a drive that never presses the contact) is a warning."""
-    from ..instrument import read_instrument
-
-    directions = tuple(b for b in ("approach", "retract") if b in res.branches)
-    try:
-        ip = read_instrument(res.branches, res.jumps, spring.stiffness, directions)
-    except ValueError as exc:
-        res.warnings.append(f"instrument: {exc}")
-        return {}
-    hl = ip.headline()
-    res.instrument = {"spring": spring.as_dict(), "paths": ip.paths, "jumps": ip.jumps,
-                      "resolution": {k[:-len("_resolution")]: v for k, v in hl.items()
-                                     if k.endswith("_resolution")},
-                      "incomplete": ip.incomplete}
-    if ip.incomplete:
-        res.warnings.append(f"instrument: {ip.incomplete}")
-    app = ip.paths.get("approach")
-    if app is not None and not any(j["branch"] == "approach" for j in ip.jumps) \
-            and app["F_N"][-1] > 0:
-        res.warnings.append("instrument: the drive never presses the contact (its deepest "
-                            f"state is still in tension, F = {app['F_N'][-1]:.4g} N): extend "
-                            "[sweep] stop")
-    return {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}

@@ -15,6 +15,7 @@ from ..materials import IsotropicMaterial, composite_modulus
 from ..schema import Key, Table
 from .instrument import BEAM, INSTRUMENT, read_instrument
 from .reader import BAD, any_bad
+from .topography import resolve as resolve_topography
 
 METHODS = ("green", "fe")
 #: relative accuracy of the headline numbers an adaptive run meets unless the scene asks
@@ -120,7 +121,8 @@ SOLVER = Table("solver", "Discretisation and solver.", (
     Key("max_iter", "integer", "Newton iterations per solve.", default=40, lo=1,
         lo_closed=True, hi=10000, hi_closed=True),
     Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
-        "laws only).", default="steps", choices=("steps", "arclength")),
+        "laws and the complementarity sigma-gap).", default="steps",
+        choices=("steps", "arclength")),
     Key("accuracy", "number", "Relative accuracy asked of the headline numbers (largest "
         "adhesion, forces at the deepest separation): femadh refines the grid and the "
         "analysis radius until its error estimate meets it, or says it cannot. Default "
@@ -256,6 +258,7 @@ class Scene:
     accuracy: float | None = None
     grid: dict | None = None
     nodes_explicit: bool = True
+    topography: dict | None = None
     instrument: object = None        # femadh.instrument.Spring, or None (a rigid drive)
     raw: dict = field(repr=False, default_factory=dict)
 
@@ -318,6 +321,8 @@ class Scene:
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
             "instrument": None if self.instrument is None else self.instrument.as_dict(),
             "output_dir": self.output_dir,
+            # (only when used: the ids of scenes without it stay as they were)
+            **({"topography": self.topography} if self.topography else {}),
         }
 
 
@@ -342,7 +347,8 @@ def parse_contact(reader, data, file):
 
     e_star, disk, slider = _read_materials(reader, data)
     layers = _read_layers(reader, data, disk)
-    gap, effects = _read_effects(reader, data.get("effects"), e_star)
+    topography = {}
+    gap, effects = _read_effects(reader, data.get("effects"), e_star, topography)
 
     so = reader.read(SOLVER, data.get("solver"), "solver")
     a = _analysis_radius_m(reader, so, sphere)
@@ -393,7 +399,7 @@ def parse_contact(reader, data, file):
                  layers=layers if layers is not BAD else (), study=study,
                  accuracy=so["accuracy"], grid=so["grid"],
                  nodes_explicit="nodes" in (data.get("solver") or {}),
-                 instrument=instrument,
+                 instrument=instrument, topography=topography or None,
                  raw=copy.deepcopy(data))
 
 
@@ -437,8 +443,9 @@ def _read_layers(reader, data, disk):
     return layers
 
 
-def _read_effects(reader, table, e_star):
-    """The sigma-gap and the laws the [effects.*] tables name (through the law registry)."""
+def _read_effects(reader, table, e_star, topography):
+    """The sigma-gap and the laws the [effects.*] tables name (through the law registry);
+    an asperity section's ``topography`` is resolved into ``topography`` (scene/topography)."""
     if table is None or not isinstance(table, dict) or not table:
         reader.fail("effects", table, "at least one surface force effect, e.g. "
                     "[effects.lennard_jones]")
@@ -468,7 +475,11 @@ def _read_effects(reader, table, e_star):
     for name, entry in reg.items():
         if name not in table:
             continue
-        values = reader.read(entry.table, table[name], f"effects.{name}")
+        raw = resolve_topography(reader, table[name], f"effects.{name}", entry.table,
+                                 topography)
+        if raw is BAD:
+            continue
+        values = reader.read(entry.table, raw, f"effects.{name}")
         if any_bad(values) or e_star is BAD:
             continue
         built = entry.build(values, ctx)
@@ -558,10 +569,17 @@ def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
             reader.fail("solver.grid.spacing", raw_grid.get("spacing"), "a spacing at most "
                         "the band's radius")
     if so["continuation"] == "arclength":
-        if gap is not None:
+        if gap is not None and gap.contact_model != "complementarity":
+            reader.fail("solver.continuation", "arclength", "'steps' with the "
+                        "hertz-closure sigma-gap: arclength continuation traces smooth laws "
+                        "and the complementarity sigma-gap only (the closure's contact "
+                        "radius is not traced through folds)")
+        elif gap is not None and gap.adhesion:
             reader.fail("solver.continuation", "arclength", "'steps' with "
-                        "[effects.asperity_gap]: arclength continuation traces smooth laws "
-                        "only (the hard sigma-gap is not smooth)")
+                        "[effects.asperity_adhesion] on the contact set: its range-less "
+                        "adhesion holds a node that reached sigma until its pressure falls to "
+                        "-P_LJa, so approach and retract part at every node and the "
+                        "equilibria are no single curve (model = 'smoothed' can be traced)")
         if not any_bad(sw) and "approach" not in sw["directions"]:
             reader.fail("sweep.directions", list(sw["directions"]), "a list with 'approach' "
                         "for [solver] continuation = 'arclength' (the curve is traced from "

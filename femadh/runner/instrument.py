@@ -1,0 +1,122 @@
+"""The instrument's numbers of a run: read off the computed states
+(:mod:`femadh.instrument.readout`), then sharpened by fresh states where the readout
+interpolates (z's turning points, the landings, the largest tension)."""
+import numpy as np
+
+#: rounds of fresh states in each interval the readout interpolates in
+REFINE_ROUNDS = 3
+#: fresh states per interval and round (the interval shrinks ~8x per round)
+REFINE_STATES = 7
+#: intervals narrower than this fraction of the sweep step are not refined further (the
+#: displacement-controlled folds are located to the same 2^-10)
+REFINE_MIN_FRACTION = 2.0**-10
+
+
+#: the instrument's headline numbers (summary.json "instrument" drops the prefix)
+INSTRUMENT_NUMBERS = ("pull_off_N", "snap_off_N", "jump_in_d_m", "jump_in_z_m",
+                      "jump_out_d_m", "jump_out_z_m", "hysteresis_J")
+
+
+def instrument_numbers(res, spring, branches=None):
+    """The instrument's headline numbers, ``instrument_<name>`` (see
+    :meth:`femadh.instrument.InstrumentPath.headline`); its paths, jumps and readout
+    resolutions go to ``res.instrument``. ``branches``: the branches with fresh states added
+    (:func:`refine_instrument`); default the run's. What the instrument cannot read (a jump landing
+    beyond the traced separations, a drive that never presses the contact) is a warning."""
+    from ..instrument import read_instrument
+
+    directions = tuple(b for b in ("approach", "retract") if b in res.branches)
+    try:
+        ip = read_instrument(branches or res.branches, res.jumps, spring.stiffness,
+                             directions)
+    except ValueError as exc:
+        res.warnings.append(f"instrument: {exc}")
+        return {}
+    hl = ip.headline()
+    res.instrument = {"spring": spring.as_dict(), "paths": ip.paths, "jumps": ip.jumps,
+                      "resolution": {k[:-len("_resolution")]: v for k, v in hl.items()
+                                     if k.endswith("_resolution")},
+                      "incomplete": ip.incomplete}
+    if ip.incomplete:
+        res.warnings.append(f"instrument: {ip.incomplete}")
+    app = ip.paths.get("approach")
+    if app is not None and not any(j["branch"] == "approach" for j in ip.jumps) \
+            and app["F_N"][-1] > 0:
+        res.warnings.append("instrument: the drive never presses the contact (its deepest "
+                            f"state is still in tension, F = {app['F_N'][-1]:.4g} N): extend "
+                            "[sweep] stop")
+    out = {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
+    if spring.rest_gap is not None:
+        # the MEMS verdict: stuck iff the instrument still holds the contact when its base is
+        # back at the rest gap (no jump-out: it peels off continuously, never stuck)
+        z_out = hl.get("jump_out_z_m")
+        out["instrument_stuck"] = float(z_out is not None and z_out > spring.rest_gap)
+        if z_out is not None:
+            out["instrument_release_margin_m"] = float(z_out - spring.rest_gap)
+    return out
+
+
+def refine_instrument(scene, res, problem, sink):
+    """Sharpen the instrument's numbers: in every interval where the readout interpolates
+    (:meth:`~femadh.instrument.InstrumentPath.brackets`), solve fresh states between the two
+    computed ones (:func:`femadh.runner.estimates.state_between`), read again; up to
+    REFINE_ROUNDS rounds. The fresh states feed the readout only (curve.csv keeps the sweep's
+    states). Updates ``res.headline`` and ``res.instrument``; returns the fresh states'
+    count."""
+    from ..contact.forces import state_forces, tail_force
+    from .estimates import state_between
+
+    spring = scene.instrument
+    pool = {b: list(v) for b, v in sink.states.items()}
+    for branch, before, after in sink.jump_states:
+        pool.setdefault(branch, []).extend([before, after])
+    rows = {b: {k: list(c[k]) for k in ("d_m", "F_ex_N", "F_tail_N")}
+            for b, c in res.branches.items()}
+    step = abs(scene.d_values[1] - scene.d_values[0]) if len(scene.d_values) > 1 else 0.0
+    done, fresh = set(), 0
+
+    def arrays():
+        out = {}
+        for b, c in rows.items():
+            order = np.argsort(c["d_m"])
+            if b == "approach":
+                order = order[::-1]
+            out[b] = {k: np.asarray(v, float)[order] for k, v in c.items()}
+        return out
+
+    def at(branch, d):
+        return next((st for st in pool.get(branch, ()) if st.d == d), None)
+
+    for _ in range(REFINE_ROUNDS):
+        from ..instrument import read_instrument
+        try:
+            ip = read_instrument(arrays(), res.jumps, spring.stiffness,
+                                 tuple(b for b in ("approach", "retract") if b in rows))
+        except ValueError:
+            break
+        added = 0
+        for branch, lo, hi in ip.brackets():
+            if (branch, lo, hi) in done or hi - lo <= REFINE_MIN_FRACTION * step:
+                continue
+            done.add((branch, lo, hi))
+            a, b = at(branch, lo), at(branch, hi)
+            if a is None or b is None:
+                continue
+            for d in np.linspace(lo, hi, REFINE_STATES + 2)[1:-1]:
+                st = state_between(problem, a, b, float(d), scene)
+                if st is None:
+                    continue
+                pool[branch].append(st)
+                rows[branch]["d_m"].append(st.d)
+                rows[branch]["F_ex_N"].append(state_forces(problem, st)[2])
+                rows[branch]["F_tail_N"].append(tail_force(problem, st.d))
+                added += 1
+        fresh += added
+        if not added:
+            break
+    if fresh:
+        warnings = list(res.warnings)
+        res.headline.update(instrument_numbers(res, spring, arrays()))
+        # the readout's warnings of the first reading stand (the same drive, same range)
+        res.warnings[:] = warnings
+    return fresh
