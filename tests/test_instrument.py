@@ -92,8 +92,9 @@ def test_a_soft_spring_reads_the_load_controlled_pull_off(mu2):
         hl = ip.headline()
         # one jump each way, as the contact's S-shaped curve has one fold each way
         assert [j["branch"] for j in ip.jumps] == ["approach", "retract"], k
-        # and lands off the contact branch it left (the free surface: a small tension)
-        assert ip.jumps[1]["F_after_N"] < 0.5 * ip.jumps[1]["F_before_N"], k
+        # and lands off the contact branch it left (the free surface: a small tension; nan
+        # where the landing lies beyond the sweep's start, k = 1 N/m)
+        assert not ip.jumps[1]["F_after_N"] >= 0.5 * ip.jumps[1]["F_before_N"], k
         assert hl["pull_off_N"] == pytest.approx(soft["pull_off_N"], rel=5e-4)
         snaps.append(hl["snap_off_N"])
     # the softer the spring, the later it lets go
