@@ -121,6 +121,8 @@ def _parser():
     rg.add_argument("--z0", default="0.165 nm", help="LJ equilibrium distance (default "
                                                      "'0.165 nm')")
     rg.add_argument("--out", default="out/regime", help="output folder (default out/regime)")
+    from .cli_data import add_parsers   # compare, fit: measured force curves
+    add_parsers(sub)
     from . import cli_topography
 
     cli_topography.add_parser(sub)
@@ -171,6 +173,9 @@ def main(argv=None):
 
 
 def _dispatch(args):
+    if args.command in ("compare", "fit"):
+        from .cli_data import dispatch
+        return dispatch(args)
     if args.command == "keys":
         from .scene import reference_page
 

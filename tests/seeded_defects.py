@@ -288,6 +288,29 @@ DEFECTS = [
       (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),
     D("jkr_spring_sign", "JKR with a spring: instability at dP/dD = +k",
       "femadh/reference/maugis.py", (("return dP + k_tilde * dD", "return dP - k_tilde * dD"),)),
+    # -- sigma-gap continuation
+    D("sigma_arc_orientation", "sigma-gap arclength: a new contact node's piece followed "
+      "against the complementarity (its pressure falling)", "femadh/contact/sigma_arclength.py",
+      (("        if grow < 0:\n            t2 = -t2", "        if grow > 0:\n            t2 = -t2"),)),
+    D("sigma_arc_jacobian_d", "sigma-gap arclength: dF/dd of the free nodes with +P' for -P'",
+      "femadh/contact/sigma_arclength.py",
+      (("J[:, -1] = self._KIA1 - D", "J[:, -1] = self._KIA1 + D"),)),
+    D("sigma_arc_multiplier", "sigma-gap arclength: contact pressure without the LJ pressure "
+      "at sigma (lambda = P_LJa - (K w)_j)", "femadh/contact/sigma_arclength.py",
+      (("self.lam0 = float(problem.pressure(np.array([self.sigma]))[0]) + adh",
+        "self.lam0 = adh"),)),
+    # -- force curves and fits
+    D("fc_afm_sign", "measured-curve model: F_AFM = +F_ex (the AFM sign not reversed)",
+      "femadh/fitting/model.py",
+      (('x, f = np.asarray(cols["d_m"], float), -np.asarray(cols["F_ex_N"], float)',
+        'x, f = np.asarray(cols["d_m"], float), np.asarray(cols["F_ex_N"], float)'),)),
+    D("fit_stderr_no_s2", "fit: covariance (J^T J)^-1 without s^2 = RSS/(n - p)",
+      "femadh/fitting/lsq.py",
+      (("cov_n = s2 * np.linalg.inv(A)", "cov_n = np.linalg.inv(A)"),)),
+    D("fit_offset_frozen", "fit: the contact-point offset not fitted (the residual keeps the "
+      "starting offset)", "femadh/fitting/lsq.py",
+      (("r = sim.force_at(curve.z, curve.branch, x[q] * OFFSET_SCALE) - curve.force",
+        "r = sim.force_at(curve.z, curve.branch, x0[q] * OFFSET_SCALE) - curve.force"),)),
     # -- topography statistics
     D("topo_mccool_radius", "McCool summit radius from the sum of the principal curvatures "
       "(0.375 -> 0.1875)", "femadh/roughness/moments.py",
@@ -298,7 +321,8 @@ DEFECTS = [
     D("topo_composite_zm", "Table 2 composite: z_m in quadrature instead of summed",
       "femadh/roughness/composite.py",
       (("z_m=s1.z_m + s2.z_m,", "z_m=math.hypot(s1.z_m, s2.z_m),"),)),
-    D("topo_cutoff_sharp", "cutoff moments: a sharp |q| <= q_c mask, no lattice-cell weight",
+    D("topo_cutoff_sharp", "cutoff moments: a sharp abs(q) <= q_c mask, no lattice-cell "
+      "weight",
       "femadh/roughness/moments.py",
       (("return np.clip((q_c - np.abs(q)) / dq + 0.5, 0.0, 1.0)",
         "return (np.abs(q) <= q_c).astype(float)"),)),

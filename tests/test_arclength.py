@@ -147,7 +147,9 @@ def test_scene_with_arclength_continuation_matches_stepping(tmp_path):
         len(c["d_m"]) for c in ra.branches.values())
 
 
-def test_arclength_with_sigma_gap_is_a_scene_error(tmp_path):
+def test_arclength_with_the_hertz_closure_is_a_scene_error(tmp_path):
+    """The complementarity sigma-gap is traced (tests/test_sigma_continuation.py); the
+    paper's Hertz closure is not."""
     from pathlib import Path
 
     import femadh
@@ -155,6 +157,7 @@ def test_arclength_with_sigma_gap_is_a_scene_error(tmp_path):
 
     fig3 = (Path(__file__).resolve().parents[1] / "validation/scenes/paper1_fig3.toml")
     text = fig3.read_text().replace('[solver]\n', '[solver]\ncontinuation = "arclength"\n', 1)
+    text = text.replace('contact_model = "complementarity"', 'contact_model = "hertz-closure"')
     p = tmp_path / "s.toml"
     p.write_text(text)
     with pytest.raises(SceneError) as e:

@@ -248,3 +248,28 @@ def test_a_stepped_sigma_gap_run_is_read_and_sharpened():
         i = p["kind"].index("fold")
         slope = (p["F_N"][i] - p["F_N"][i - 1]) / (p["d_m"][i] - p["d_m"][i - 1])
         assert slope == pytest.approx(-k, rel=0.01), b
+
+
+def test_mems_verdict_across_the_rest_gap(tmp_path, mu2):
+    """The verdict follows the instrument's jump-out: a part stuck to the flat frees itself
+    iff its suspension's base, back at the rest gap, lies beyond the jump-out z. A study over
+    the rest gap on both sides of it (k = 3000 N/m: jump-out z = 0.80 nm) records stuck and
+    free, and its figure marks them."""
+    from femadh.instrument import Spring
+    from femadh.runner.instrument import instrument_numbers
+    from femadh.studies.sweep import run_study
+
+    z_out = instrument_numbers(mu2, Spring(3000.0))["instrument_jump_out_z_m"]
+    for gap, stuck in ((0.9 * z_out, 1.0), (1.1 * z_out, 0.0)):
+        hl = instrument_numbers(mu2, Spring(3000.0, rest_gap=gap))
+        assert hl["instrument_stuck"] == stuck
+        assert hl["instrument_release_margin_m"] == pytest.approx(z_out - gap, rel=1e-12)
+    text = open(MU2).read().replace("[output]", '[instrument]\nstiffness = "3000 N/m"\n'
+                                    'rest_gap = "1 nm"\n\n[output]')
+    sc = scene_from_text(text)
+    vary = {"instrument.rest_gap": "0.6 nm,1.2 nm"}
+    _, rec = run_study(sc, vary, tmp_path / "s", workers=1, estimate=False)
+    verdicts = sorted((r["instrument_stuck"], r["instrument_release_margin_m"] > 0)
+                      for r in rec.values())
+    assert verdicts == [(0.0, False), (1.0, True)]
+    assert (tmp_path / "s" / "study.png").exists()

@@ -8,6 +8,7 @@ operator, its solvers and continuation.
 - :mod:`.stability` - the energy Hessian's inertia
 - :mod:`.stepping`, :mod:`.landing` - continuation in d with folds and landings
 - :mod:`.arclength`, :mod:`.curve` - pseudo-arclength continuation through folds, paths
+- :mod:`.sigma_arclength` - the same for the sigma-gap: pieces of fixed active set, events
 - :mod:`.forces` - force integration (paper 1 eqs 11-13 with area weights)
 """
 from .constraints import AsperityGap, CONTACT_MODELS

@@ -109,10 +109,13 @@ class EquilibriumCurve:
         run = next(r for r in runs if r[0] <= start <= r[1])
         lo, hi, i = run[0], run[1], start
         visited = set()
+        forced = None       # after a landing: the index direction toward the travel side
         while True:
             visited.add(run)
-            # direction along the run in which d moves the right way
-            step = 1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1
+            # direction along the run in which d moves the right way (after a landing in
+            # the first interval of a run, lo == hi: only the landing knows the direction)
+            step = forced if forced is not None else (
+                1 if hi == lo or sign * (pts[hi].d - pts[lo].d) > 0 else -1)
             end = hi if step == 1 else lo
             out.append(("run", i, end))
             # what lies beyond the run's end: a fold (then jump) or the curve's end
@@ -160,9 +163,9 @@ class EquilibriumCurve:
             out.append(("land", a, bracket))
             # continue from the landing toward the travel direction
             if sign * dd > 0:
-                lo, hi, i = last, run[1], last
+                lo, hi, i, forced = last, run[1], last, 1
             else:
-                lo, hi, i = run[0], first, first
+                lo, hi, i, forced = run[0], first, first, -1
 
     def _dist(self, p, q):
         tr = self.tracers[p.seg]
@@ -248,6 +251,65 @@ class EquilibriumCurve:
                 d_f = out[-1][1]
                 out.append(("land", d_f, self.point_at(i, d_f, j), pts[i].seg))
         return out if segments else [e[:3] for e in out]
+
+
+    def cycle_work(self, force):
+        """Work (J) of the approach-retract cycle, the loop integral of F dd along the two
+        displacement-controlled paths (the area their closed loop encloses in the (d, F)
+        plane; the jumps at fixed d add none), so that it equals the energy the jumps
+        release (the hysteresis) up to the quadrature error.
+
+        Each stretch of a path lies on one interval of the curve (between two of its points,
+        or a point and a fold or a landing); there d and F = force(d, w) (N) are interpolated
+        quadratically in the offset along the interval's first tangent through a midpoint
+        corrected onto the curve, and F d'(s) is integrated by Simpson's rule (exact for
+        these quadratics: error O(stretch^5) per stretch)."""
+        pts = self.points
+        total = 0.0
+
+        def offset(a, d, w):
+            p, tr = pts[a], self.tracers[pts[a].seg]
+            dx = (np.r_[w, d] - np.r_[p.w, p.d]) / tr.scale
+            return float(tr.omega * (p.t[:-1] @ dx[:-1]) + p.t[-1] * dx[-1])
+
+        def stretch(a, lo, hi):
+            """int F dd from state lo to state hi (each (d, w)) on interval a."""
+            s0, s1 = offset(a, *lo), offset(a, *hi)
+            if s0 == s1:
+                return 0.0
+            mid = self._on_curve(pts[a], 0.5 * (s0 + s1))
+            if mid is None:
+                raise ConvergenceError("cycle work: a midpoint on the curve could not be "
+                                       "recomputed", d=lo[0], residual=math.nan, n_iter=0)
+            d0, dm, d1 = lo[0], mid[0], hi[0]
+            f0, fm, f1 = force(*lo), force(*mid), force(*hi)
+            # Simpson on F(s) d'(s) with d' of the quadratic through the three points
+            return (f0 * (-3 * d0 + 4 * dm - d1) + 4 * fm * (d1 - d0)
+                    + f1 * (d0 - 4 * dm + 3 * d1)) / 6.0
+
+        for direction in ("approach", "retract"):
+            here = None             # (d, w) where the path stands, and its interval side
+            for kind, i, j in self.walk(direction):
+                if kind == "run":
+                    if here is not None:            # from the landing to the run's start
+                        a = here[2]
+                        total += stretch(a, here[:2], (pts[i].d, pts[i].w))
+                    step = 1 if j >= i else -1
+                    for k in range(i, j, step):
+                        a = min(k, k + step)
+                        if not self._seam(a):
+                            total += stretch(a, (pts[k].d, pts[k].w),
+                                             (pts[k + step].d, pts[k + step].w))
+                    end = j
+                    here = None
+                elif kind == "fold":
+                    f = self.folds[i]
+                    total += stretch(f.index, (pts[end].d, pts[end].w), (f.d, f.w))
+                    d_f = f.d
+                else:
+                    w = self.point_at(i, d_f, j)
+                    here = (d_f, w, i)
+        return total
 
 
 def bracketed_root(f, lo, hi, *, xtol):

@@ -102,13 +102,16 @@ def work_of_adhesion(effects, floor):
 def tail_delta(effects, sphere, radius, d_min, target, floor):
     """The analysis radius (m): ``radius`` doubled until the tail at d_min is at most
     TAIL_SHARE * target of 2 pi R W (W the work of adhesion from the floor); ``radius``
-    itself without adhesive laws. Capped at 0.5 R for the exact sphere (its cap ends at R)."""
+    itself without adhesive laws. Doubled no further than R (the exact sphere: 0.5 R, its cap
+    ends at R; the paraboloid of eq 4 is a sphere only for r << R, and a scene's radius must
+    stay below R): a small tip keeps the rest of its tail as F_tail, exact for the
+    paraboloid, and the estimate's tail part."""
     if not effects:
         return radius
     scale = 2 * math.pi * sphere.radius * abs(work_of_adhesion(effects, floor))
     if scale <= 0:
         return radius
-    cap = 0.5 * sphere.radius if sphere.profile == "sphere" else math.inf
+    cap = 0.5 * sphere.radius if sphere.profile == "sphere" else sphere.radius
     a = radius
     for _ in range(MAX_RADIUS_DOUBLINGS):
         if abs(tail_force(effects, sphere, a, d_min)) <= TAIL_SHARE * target * scale or \

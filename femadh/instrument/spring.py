@@ -34,11 +34,16 @@ class Spring:
         "stiffness" (given as calibrated), "cantilever" or "bridge" (from the geometry).
     geometry : dict or None
         The beam's length, width, thickness (m) and youngs_modulus (Pa).
+    rest_gap : float or None
+        Where the suspension holds the part at rest (m, the base position z at rest): a MEMS
+        part stuck to the flat frees itself iff the instrument lets go before z comes back
+        to it (its jump-out z is below the rest gap).
     """
 
     stiffness: float
     kind: str = "stiffness"
     geometry: dict | None = None
+    rest_gap: float | None = None
 
     @classmethod
     def beam(cls, kind, length, width, thickness, youngs_modulus):
@@ -46,6 +51,10 @@ class Spring:
         return cls(k, kind, {"length_m": length, "width_m": width, "thickness_m": thickness,
                              "youngs_modulus_Pa": youngs_modulus})
 
+    def at_rest_gap(self, gap):
+        """The same spring with its rest position (the base at rest) at separation ``gap``."""
+        return Spring(self.stiffness, self.kind, self.geometry, gap)
+
     def as_dict(self):
         return {"stiffness_N_per_m": self.stiffness, "kind": self.kind,
-                "geometry": self.geometry}
+                "geometry": self.geometry, "rest_gap_m": self.rest_gap}

@@ -110,8 +110,19 @@ def instrument_figure(res, path):
         ax[1].plot(p["d_m"][pts] * ls, p["F_N"][pts] * fs, ".", ms=3, color=colors[b],
                    label=f"held by the instrument ({b})")
     ax[1].axhline(0, color="0.7", lw=0.8)
+    # where the contact acts: from the deepest state to a few times the farthest jump
+    far = max([j["d_fold_m"] for j in ins["jumps"]], default=None)
+    if far is not None and far > 0:
+        lo = min(float(np.min(p["d_m"])) for p in paths.values())
+        hi = min(lo + 4 * (far - lo), float(np.max(alld)))
+        ax[1].set_xlim(lo * ls, hi * ls)
+        near = np.concatenate([p["F_N"][(p["d_m"] >= lo) & (p["d_m"] <= hi)]
+                               for p in paths.values()])
+        if near.size:
+            pad = 0.05 * (near.max() - near.min() + 1e-300)
+            ax[1].set_ylim((near.min() - pad) * fs, (near.max() + pad) * fs)
     ax[1].set(xlabel=f"separation d ({ll})", ylabel=f"F ({fl})",
-              title="the contact's own curve")
+              title="the contact's own curve (near contact)")
     ax[1].legend(fontsize=8)
     fig.tight_layout()
     _save(fig, path)

@@ -450,12 +450,16 @@ def _trace_arclength(scene, problem, sink):
     equilibrium_curve.csv), then its displacement-controlled paths as branches."""
     from ..contact.arclength import trace_curve
 
+    make_state = _curve_state
+    if problem.sigma is not None:     # the sigma-gap's piecewise curve (its own states)
+        from ..contact.sigma_arclength import curve_state as make_state
+        from ..contact.sigma_arclength import trace_sigma_curve as trace_curve
     d = scene.d_values
     step = abs(d[1] - d[0])
     curve_rows = []
 
     def on_point(i, point):
-        st = _curve_state(problem, point.d, point.w, point.stable)
+        st = make_state(problem, point.d, point.w, point.stable)
         curve_rows.append((i, point, st))
         if sink.writer:
             sink.writer.write_curve_point(i, point, st)
@@ -471,11 +475,13 @@ def _trace_arclength(scene, problem, sink):
             "stable": np.array([p.stable for _, p, _ in curve_rows], bool),
             "dd_ds": np.array([p.t_d for _, p, _ in curve_rows])}
     for branch in scene.directions:
-        path = curve.branch(branch)
+        # a sigma-gap event state is on the curve twice (end and start of two pieces of the
+        # active set, at one d): it is one state of the path
+        path = _once(curve.branch(branch))
         sink.plan(branch, sum(kind != "fold" for kind, _, _ in path))
         before = None
         for kind, dk, wk in path:
-            st = _curve_state(problem, dk, wk, True)
+            st = make_state(problem, dk, wk, True)
             if kind == "fold":
                 before = st
                 continue        # the fold state is the jump's 'before', not a grid state
@@ -483,3 +489,14 @@ def _trace_arclength(scene, problem, sink):
             if kind == "land":
                 sink.jump(Jump(branch, dk, dk, 0.0, before, st))
     sink.close()
+
+
+def _once(path):
+    """A path without repeated consecutive points at the same d and w (a sigma-gap event)."""
+    out = []
+    for e in path:
+        if out and e[0] == out[-1][0] == "point" and e[1] == out[-1][1] \
+                and np.array_equal(e[2], out[-1][2]):
+            continue
+        out.append(e)
+    return out

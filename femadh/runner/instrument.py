@@ -45,7 +45,15 @@ def instrument_numbers(res, spring, branches=None):
         res.warnings.append("instrument: the drive never presses the contact (its deepest "
                             f"state is still in tension, F = {app['F_N'][-1]:.4g} N): extend "
                             "[sweep] stop")
-    return {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
+    out = {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
+    if spring.rest_gap is not None:
+        # the MEMS verdict: stuck iff the instrument still holds the contact when its base is
+        # back at the rest gap (no jump-out: it peels off continuously, never stuck)
+        z_out = hl.get("jump_out_z_m")
+        out["instrument_stuck"] = float(z_out is not None and z_out > spring.rest_gap)
+        if z_out is not None:
+            out["instrument_release_margin_m"] = float(z_out - spring.rest_gap)
+    return out
 
 
 def refine_instrument(scene, res, problem, sink):

@@ -191,6 +191,10 @@ def instrument_summary(res):
             out[name] = res.headline[key]
             if f"{key}_error" in res.headline:
                 out[f"{name}_error"] = res.headline[f"{key}_error"]
+    if "instrument_stuck" in res.headline:
+        out["verdict"] = "stuck" if res.headline["instrument_stuck"] else "free"
+        if "instrument_release_margin_m" in res.headline:
+            out["release_margin_m"] = res.headline["instrument_release_margin_m"]
     out["jumps"] = res.instrument["jumps"]
     out["incomplete"] = res.instrument["incomplete"]
     return out

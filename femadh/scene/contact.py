@@ -121,7 +121,8 @@ SOLVER = Table("solver", "Discretisation and solver.", (
     Key("max_iter", "integer", "Newton iterations per solve.", default=40, lo=1,
         lo_closed=True, hi=10000, hi_closed=True),
     Key("continuation", "choice", "'steps' in d, or 'arclength' through the folds (smooth "
-        "laws only).", default="steps", choices=("steps", "arclength")),
+        "laws and the complementarity sigma-gap).", default="steps",
+        choices=("steps", "arclength")),
     Key("accuracy", "number", "Relative accuracy asked of the headline numbers (largest "
         "adhesion, forces at the deepest separation): femadh refines the grid and the "
         "analysis radius until its error estimate meets it, or says it cannot. Default "
@@ -568,10 +569,17 @@ def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
             reader.fail("solver.grid.spacing", raw_grid.get("spacing"), "a spacing at most "
                         "the band's radius")
     if so["continuation"] == "arclength":
-        if gap is not None:
+        if gap is not None and gap.contact_model != "complementarity":
+            reader.fail("solver.continuation", "arclength", "'steps' with the "
+                        "hertz-closure sigma-gap: arclength continuation traces smooth laws "
+                        "and the complementarity sigma-gap only (the closure's contact "
+                        "radius is not traced through folds)")
+        elif gap is not None and gap.adhesion:
             reader.fail("solver.continuation", "arclength", "'steps' with "
-                        "[effects.asperity_gap]: arclength continuation traces smooth laws "
-                        "only (the hard sigma-gap is not smooth)")
+                        "[effects.asperity_adhesion] on the contact set: its range-less "
+                        "adhesion holds a node that reached sigma until its pressure falls to "
+                        "-P_LJa, so approach and retract part at every node and the "
+                        "equilibria are no single curve (model = 'smoothed' can be traced)")
         if not any_bad(sw) and "approach" not in sw["directions"]:
             reader.fail("sweep.directions", list(sw["directions"]), "a list with 'approach' "
                         "for [solver] continuation = 'arclength' (the curve is traced from "

@@ -6,6 +6,7 @@ a MEMS beam from its geometry); the drive is the spring's base z, swept over the
     cantilever = { length = "200 um", width = "30 um", thickness = "2 um",
                    youngs_modulus = "169 GPa" }    # end-loaded: k = E w t^3 / (4 L^3)
     bridge = { ... }                               # fixed-fixed, centre load: k = 16 E w t^3 / L^3
+    rest_gap = "2 um"                              # optional: the MEMS verdict, stuck or free
 """
 from ..instrument import Spring
 from ..schema import Key, Table
@@ -43,6 +44,11 @@ INSTRUMENT = Table("instrument", "The spring in series with the contact: an AFM 
     Key("bridge", "custom", "A fixed-fixed bridge loaded at its middle { length, width, "
         "thickness, youngs_modulus }: k = 16 E w t^3 / L^3.", default=None,
         parse=_beam("bridge"), expect="a table { length, width, thickness, youngs_modulus }"),
+    Key("rest_gap", "length", "Where the suspension holds the part at rest (the base z at "
+        "rest, a separation). With it the run gives the MEMS verdict: a part once stuck frees "
+        "itself iff the instrument jumps out before z returns to the rest gap (jump-out z < "
+        "rest_gap); else the restoring force k (rest_gap - d) never beats the adhesion.",
+        default=None, lo=0.0),
 ))
 
 
@@ -57,6 +63,5 @@ def read_instrument(reader, raw):
     if len(given) != 1:
         return reader.fail("instrument", raw, "exactly one of stiffness, cantilever, bridge "
                            f"(this table gives {', '.join(given) or 'none'})")
-    if given[0] == "stiffness":
-        return Spring(v["stiffness"])
-    return v[given[0]]
+    spring = Spring(v["stiffness"]) if given[0] == "stiffness" else v[given[0]]
+    return spring if v["rest_gap"] is None else spring.at_rest_gap(v["rest_gap"])

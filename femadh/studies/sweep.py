@@ -38,7 +38,9 @@ from ..io.atomic import write_atomic
 
 #: headline numbers a study's table carries (when the scene kind has them)
 HEADLINE = ("max_adhesion_N", "d_at_max_adhesion_m", "jump_in_d_m", "jump_out_d_m",
-            "hysteresis_J", "F_LJ_deepest_N", "F_ex_deepest_N", "work_of_adhesion_J_per_m2")
+            "hysteresis_J", "F_LJ_deepest_N", "F_ex_deepest_N", "work_of_adhesion_J_per_m2",
+            "instrument_pull_off_N", "instrument_snap_off_N", "instrument_jump_out_z_m",
+            "instrument_stuck", "instrument_release_margin_m")
 _RANGE = re.compile(r"^\s*(?P<lo>[^.:]+(?:\.\d+)?(?:[eE][-+]?\d+)?[^.:]*?)\s*\.\.\s*"
                     r"(?P<hi>[^:]+?)\s*:\s*(?P<n>\d+)\s*(?::\s*(?P<log>log|lin))?\s*$")
 
@@ -472,6 +474,8 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
         order = np.argsort(x)
         ax.plot(x[order], y[order] * fs, "o-")
         ax.set(xlabel=xl, ylabel=qlabel)
+        _verdicts(ax, [(xv, yv * fs, records[p.id].get("instrument_stuck"))
+                       for (p, _), xv, yv in zip(vals, x, y)])
         ax.grid(alpha=0.3)
     else:
         (xmap, xl), (ymap, yl) = axis(keys[0]), axis(keys[1])
@@ -483,12 +487,27 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
         im = ax.pcolormesh(_edges(xs), _edges(ys), Z, shading="flat", cmap="viridis")
         fig.colorbar(im, ax=ax, label=qlabel)
         ax.set(xlabel=xl, ylabel=yl)
+        _verdicts(ax, [(xmap[repr(p.changes[keys[0]])], ymap[repr(p.changes[keys[1]])],
+                        records[p.id].get("instrument_stuck")) for p, _ in vals])
     ax.set_title("study: " + quantity.removesuffix("_N").replace("_", " "))
     fig.tight_layout()
     path = Path(out) / "study.png"
     save_atomic(path, lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
     return path
+
+
+def _verdicts(ax, points):
+    """The MEMS verdict of each point (scenes with [instrument] rest_gap): a red cross where
+    the part stays stuck, a white circle where its suspension frees it."""
+    stuck = [(x, y) for x, y, v in points if v == 1.0]
+    free = [(x, y) for x, y, v in points if v == 0.0]
+    if stuck:
+        ax.plot(*zip(*stuck), "x", color="tab:red", ms=9, mew=2, ls="", label="stuck")
+    if free:
+        ax.plot(*zip(*free), "o", mfc="white", mec="k", ms=7, ls="", label="frees itself")
+    if stuck or free:
+        ax.legend(loc="best", fontsize=8)
 
 
 def _edges(c):
