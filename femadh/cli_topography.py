@@ -69,7 +69,8 @@ def main(args):
 def _rows(v):
     return [("m0 (nm^2)", v["m0"] * 1e18), ("m2", v["m2"]), ("m4 (um^-2)", v["m4"] * 1e-12),
             ("alpha", v["alpha"]), ("rho = eta (um^-2)", v["eta_per_m2"] * 1e-12),
-            ("R_a = beta (um)", v["beta_m"] * 1e6), ("sigma_a = sigma_s (nm)", v["sigma_s_m"] * 1e9),
+            ("R_a = beta (um)", v["beta_m"] * 1e6),
+            ("sigma_a = sigma_s (nm)", v["sigma_s_m"] * 1e9),
             ("z_m (nm)", v["z_m_m"] * 1e9)]
 
 

@@ -325,7 +325,8 @@ DEFECTS = [
     D("topo_composite_zm", "Table 2 composite: z_m in quadrature instead of summed",
       "femadh/roughness/composite.py",
       (("z_m=s1.z_m + s2.z_m,", "z_m=math.hypot(s1.z_m, s2.z_m),"),)),
-    D("topo_cutoff_sharp", "cutoff moments: a sharp |q| <= q_c mask, no lattice-cell weight",
+    D("topo_cutoff_sharp", "cutoff moments: a sharp abs(q) <= q_c mask, no lattice-cell "
+      "weight",
       "femadh/roughness/moments.py",
       (("return np.clip((q_c - np.abs(q)) / dq + 0.5, 0.0, 1.0)",
         "return (np.abs(q) <= q_c).astype(float)"),)),

@@ -18,7 +18,6 @@ roll-off), writes them with SurfaceTopography's NetCDF writer, and
 (~30 s; the surfaces go to out/roughness_topography/, not committed).
 """
 import argparse
-import json
 import math
 from pathlib import Path
 import statistics as stats
@@ -235,7 +234,8 @@ def main(argv=None):
                                   "power law)"), ""]
     lines += ["## The slider scene (`paper1_slider_gw.toml`, GW laws, 200 nodes)", "",
               "| asperity numbers | rho (um^-2) | R_a (um) | sigma_a (nm) | z_m (nm) | max "
-              "adhesion (uN) | at d (nm) | status | run (s) |", "|---|---|---|---|---|---|---|---|---|"]
+              "adhesion (uN) | at d (nm) | status | run (s) |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for name in ("table2", "topography"):
         r = runs[name]
         s = r["summits"]

@@ -22,7 +22,6 @@ FILE_KEY = "(topography)"
 
 def _surface_topography():
     try:
-        import SurfaceTopography  # noqa: F401 (the package; its IO is imported below)
         from SurfaceTopography import open_topography
     except ImportError:
         raise DependencyError('reading topography files needs SurfaceTopography: pip install '

@@ -3,11 +3,12 @@ spectral density, where the instrument (tip radius, pixel size, noise, filters) 
 
 Criterion (stated, simple): fit a power law C ~ q^s by least squares in log-log over the two
 octaves q in [q_N / 16, q_N / 4] below the tail (q_N = pi / pixel the Nyquist wavevector;
-a lower start would reach into the long-wavelength roll-off most surfaces have) and compare the measured PSD over the top octave [q_N / 2, q_N] with the power
-law extrapolated there. If the geometric mean of measured / extrapolated over that octave
-is above 2, the tail *flattens* (a noise floor, or pixel-level artefacts: m2 and m4 at the
-pixel scale are then inflated); below 1/2, it *drops steeply* (the tip radius or a filter
-smooths the data: m4 at the pixel scale is the instrument's, not the surface's). Either way
+a lower start would reach into the long-wavelength roll-off most surfaces have) and compare
+the measured PSD over the top octave [q_N / 2, q_N] with the power law extrapolated there.
+If the geometric mean of measured / extrapolated over that octave is above 2, the tail
+*flattens* (a noise floor, or pixel-level artefacts: m2 and m4 at the pixel scale are then
+inflated); below 1/2, it *drops steeply* (the tip radius or a filter smooths the data: m4
+at the pixel scale is the instrument's, not the surface's). Either way
 the pixel-scale moments, above all m4, are not the surface's, and a cutoff (``--cutoff``)
 above the deviation gives moments that are. For a map the radially averaged 2D PSD is used
 (its tail is the isotropic spectrum up to q_N); for a line scan the profile PSD.
