@@ -546,7 +546,7 @@ def findings(stats, ok, vac, rows):
         f"switches on, at d = {min(cap_in):.2f}–{max(cap_in):.2f} × the filled gap 2|r_K| + 2t "
         "(z turns where the smoothed law's force gradient 2πR (γ/|r_K|) S reaches k, about 5 "
         "smoothing widths outside the filled gap: the excess is the law's smoothing, not "
-        f"physics), except in {len(lj_in)} runs (the 1-µm tip at low p/psat) where the "
+        f"physics), except in {len(lj_in)} runs (the larger tips at low p/psat) where the "
         "Lennard-Jones snap-in d = (A R / 3k)^(1/3) = "
         f"{min(snap(r) for r in lj_in) * 1e9:.1f}–{max(snap(r) for r in lj_in) * 1e9:.1f} nm "
         "comes first; on retract it "
@@ -561,10 +561,11 @@ def findings(stats, ok, vac, rows):
            v.get("d_po", math.nan)) for k, v in stiff.items() if k in base]
     if el:
         L.append(
-            f"**The elastic contact.** Against the same runs with both moduli × {STIFF:g} "
-            "(near-rigid, ethanol): " + "; ".join(
-                f"R = {R * 1e9:g} nm p/psat {x:g}: {dv:+.2%} (pull-off at d = {d1 * 1e9:.3f} "
-                f"vs {d2 * 1e9:.3f} nm)" for (R, x), dv, d1, d2 in sorted(el)) +
+            "**The elastic contact.** The pull-off relative to the same runs with both moduli "
+            f"× {STIFF:g} (near-rigid; ethanol; in brackets d at pull-off, elastic vs "
+            "near-rigid): " + "; ".join(
+                f"R = {R * 1e9:g} nm p/psat {x:g}: {dv:+.2%} ({d1 * 1e9:.3f} vs "
+                f"{d2 * 1e9:.3f} nm)" for (R, x), dv, d1, d2 in sorted(el)) +
             ". Elasticity lowers the pull-off, the more the larger the tip and the drier "
             "the vapour: under tension the tip necks toward the flat, the largest tension is "
             "reached at a larger separation d, and part of the contact's centre sits in the "
