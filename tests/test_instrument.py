@@ -281,3 +281,63 @@ def test_mems_verdict_across_the_rest_gap(tmp_path, mu2):
                       for r in rec.values())
     assert verdicts == [(0.0, False), (1.0, True)]
     assert (tmp_path / "s" / "study.png").exists()
+
+
+#: a 100-nm SiO2 tip in ethanol vapour at p/psat 0.5 (GAB film) on a 0.1 N/m lever, traced 30 nm
+#: -> 0 nm: the meniscus forms within one 0.5-nm step near d = 3 nm (issue 22's first try)
+MENISCUS_ONSET = """
+[scene]
+name = "meniscus-onset"
+[sphere]
+radius = "100 nm"
+[materials]
+disk   = { youngs_modulus = "73 GPa",  poisson_ratio = 0.17 }
+slider = { youngs_modulus = "73 GPa", poisson_ratio = 0.17 }
+[effects.lennard_jones]
+hamaker = "6.5e-20 J"
+equilibrium_distance = "0.165 nm"
+[effects.capillary]
+liquid = "ethanol"
+relative_pressure = 0.5
+[solver]
+analysis_radius = { delta = "20 nm" }
+continuation = "arclength"
+nodes = 60
+[sweep]
+start = "30 nm"
+stop = "0 nm"
+step = "0.5 nm"
+[instrument]
+stiffness = "0.1 N/m"
+"""
+
+
+def test_a_step_like_force_is_not_read_past_its_states():
+    """The meniscus switches on within one step: F (nN) 0.087, 0.13, 5.1 at d = 3.5, 3, 2.5 nm,
+    monotone, while z = d + F/k turns between them. The parabola through the three states put
+    z's turning point at z = -1.82 nm with F = -0.51 nN (repulsive, between attractive states,
+    z below every state's): the readout must not read an extremum that the monotone states do
+    not have. It reads the state itself, resolved to the bracket."""
+    d = np.array([5.0, 4.5, 4.0, 3.5, 3.0, 2.5, 2.0, 1.5]) * 1e-9
+    F = np.array([0.0433, 0.0535, 0.06583, 0.08648, 0.1315, 5.105, 10.2, 15.3]) * 1e-9
+    ip = read_instrument({"approach": {"d_m": d, "F_ex_N": F}}, [], 0.1, ("approach",))
+    (j,) = ip.jumps
+    assert j["F_before_N"] == pytest.approx(0.1315e-9)
+    assert j["z_m"] == pytest.approx(3e-9 + 1.315e-9)
+    assert j["resolution_d_m"] == pytest.approx(0.5e-9)
+
+
+def test_the_warnings_name_the_sharpened_jump():
+    """The instrument's warning (a jump landing beyond the sweep) is read from the same states
+    as the headline: the sharpened reading, not the first one between the sweep's states (which
+    named a jump at z = -1.8 nm, F = -0.5 nN, while the headline said z = 4.25 nm). Both jumps
+    land beyond the traced range (the lever needs z ~ 4 nm in, ~745 nm out): both are named."""
+    res = run(scene_from_text(MENISCUS_ONSET), None, estimate="peak", figures=False,
+              progress=False)
+    assert res.status == "converged" and res.instrument["fresh_states"] > 0
+    hl = res.headline
+    inst = [w for w in res.warnings if w.startswith("instrument:")]
+    assert len(inst) == 1
+    assert f"approach jump at z = {hl['instrument_jump_in_z_m'] * 1e9:.6g} nm" in inst[0]
+    assert f"retract jump at z = {hl['instrument_jump_out_z_m'] * 1e9:.6g} nm" in inst[0]
+    assert 4e-9 < hl["instrument_jump_in_z_m"] < 4.5e-9

@@ -77,9 +77,10 @@ class InstrumentPath:
 
     @property
     def incomplete(self):
-        """Why a path stops short of the drive's end (a jump that lands beyond the traced
-        separations), or None."""
-        return next((p["incomplete"] for p in self.paths.values() if p["incomplete"]), None)
+        """Why the paths stop short of the drive's end (a jump that lands beyond the traced
+        separations), each path's reason, or None."""
+        return "; ".join(p["incomplete"] for p in self.paths.values() if p["incomplete"]) \
+            or None
 
     def brackets(self):
         """The intervals between computed states (branch, d_lo, d_hi) where the readout
@@ -348,7 +349,27 @@ def _turning_point(p, z, i, s):
         return z[i], p.d[i], p.F[i], 0.0, 0.0, 0.0
     c = np.polyfit(p.d[sl] - p.d[j], p.F[sl], 2)
     Fv = float(np.polyval(c, dv - p.d[j]))
+    if _overshoots(p.d[sl], p.F[sl], dv, Fv):
+        # F runs monotonically through the three states but the parabola puts an extremum of
+        # its own between two of them: the curve is not locally parabolic there (a step-like
+        # F, e.g. a meniscus that forms within one step), and the vertex is an extrapolation
+        # (it read z and F far beyond every state: a repulsive F between attractive states).
+        # Read the state itself, resolved to the bracket; fresh states sharpen it.
+        return (z[i], p.d[i], p.F[i], float(np.max(np.abs(z[sl] - z[i]))),
+                float(np.max(np.abs(p.d[sl] - p.d[i]))),
+                float(np.max(np.abs(p.F[sl] - p.F[i]))))
     return zv, dv, Fv, abs(zv - z[i]), abs(dv - p.d[i]), abs(Fv - p.F[i])
+
+
+def _overshoots(d, F, dv, Fv):
+    """Whether a parabola's value Fv at dv leaves the range of the two states around dv while
+    F is monotone through the three states (d ascending): an interpolant of monotone data
+    that creates an extremum between them (a monotone interpolant never does)."""
+    if (F[1] - F[0]) * (F[2] - F[1]) < 0:
+        return False                     # F turns here: the parabola's extremum is the curve's
+    a, b = (F[0], F[1]) if dv <= d[1] else (F[1], F[2])
+    tol = 1e-9 * max(abs(F[0]), abs(F[1]), abs(F[2]))
+    return not min(a, b) - tol <= Fv <= max(a, b) + tol
 
 
 def _landing(pieces, k, zJ, dJ, s, *, seam, scale, origin):

@@ -119,8 +119,16 @@ def refine_instrument(scene, res, problem, sink):
         if not added:
             break
     if fresh:
-        warnings = list(res.warnings)
-        res.headline.update(instrument_numbers(res, spring, arrays()))
-        # the readout's warnings of the first reading stand (the same drive, same range)
-        res.warnings[:] = warnings
+        before = list(res.warnings)
+        numbers = instrument_numbers(res, spring, arrays())
+        if numbers:
+            res.headline.update(numbers)
+            # the sharpened reading's warnings replace the first reading's: the same drive and
+            # range, so the same warnings, but the first one's numbers (a jump read between
+            # the sweep's states) would contradict the headline read from the fresh states
+            fresh_warnings = res.warnings[len(before):]
+            res.warnings[:] = [w for w in before if not w.startswith("instrument:")] \
+                + fresh_warnings
+        else:
+            res.warnings[:] = before         # the sharpened reading failed: the first stands
     return fresh
