@@ -4,9 +4,15 @@ interpolates (z's turning points, the landings, the largest tension)."""
 import numpy as np
 
 #: rounds of fresh states in each interval the readout interpolates in
-REFINE_ROUNDS = 3
-#: fresh states per interval and round (the interval shrinks ~8x per round)
-REFINE_STATES = 7
+REFINE_ROUNDS = 4
+#: fresh states per interval and round (the interval shrinks ~4x per round)
+REFINE_STATES = 3
+#: the readout's share of the run's accuracy target: fresh states stop once every headline
+#: number's readout resolution is below this share of it (the hysteresis, an integral over the
+#: whole loop, is judged by its own estimate and not refined locally)
+REFINE_SHARE = 0.1
+#: the target of runs without one (explicit nodes, no accuracy)
+DEFAULT_TARGET = 1e-3
 #: intervals narrower than this fraction of the sweep step are not refined further (the
 #: displacement-controlled folds are located to the same 2^-10)
 REFINE_MIN_FRACTION = 2.0**-10
@@ -78,6 +84,7 @@ def refine_instrument(scene, res, problem, sink):
             for b, c in res.branches.items()}
     step = abs(scene.d_values[1] - scene.d_values[0]) if len(scene.d_values) > 1 else 0.0
     done, fresh = set(), 0
+    target = REFINE_SHARE * (scene.target_accuracy or DEFAULT_TARGET)
 
     def arrays():
         out = {}
@@ -97,6 +104,8 @@ def refine_instrument(scene, res, problem, sink):
             ip = read_instrument(arrays(), res.jumps, spring.stiffness,
                                  tuple(b for b in ("approach", "retract") if b in rows))
         except ValueError:
+            break
+        if _resolved(ip.headline(), target, step):
             break
         added = 0
         for branch, lo, hi in ip.brackets():
@@ -131,4 +140,38 @@ def refine_instrument(scene, res, problem, sink):
                 + fresh_warnings
         else:
             res.warnings[:] = before         # the sharpened reading failed: the first stands
+    _pull_off_at_the_peak(res, problem)
     return fresh
+
+
+def _pull_off_at_the_peak(res, problem):
+    """The largest tension the instrument records is the contact's largest tension wherever
+    the instrument holds that state (dF/dd = 0 > -k there): the peak the run located by its
+    own bounded search (:func:`femadh.runner.estimates.refine_peak`) plus the tail there,
+    when the instrument's retract path passes that separation and reads no more. Sharper
+    than sampling a narrow peak (Fig 3's sigma-gap adhesion peak is ~0.1 nm wide)."""
+    from ..contact.forces import tail_force
+
+    hl, ins = res.headline, res.instrument
+    ret = ins["paths"].get("retract")
+    if ret is None or "instrument_pull_off_N" not in hl or "d_at_max_adhesion_m" not in hl:
+        return
+    d = hl["d_at_max_adhesion_m"]
+    F = hl["max_adhesion_N"] + tail_force(problem, d)
+    held = [dk for dk, kind in zip(ret["d_m"], ret["kind"]) if kind == "point"]
+    if held and min(held) <= d <= max(held) and F >= hl["instrument_pull_off_N"]:
+        hl["instrument_pull_off_N"] = float(F)
+        ins["resolution"]["pull_off_N"] = 0.0
+
+
+def _resolved(hl, target, step):
+    """Whether every instrument number but the hysteresis is read to ``target`` relative
+    (forces relative to themselves, positions relative to max(|value|, the sweep step))."""
+    for name in INSTRUMENT_NUMBERS:
+        if name == "hysteresis_J" or name not in hl:
+            continue
+        r = hl.get(f"{name}_resolution", 0.0)
+        scale = abs(hl[name]) if name.endswith("_N") else max(abs(hl[name]), step)
+        if r > target * scale:
+            return False
+    return True
