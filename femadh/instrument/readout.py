@@ -325,10 +325,23 @@ def _spacing(p):
     return float(np.max(np.abs(np.diff(p.d)))) if len(p.d) > 1 else 0.0
 
 
+def _parabola(x, y):
+    """Coefficients (highest first) of the parabola through three points (x distinct), by
+    divided differences: exact where a least-squares fit of nearly coincident abscissae (fresh
+    states picometres apart) is ill-conditioned. None if two abscissae coincide."""
+    if x[0] == x[1] or x[1] == x[2] or x[0] == x[2]:
+        return None
+    f01 = (y[1] - y[0]) / (x[1] - x[0])
+    f12 = (y[2] - y[1]) / (x[2] - x[1])
+    a = (f12 - f01) / (x[2] - x[0])
+    b = f01 - a * (x[0] + x[1])
+    return np.array([a, b, y[0] - a * x[0] ** 2 - b * x[0]])
+
+
 def _vertex(x, y):
     """Vertex (value, abscissa) of the parabola through three points, or (None, None)."""
-    c = np.polyfit(x - x[1], y, 2)
-    if c[0] == 0:
+    c = _parabola(x - x[1], y)
+    if c is None or c[0] == 0:
         return None, None
     xv = -c[1] / (2 * c[0])
     if not (min(x - x[1]) <= xv <= max(x - x[1])):
@@ -341,23 +354,26 @@ def _turning_point(p, z, i, s):
     the parabola's vertex through the three states around the extreme, F and d there by the
     same parabola in d. Returns z, d, F and their resolutions (vertex minus the state)."""
     j = i if 0 < i < len(p.d) - 1 else min(max(i, 1), len(p.d) - 2)
-    sl = slice(j - 1, j + 2)
+    sl = slice(max(j - 1, 0), j + 2)
+
+    def the_state():
+        # the state itself, resolved to its bracket (fresh states sharpen it)
+        return (z[i], p.d[i], p.F[i], float(np.max(np.abs(z[sl] - z[i]))),
+                float(np.max(np.abs(p.d[sl] - p.d[i]))),
+                float(np.max(np.abs(p.F[sl] - p.F[i]))))
     if len(p.d) < 3:
-        return z[i], p.d[i], p.F[i], 0.0, 0.0, 0.0
+        return the_state()
     zv, dv = _vertex(p.d[sl], z[sl])
-    if zv is None:
-        return z[i], p.d[i], p.F[i], 0.0, 0.0, 0.0
-    c = np.polyfit(p.d[sl] - p.d[j], p.F[sl], 2)
+    c = None if zv is None else _parabola(p.d[sl] - p.d[j], p.F[sl])
+    if c is None:
+        return the_state()
     Fv = float(np.polyval(c, dv - p.d[j]))
     if _overshoots(p.d[sl], p.F[sl], dv, Fv):
         # F runs monotonically through the three states but the parabola puts an extremum of
         # its own between two of them: the curve is not locally parabolic there (a step-like
         # F, e.g. a meniscus that forms within one step), and the vertex is an extrapolation
         # (it read z and F far beyond every state: a repulsive F between attractive states).
-        # Read the state itself, resolved to the bracket; fresh states sharpen it.
-        return (z[i], p.d[i], p.F[i], float(np.max(np.abs(z[sl] - z[i]))),
-                float(np.max(np.abs(p.d[sl] - p.d[i]))),
-                float(np.max(np.abs(p.F[sl] - p.F[i]))))
+        return the_state()
     return zv, dv, Fv, abs(zv - z[i]), abs(dv - p.d[i]), abs(Fv - p.F[i])
 
 
@@ -411,7 +427,9 @@ def _landing_error(q, a, dL):
         return 0.0
     j = min(max(a, 1), len(q.d) - 2)
     sl = slice(j - 1, j + 2)
-    c = np.polyfit(q.d[sl] - q.d[j], q.F[sl], 2)
+    c = _parabola(q.d[sl] - q.d[j], q.F[sl])
+    if c is None:
+        return 0.0
     t = (dL - q.d[a]) / (q.d[a + 1] - q.d[a])
     line = q.F[a] + t * (q.F[a + 1] - q.F[a])
     return abs(float(np.polyval(c, dL - q.d[j])) - line)
