@@ -237,8 +237,8 @@ def test_a_stepped_sigma_gap_run_is_read_and_sharpened():
     the instrument holds the contact's largest tension (dF/dd = 0 > -k), so its pull-off is
     the displacement-controlled peak found by the run's bounded search plus the tail there
     (1e-4: the peak's own search tolerance). At each jump z turns where dF/dd = -k: the slope
-    between the instrument's last two (fresh) states before it, measured within 0.2 %
-    (approach) and 1.8 % (retract) of -k (a secant across the turn); tolerance 3 %."""
+    between the instrument's last two (fresh) states before it, measured within 0.02 %
+    (approach) and 1.7 % (retract) of -k (a secant across the turn); tolerance 3 %."""
     from conftest import fig3_uniform_text
 
     k = 3e4

@@ -82,14 +82,16 @@ class InstrumentPath:
         return "; ".join(p["incomplete"] for p in self.paths.values() if p["incomplete"]) \
             or None
 
-    def brackets(self):
+    def brackets(self, which=("turn", "land", "peak")):
         """The intervals between computed states (branch, d_lo, d_hi) where the readout
-        interpolates a headline number: z's turning points, the landings, and the largest
-        tension of the retract path. Fresh states there sharpen it
+        interpolates: z's turning points ("turn": the jumps' positions and snap-off), the
+        landings ("land": where a jump ends, in the hysteresis) and the largest tension of the
+        retract path ("peak": the pull-off). Fresh states there sharpen it
         (:func:`femadh.runner.instrument.refine_instrument`)."""
-        out = [b for j in self.jumps for b in j.get("brackets", ())]
+        out = [b for j in self.jumps for kind, b in zip(("turn", "land"), j.get("brackets", ()))
+               if kind in which]
         ret = self.paths.get("retract")
-        if ret is not None and len(ret["F_N"]) > 2:
+        if "peak" in which and ret is not None and len(ret["F_N"]) > 2:
             i = int(np.argmax(ret["F_N"]))
             nb = [m for m in (i - 1, i, i + 1) if 0 <= m < len(ret["F_N"])
                   and ret["kind"][m] == "point" and ret["branch_of"][m] == ret["branch_of"][i]]
@@ -406,18 +408,19 @@ def _landing(pieces, k, zJ, dJ, s, *, seam, scale, origin):
             # would offer a landing on the branch the instrument has just left
             continue
         z = q.d + q.F / k
-        for a in range(len(q.d) - 1):
-            dz, dd = z[a + 1] - z[a], q.d[a + 1] - q.d[a]
-            if not (dz > 0 and dd > 0) or not (min(z[a], z[a + 1]) <= zJ <= max(z[a], z[a + 1])):
-                continue
-            t = (zJ - z[a]) / dz
-            dL = q.d[a] + t * dd
+        dz, dd = np.diff(z), np.diff(q.d)
+        # segments the instrument holds (dz/dd > 0) whose z range holds zJ
+        ok = (dz > 0) & (dd > 0) & (np.minimum(z[:-1], z[1:]) <= zJ) & \
+            (zJ <= np.maximum(z[:-1], z[1:]))
+        for a in np.flatnonzero(ok):
+            t = (zJ - z[a]) / dz[a]
+            dL = q.d[a] + t * dd[a]
             gap = s * (dL - dJ)
             if (abs(gap) > tol) if seam else (gap < tol):
                 continue
             gap = abs(gap)
             if best is None or gap < best[0]:
-                best = (gap, q, a, dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))
+                best = (gap, q, int(a), dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))
     return (None, None, None, None) if best is None else best[1:]
 
 

@@ -4,7 +4,7 @@ interpolates (z's turning points, the landings, the largest tension)."""
 import numpy as np
 
 #: rounds of fresh states in each interval the readout interpolates in
-REFINE_ROUNDS = 4
+REFINE_ROUNDS = 8
 #: fresh states per interval and round (the interval shrinks ~4x per round)
 REFINE_STATES = 3
 #: the readout's share of the run's accuracy target: fresh states stop once every headline
@@ -67,8 +67,9 @@ def instrument_numbers(res, spring, branches=None):
 
 
 def refine_instrument(scene, res, problem, sink):
-    """Sharpen the instrument's numbers: in every interval where the readout interpolates
-    (:meth:`~femadh.instrument.InstrumentPath.brackets`), solve fresh states between the two
+    """Sharpen the instrument's numbers: in every interval where the readout interpolates a
+    turning point of z (:meth:`~femadh.instrument.InstrumentPath.brackets`), solve fresh
+    states between the two
     computed ones (:func:`femadh.runner.estimates.state_between`), read again; up to
     REFINE_ROUNDS rounds. The fresh states feed the readout only (curve.csv keeps the sweep's
     states). Updates ``res.headline`` and ``res.instrument``; returns the fresh states'
@@ -108,7 +109,9 @@ def refine_instrument(scene, res, problem, sink):
         if _resolved(ip.headline(), target, step):
             break
         added = 0
-        for branch, lo, hi in ip.brackets():
+        # the turning points only: the pull-off is the run's own peak (below), a landing's
+        # interpolation enters no headline number but the hysteresis, judged by its estimate
+        for branch, lo, hi in ip.brackets(("turn",)):
             if (branch, lo, hi) in done or hi - lo <= REFINE_MIN_FRACTION * step:
                 continue
             done.add((branch, lo, hi))
@@ -148,8 +151,8 @@ def _pull_off_at_the_peak(res, problem):
     """The largest tension the instrument records is the contact's largest tension wherever
     the instrument holds that state (dF/dd = 0 > -k there): the peak the run located by its
     own bounded search (:func:`femadh.runner.estimates.refine_peak`) plus the tail there,
-    when the instrument's retract path passes that separation and reads no more. Sharper
-    than sampling a narrow peak (Fig 3's sigma-gap adhesion peak is ~0.1 nm wide)."""
+    when the instrument's retract path passes that separation and its own largest reading is
+    an interior state there, not a jump's fold. Sharper than sampling a narrow peak (Fig 3's sigma-gap adhesion peak is ~0.1 nm wide)."""
     from ..contact.forces import tail_force
 
     hl, ins = res.headline, res.instrument
@@ -159,7 +162,10 @@ def _pull_off_at_the_peak(res, problem):
     d = hl["d_at_max_adhesion_m"]
     F = hl["max_adhesion_N"] + tail_force(problem, d)
     held = [dk for dk, kind in zip(ret["d_m"], ret["kind"]) if kind == "point"]
-    if held and min(held) <= d <= max(held) and F >= hl["instrument_pull_off_N"]:
+    # the readout's largest tension is an interior state of the path (not a jump's fold),
+    # and the peak lies where the path holds the contact: the same maximum, sampled
+    i = int(np.argmax(ret["F_N"]))
+    if held and min(held) <= d <= max(held) and ret["kind"][i] == "point":
         hl["instrument_pull_off_N"] = float(F)
         ins["resolution"]["pull_off_N"] = 0.0
 
