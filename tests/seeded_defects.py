@@ -268,6 +268,9 @@ DEFECTS = [
     D("feature_gap_fraction", "feature gap: |P'| threshold 1e-3 instead of FEATURE_FRACTION",
       "femadh/discretisation/plan.py",
       (("stiff >= FEATURE_FRACTION * top", "stiff >= 1e-3 * top"),)),
+    D("tail_refines_h", "adaptive grid: a tail the capped disk cannot hold refines the spacing "
+      "in vain", "femadh/runner/adaptive.py",
+      (("        if tail_e > SAFETY * target:", "        if False:"),)),
     # -- the instrument in series with the contact
     D("instrument_z_sign", "instrument: drive z = d - F/k (the spring's force reversed)",
       "femadh/instrument/readout.py",

@@ -1,6 +1,7 @@
 """The adaptive discretisation: the banded grid family, its plan from the laws, the error
 estimate on its members, and the refine-until-met loop."""
 import copy
+from pathlib import Path
 import math
 
 import numpy as np
@@ -199,3 +200,24 @@ def test_a_failed_landing_refines_instead_of_refusing():
     assert steps[0]["status"] == "failed" and "landing" in steps[0]["refined_after"]
     assert steps[1]["spacing_m"] == pytest.approx(0.5 * steps[0]["spacing_m"], rel=1e-12)
     assert res.status == "converged" and res.accuracy["met"], res.error
+
+
+def test_a_tail_the_disk_cannot_hold_ends_the_run_not_the_budget():
+    """A 20-nm tip: its analysis radius stays below R, so the force beyond it (1.4e-3 of the
+    largest adhesion, measured) cannot shrink; refining the spacing would not help (the run
+    used to spend 5 runs and 170 s refining h in vain). It stops after its first run, saying
+    which part of the estimate and why, with its results kept."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:      # Python 3.10
+        import tomli as tomllib
+
+    from femadh.runner.contact import run
+    from femadh.scene import scene_from_dict
+
+    text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"
+            / "afm_tip_cantilever.toml").read_text().replace("\nnodes = 150", "\n")
+    res = run(scene_from_dict(tomllib.loads(text), "afm.toml", bare_numbers=False), None,
+              figures=False, progress=False)
+    assert res.status == "failed" and "cannot grow" in res.error
+    assert len(res.accuracy["steps"]) == 1 and res.branches["retract"]["d_m"].size > 0

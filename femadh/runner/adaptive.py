@@ -147,6 +147,19 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         err = grid_e + tail_e
         if err <= target:
             break
+        if tail_e > SAFETY * target:
+            # the force beyond the disk: a finer spacing cannot help, a larger disk can -
+            # unless it would reach the sphere's own size (eq 4's paraboloid is a sphere only
+            # for r << R; a small tip keeps its tail as F_tail and this part of the estimate)
+            cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
+            if 2 * family.radius < cap:
+                family = GridFamily(2 * family.radius, family.band, family.grading)
+                steps[-1]["tail_grew_radius"] = True
+                continue
+            failure = (f"the force beyond the analysis radius alone is {tail_e:.2g} relative "
+                       f"and the radius cannot grow (it would reach the sphere's radius "
+                       f"{scene.sphere.radius * 1e9:.4g} nm); the grid part is {grid_e:.2g}")
+            break
         factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
         h *= min(MAX_FACTOR, max(MIN_FACTOR, factor))
     met = bool(res is not None and res.status == "converged" and estimate is True and steps
