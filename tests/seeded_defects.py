@@ -290,6 +290,9 @@ DEFECTS = [
       "the branch it just left", "femadh/instrument/readout.py",
       (("abs(np.interp(dJ, q.d, q.F) - FJ) <= step_F:", "abs(np.interp(dJ, q.d, q.F) - FJ) "
         "<= -1.0:"),)),
+    D("mems_verdict_reversed", "MEMS verdict: stuck when the jump-out comes before the rest "
+      "gap", "femadh/runner/instrument.py",
+      (("return bool(z[folds[-1]] > rest_gap)", "return bool(z[folds[-1]] < rest_gap)"),)),
     D("bridge_factor", "fixed-fixed bridge: 12 E w t^3 / L^3 instead of 16",
       "femadh/instrument/spring.py",
       (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),

@@ -341,3 +341,28 @@ def test_the_warnings_name_the_sharpened_jump():
     assert f"approach jump at z = {hl['instrument_jump_in_z_m'] * 1e9:.6g} nm" in inst[0]
     assert f"retract jump at z = {hl['instrument_jump_out_z_m'] * 1e9:.6g} nm" in inst[0]
     assert 4e-9 < hl["instrument_jump_in_z_m"] < 4.5e-9
+
+
+def test_mems_verdict_of_a_continuous_peel_off():
+    """A suspension stiffer than the contact everywhere never jumps: the part peels off as the
+    base rises, and the verdict is where it hangs with its base at the rest gap g - near
+    contact (the adhesion balancing k (g - d): stuck) or near g (free); not traced up to g:
+    no verdict."""
+    from femadh.runner.instrument import mems_verdict
+
+    g, k = 1e-6, 100.0
+    z = np.array([-0.2, 0.5, 1.0, 1.5]) * g
+
+    def path(d):
+        d = np.array(d) * g
+        return {"z_m": z, "d_m": d, "F_N": k * (z - d), "kind": ["point"] * 4}
+    assert mems_verdict(path([-0.2, 0.002, 0.004, 1.2]), g, k) is True
+    assert mems_verdict(path([-0.2, 0.45, 0.97, 1.49]), g, k) is False
+    # not traced up to z = g: still pulling at least k g / 2 at its end (unknown), or less
+    # (the laws only decay beyond: too weak to hold it within g / 2 of contact: free)
+    assert mems_verdict(path([-0.2, 0.002, 0.004, 0.005]), 2 * g, k) is None
+    assert mems_verdict(path([-0.2, 0.002, 0.004, 1.2]), 2 * g, k) is False
+    # a jump-out decides exactly: beyond g stuck, short of it free
+    jump = {"z_m": np.array([0.0, 0.8, 0.8]) * g, "d_m": np.array([0.0, 0.001, 0.8]) * g,
+            "F_N": np.array([0.0, 0.799, 0.0]) * g * k, "kind": ["point", "fold", "land"]}
+    assert mems_verdict(jump, g, k) is False and mems_verdict(jump, 0.7 * g, k) is True

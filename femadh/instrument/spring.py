@@ -36,8 +36,8 @@ class Spring:
         The beam's length, width, thickness (m) and youngs_modulus (Pa).
     rest_gap : float or None
         Where the suspension holds the part at rest (m, the base position z at rest): a MEMS
-        part stuck to the flat frees itself iff the instrument lets go before z comes back
-        to it (its jump-out z is below the rest gap).
+        part stuck to the flat frees itself iff the instrument lets go (jumps out or peels
+        off) before z comes back to it (:func:`femadh.runner.instrument.mems_verdict`).
     """
 
     stiffness: float

@@ -57,13 +57,51 @@ def instrument_numbers(res, spring, branches=None):
                             "[sweep] stop")
     out = {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
     if spring.rest_gap is not None:
-        # the MEMS verdict: stuck iff the instrument still holds the contact when its base is
-        # back at the rest gap (no jump-out: it peels off continuously, never stuck)
+        stuck = mems_verdict(ip.paths.get("retract"), spring.rest_gap, spring.stiffness)
+        if stuck is None:
+            res.warnings.append("instrument: the retract ends before the suspension's base is "
+                                f"back at its rest gap ({spring.rest_gap * 1e9:.4g} nm): no "
+                                "verdict; extend [sweep] start")
+        else:
+            out["instrument_stuck"] = float(stuck)
         z_out = hl.get("jump_out_z_m")
-        out["instrument_stuck"] = float(z_out is not None and z_out > spring.rest_gap)
         if z_out is not None:
             out["instrument_release_margin_m"] = float(z_out - spring.rest_gap)
     return out
+
+
+#: a part held closer than this fraction of the rest gap, with its base at the rest gap, is
+#: stuck (a free part hangs near the rest gap, a stuck one at contact: the two differ by ~g)
+STUCK_FRACTION = 0.5
+
+
+def mems_verdict(retract, rest_gap, stiffness):
+    """Whether a part pressed into contact stays stuck when its suspension's base is back at
+    the rest gap g. If the instrument's retract jumps out, exactly when the jump-out z lies
+    beyond g (the restoring force k (g - d) never beats the adhesion before). If it peels off
+    continuously (a suspension stiffer than the contact anywhere), by where it is at z = g:
+    near contact (d < STUCK_FRACTION g, the adhesion balancing k (g - d)) rather than near g;
+    if the trace ends short of z = g pulling less than (1 - STUCK_FRACTION) k g, free (beyond
+    it the surface laws only decay, too weak to hold the part near contact). Else None."""
+    if retract is None or not len(retract["z_m"]):
+        return None
+    z, d, kind = retract["z_m"], retract["d_m"], retract["kind"]
+    folds = [i for i, k in enumerate(kind) if k == "fold"]
+    if folds:
+        return bool(z[folds[-1]] > rest_gap)
+    reach = np.flatnonzero(z >= rest_gap)
+    if not reach.size:
+        # every traced state pulls less than k (g - d) would need at z = g; beyond the trace
+        # the surface laws only decay, so a pull of F_end < (1 - STUCK_FRACTION) k g cannot
+        # hold the part within STUCK_FRACTION g of contact there
+        if abs(retract["F_N"][-1]) < (1 - STUCK_FRACTION) * stiffness * rest_gap:
+            return False
+        return None
+    i = int(reach[0])
+    if i == 0:
+        return bool(d[0] < STUCK_FRACTION * rest_gap)
+    t = (rest_gap - z[i - 1]) / (z[i] - z[i - 1]) if z[i] > z[i - 1] else 1.0
+    return bool(d[i - 1] + t * (d[i] - d[i - 1]) < STUCK_FRACTION * rest_gap)
 
 
 def refine_instrument(scene, res, problem, sink):

@@ -77,7 +77,8 @@ def _instrument_lines(res):
         out.append(f"MEMS verdict: {'STUCK' if hl['instrument_stuck'] else 'free'} at rest gap "
                    f"{g * 1e9:.4g} nm (restoring force k g = {_force(k * g)}"
                    + (f", jump-out at z = {hl['instrument_jump_out_z_m'] * 1e9:.4g} nm)"
-                      if "instrument_jump_out_z_m" in hl else ", no jump-out: it peels off)"))
+                      if "instrument_jump_out_z_m" in hl else ", no jump-out: it peels off "
+                      "continuously)"))
     if "instrument_hysteresis_J" in hl:
         e = hl.get("instrument_hysteresis_J_error")
         out.append(f"instrument hysteresis {hl['instrument_hysteresis_J']:.4g}"

@@ -45,9 +45,10 @@ INSTRUMENT = Table("instrument", "The spring in series with the contact: an AFM 
         "thickness, youngs_modulus }: k = 16 E w t^3 / L^3.", default=None,
         parse=_beam("bridge"), expect="a table { length, width, thickness, youngs_modulus }"),
     Key("rest_gap", "length", "Where the suspension holds the part at rest (the base z at "
-        "rest, a separation). With it the run gives the MEMS verdict: a part once stuck frees "
-        "itself iff the instrument jumps out before z returns to the rest gap (jump-out z < "
-        "rest_gap); else the restoring force k (rest_gap - d) never beats the adhesion.",
+        "rest, a separation). With it the run gives the MEMS verdict: a part pressed into "
+        "contact stays stuck iff, with its base back at the rest gap, the instrument still "
+        "holds it near contact (the adhesion balancing k (rest_gap - d)) - it has not jumped "
+        "out, nor peeled off, before z returned to the rest gap.",
         default=None, lo=0.0),
 ))
 
