@@ -292,7 +292,14 @@ DEFECTS = [
         "<= -1.0:"),)),
     D("mems_verdict_reversed", "MEMS verdict: stuck when the jump-out comes before the rest "
       "gap", "femadh/runner/instrument.py",
-      (("return bool(z[folds[-1]] > rest_gap)", "return bool(z[folds[-1]] < rest_gap)"),)),
+      (("    if folds and i <= folds[-1]:", "    if folds and i > folds[-1]:"),)),
+    D("instrument_fresh_duplicates", "instrument: fresh states solved where the branch has "
+      "one already (read as a turn of z)", "femadh/runner/instrument.py",
+      (("if np.any(np.abs(have - d) <= 1e-6 * (hi - lo)):", "if False:"),)),
+    D("instrument_pull_off_exact", "instrument: the pull-off from the peak search claimed "
+      "exact (resolution 0)", "femadh/runner/instrument.py",
+      (("ins[\"resolution\"][\"pull_off_N\"] = max(abs(F - sampled),",
+        "ins[\"resolution\"][\"pull_off_N\"] = 0 * max(abs(F - sampled),"),)),
     D("bridge_factor", "fixed-fixed bridge: 12 E w t^3 / L^3 instead of 16",
       "femadh/instrument/spring.py",
       (("return 16.0 * youngs_modulus", "return 12.0 * youngs_modulus"),)),

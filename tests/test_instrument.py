@@ -251,6 +251,14 @@ def test_a_stepped_sigma_gap_run_is_read_and_sharpened():
     order = np.argsort(c["d_m"])
     tail = float(np.interp(hl["d_at_max_adhesion_m"], c["d_m"][order], c["F_tail_N"][order]))
     assert hl["instrument_pull_off_N"] == pytest.approx(hl["max_adhesion_N"] + tail, rel=1e-4)
+    # that is one reading of the maximum; the path's own states give another, and their
+    # difference is the pull-off's resolution: never zero
+    assert res.instrument["resolution"]["pull_off_N"] > 0
+    for b in ("approach", "retract"):
+        p = res.instrument["paths"][b]
+        held = np.array([x for x, kind in zip(p["d_m"], p["kind"]) if kind == "point"])
+        # fresh states never repeat a computed one (two states at one d read as a turn)
+        assert np.all(np.diff(held) != 0), b
     for b in ("approach", "retract"):
         p = res.instrument["paths"][b]
         i = p["kind"].index("fold")
@@ -366,3 +374,50 @@ def test_mems_verdict_of_a_continuous_peel_off():
     jump = {"z_m": np.array([0.0, 0.8, 0.8]) * g, "d_m": np.array([0.0, 0.001, 0.8]) * g,
             "F_N": np.array([0.0, 0.799, 0.0]) * g * k, "kind": ["point", "fold", "land"]}
     assert mems_verdict(jump, g, k) is False and mems_verdict(jump, 0.7 * g, k) is True
+
+
+def test_a_spring_softer_than_the_contact_at_the_start_reads_no_jump_in():
+    """Fig 3 on a 3000 N/m spring: at the sweep's start (2 nm) the contact already pulls with
+    a stiffness beyond k, so the instrument's jump-in lies farther out than the sweep: it is
+    not read (a bound is no number) and a warning names the key to extend."""
+    from conftest import fig3_uniform_text
+
+    text = fig3_uniform_text().replace("nodes = 200", "nodes = 60").replace(
+        "[output]", '[instrument]\nstiffness = "3000 N/m"\n\n[output]')
+    res = run(scene_from_text(text), None, figures=False, progress=False, estimate=False)
+    assert "instrument_jump_in_d_m" not in res.headline
+    assert "instrument_jump_out_z_m" in res.headline
+    assert any("already softer than the contact" in w and "[sweep] start" in w
+               for w in res.warnings)
+
+
+def test_mems_verdict_after_a_jump_onto_a_longer_range_hold():
+    """A jump-out that lands on a state still held near contact (a meniscus holding after the
+    LJ contact let go) is no release: at z = g the part hangs at 0.02 g - stuck."""
+    from femadh.runner.instrument import mems_verdict
+
+    g, k = 1e-6, 100.0
+    path = {"z_m": np.array([0.0, 0.3, 0.3, 0.6, 1.2]) * g,
+            "d_m": np.array([0.0, 0.001, 0.01, 0.015, 0.025]) * g,
+            "kind": ["point", "fold", "land", "point", "point"]}
+    path["F_N"] = k * (path["z_m"] - path["d_m"])
+    assert mems_verdict(path, g, k) is True
+
+
+def test_jump_in_read_on_a_coarse_sweep_agrees_with_a_fine_one_within_its_resolution():
+    """The mu = 2 sphere stepped in d every 0.2 nm and every 0.02 nm (80 nodes, 3000 N/m): the
+    coarse sweep's jump-in d and z, read through fresh states at z's turn, agree with the fine
+    sweep's within 3x the sum of their readout resolutions (measured 0.03x and 0.0001x; a fresh
+    state repeating a computed one used to stop the walk early: 6.5x)."""
+    text = open(MU2).read().replace('continuation = "arclength"', "").replace(
+        "nodes = 150", "nodes = 80").replace(
+        "[output]", '[instrument]\nstiffness = "3000 N/m"\n\n[output]')
+    read = {}
+    for step in ("0.2 nm", "0.02 nm"):
+        sc = scene_from_text(text.replace('step = "0.1 nm"', f'step = "{step}"'))
+        res = run(sc, None, figures=False, progress=False, estimate="peak")
+        read[step] = res.headline, res.instrument["resolution"]
+    (hc, rc), (hf, rf) = read["0.2 nm"], read["0.02 nm"]
+    for name in ("jump_in_d_m", "jump_in_z_m"):
+        diff = abs(hc[f"instrument_{name}"] - hf[f"instrument_{name}"])
+        assert diff <= 3 * (rc[name] + rf[name]), name

@@ -251,17 +251,24 @@ def write_instrument(folder, res):
     rows = [INSTRUMENT_HEADER]
     visited = {}
     for b, p in ins["paths"].items():
-        for z, d, F, kind in zip(p["z_m"], p["d_m"], p["F_N"], p["kind"]):
+        for z, d, F, kind, of in zip(p["z_m"], p["d_m"], p["F_N"], p["kind"], p["branch_of"]):
             rows.append([b, _g(z), _g(d), _g(F), kind])
             if kind == "point":
-                visited[(b, float(d))] = float(F)
+                # keyed by the branch whose state it is: after a landing, the approach path
+                # may walk the retract's trace of the contact branch (and vice versa)
+                visited[(of, float(d))] = float(F)
     write_atomic(folder / "instrument.csv", csv_text(rows))
     path = folder / "curve.csv"
     with open(path, newline="") as f:
         table = list(csv.reader(f))
-    if not table or "z_m" in table[0]:
+    if not table:
         return
     head = table[0]
+    if "z_m" in head:
+        # a resumed run appended rows without them: recompute both columns for every row
+        keep = [i for i, h in enumerate(head) if h not in ("z_m", "F_instrument_N")]
+        table = [[r[i] for i in keep if i < len(r)] for r in table]
+        head = table[0]
     ib, idd, iF = head.index("branch"), head.index("d_m"), head.index("F_ex_N")
     it = head.index("F_tail_N") if "F_tail_N" in head else None
     out = [head + ["z_m", "F_instrument_N"]]

@@ -46,19 +46,30 @@ def instrument_numbers(res, spring, branches=None):
     if ip.incomplete:
         res.warnings.append(f"instrument: {ip.incomplete}")
     app = ip.paths.get("approach")
-    if app is not None and len(app["kind"]) > 1 and app["kind"][1] == "fold":
+    early = app is not None and len(app["kind"]) > 1 and app["kind"][1] == "fold"
+    if early:
+        # its jump-in lies before the sweep's first state: not read (a bound is no number)
+        for name in ("jump_in_d_m", "jump_in_z_m"):
+            hl.pop(name, None)
         res.warnings.append("instrument: the spring is already softer than the contact at the "
                             f"sweep's start (d = {app['d_m'][0] * 1e9:.4g} nm): it jumps in "
-                            "from farther out; extend [sweep] start")
+                            "from farther out, not read; extend [sweep] start")
     if app is not None and not any(j["branch"] == "approach" for j in ip.jumps) \
             and app["F_N"][-1] > 0:
         res.warnings.append("instrument: the drive never presses the contact (its deepest "
                             f"state is still in tension, F = {app['F_N'][-1]:.4g} N): extend "
                             "[sweep] stop")
+    if directions == ("retract",):
+        # a retract-only sweep runs from start up to stop: its far end is [sweep] stop
+        res.warnings[:] = [w.replace("extend [sweep] start", "extend [sweep] stop")
+                           if w.startswith("instrument:") else w for w in res.warnings]
     out = {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
     if spring.rest_gap is not None:
         stuck = mems_verdict(ip.paths.get("retract"), spring.rest_gap, spring.stiffness)
-        if stuck is None:
+        if "retract" not in ip.paths:
+            res.warnings.append("instrument: no verdict without a retract: add 'retract' to "
+                                "[sweep] directions")
+        elif stuck is None:
             res.warnings.append("instrument: the retract ends before the suspension's base is "
                                 f"back at its rest gap ({spring.rest_gap * 1e9:.4g} nm): no "
                                 "verdict; extend [sweep] start")
@@ -77,27 +88,27 @@ STUCK_FRACTION = 0.5
 
 def mems_verdict(retract, rest_gap, stiffness):
     """Whether a part pressed into contact stays stuck when its suspension's base is back at
-    the rest gap g. If the instrument's retract jumps out, exactly when the jump-out z lies
-    beyond g (the restoring force k (g - d) never beats the adhesion before). If it peels off
-    continuously (a suspension stiffer than the contact anywhere), by where it is at z = g:
-    near contact (d < STUCK_FRACTION g, the adhesion balancing k (g - d)) rather than near g;
-    if the trace ends short of z = g pulling less than (1 - STUCK_FRACTION) k g, free (beyond
-    it the surface laws only decay, too weak to hold the part near contact). Else None."""
+    the rest gap g: where the instrument's retract path is at z = g (its drive order: a jump
+    keeps z) - still before its last jump-out (the restoring force k (g - d) has not beaten the
+    adhesion yet), or near contact (d < STUCK_FRACTION g, the adhesion balancing k (g - d), as
+    after a peel-off without a jump or a landing on a longer-range hold). A path that ends in a
+    jump-out short of g is free (it landed beyond the traced separations); one that ends short
+    of g pulling less than (1 - STUCK_FRACTION) k g is free too (beyond the trace the surface
+    laws only decay: too weak to hold it near contact). Else None: trace further."""
     if retract is None or not len(retract["z_m"]):
         return None
     z, d, kind = retract["z_m"], retract["d_m"], retract["kind"]
     folds = [i for i, k in enumerate(kind) if k == "fold"]
-    if folds:
-        return bool(z[folds[-1]] > rest_gap)
     reach = np.flatnonzero(z >= rest_gap)
     if not reach.size:
-        # every traced state pulls less than k (g - d) would need at z = g; beyond the trace
-        # the surface laws only decay, so a pull of F_end < (1 - STUCK_FRACTION) k g cannot
-        # hold the part within STUCK_FRACTION g of contact there
+        if folds and folds[-1] == len(kind) - 1:
+            return False
         if abs(retract["F_N"][-1]) < (1 - STUCK_FRACTION) * stiffness * rest_gap:
             return False
         return None
     i = int(reach[0])
+    if folds and i <= folds[-1]:
+        return True                  # z = g comes before the last jump-out: still held
     if i == 0:
         return bool(d[0] < STUCK_FRACTION * rest_gap)
     t = (rest_gap - z[i - 1]) / (z[i] - z[i - 1]) if z[i] > z[i - 1] else 1.0
@@ -156,7 +167,12 @@ def refine_instrument(scene, res, problem, sink):
             a, b = at(branch, lo), at(branch, hi)
             if a is None or b is None:
                 continue
+            have = np.asarray(rows[branch]["d_m"], float)
             for d in np.linspace(lo, hi, REFINE_STATES + 2)[1:-1]:
+                # a fresh state where the branch has one already would read as a turn of z
+                # (two states at one d): the bracket's middle is often a computed state
+                if np.any(np.abs(have - d) <= 1e-6 * (hi - lo)):
+                    continue
                 st = state_between(problem, a, b, float(d), scene)
                 if st is None:
                     continue
@@ -204,8 +220,12 @@ def _pull_off_at_the_peak(res, problem):
     # and the peak lies where the path holds the contact: the same maximum, sampled
     i = int(np.argmax(ret["F_N"]))
     if held and min(held) <= d <= max(held) and ret["kind"][i] == "point":
+        # the two readings of one maximum (the path's states, the bounded search) differ by
+        # at least their errors: that difference is the pull-off's resolution, never zero
+        sampled = hl["instrument_pull_off_N"]
         hl["instrument_pull_off_N"] = float(F)
-        ins["resolution"]["pull_off_N"] = 0.0
+        ins["resolution"]["pull_off_N"] = max(abs(F - sampled),
+                                              ins["resolution"].get("pull_off_N", 0.0))
 
 
 def _resolved(hl, target, step):
