@@ -284,8 +284,8 @@ DEFECTS = [
         "while 0 <= nxt < len(p.d) and True and"),)),
     D("instrument_landing_force", "instrument: the landing's force taken at the state before "
       "it, not interpolated", "femadh/instrument/readout.py",
-      (("best = (gap, q, a, dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))",
-        "best = (gap, q, a, dL, q.F[a])"),)),
+      (("best = (gap, q, int(a), dL, q.F[a] + t * (q.F[a + 1] - q.F[a]))",
+        "best = (gap, q, int(a), dL, q.F[a])"),)),
     D("instrument_lands_on_its_branch", "instrument: a landing allowed on another trace of "
       "the branch it just left", "femadh/instrument/readout.py",
       (("abs(np.interp(dJ, q.d, q.F) - FJ) <= step_F:", "abs(np.interp(dJ, q.d, q.F) - FJ) "
