@@ -53,7 +53,7 @@ def test_feature_gap_of_lj_is_its_h4_softening():
     lj = LennardJones(1e-19, 0.165e-9)
     sigma = 1e-9
     H = feature_gap({"lj": lj}, sigma)
-    assert H == pytest.approx(sigma * plan_mod.FEATURE_FRACTION ** -0.25, rel=0.01)
+    assert H == pytest.approx(sigma * plan_mod.FEATURE_FRACTION ** -0.25, rel=0.01, abs=0)
 
 
 def test_tail_radius_is_the_smallest_doubling_that_meets_its_share():
@@ -76,12 +76,12 @@ def test_envelope_estimate_of_an_oscillating_sequence():
     r, p = 1.5, 1.5
     fine, coarse, coarser = {"q": 1.0}, {"q": 1.001}, {"q": 0.99}
     est = discretisation(fine, coarse, coarser, ratio=r)["q"]
-    assert est == pytest.approx(-max(0.001, 0.011 / r**p) / (r**p - 1), rel=1e-12)
+    assert est == pytest.approx(-max(0.001, 0.011 / r**p) / (r**p - 1), rel=1e-12, abs=0)
     # monotone: Richardson with the observed order (here 1.36), capped at the envelope order
     est2 = discretisation({"q": 1.0}, {"q": 1.01}, {"q": 1.0275}, ratio=r)["q"]
     p_obs = math.log(0.0175 / 0.01) / math.log(r)
     assert 1 < p_obs < 1.5
-    assert est2 == pytest.approx(-0.01 / (r**p_obs - 1), rel=1e-12)
+    assert est2 == pytest.approx(-0.01 / (r**p_obs - 1), rel=1e-12, abs=0)
 
 
 @pytest.fixture(scope="module")
@@ -108,7 +108,7 @@ def test_adaptive_run_meets_its_target_against_a_finer_member(fig3_adaptive):
     # the estimate's members: the same family at r h and r^2 h
     r = res.grid["member_ratio"]
     assert res.grid["member_spacings_m"] == pytest.approx(
-        [r * last["spacing_m"], r * r * last["spacing_m"]], rel=1e-9)
+        [r * last["spacing_m"], r * r * last["spacing_m"]], rel=1e-9, abs=0)
     for q in ("max_adhesion_N", "F_LJ_deepest_N"):
         true = abs(res.headline[q] - ref.headline[q])
         est = res.headline[q + "_error"]
@@ -198,7 +198,7 @@ def test_a_failed_landing_refines_instead_of_refusing():
     res = femadh.run(sc, progress=False)
     steps = res.accuracy["steps"]
     assert steps[0]["status"] == "failed" and "landing" in steps[0]["refined_after"]
-    assert steps[1]["spacing_m"] == pytest.approx(0.5 * steps[0]["spacing_m"], rel=1e-12)
+    assert steps[1]["spacing_m"] == pytest.approx(0.5 * steps[0]["spacing_m"], rel=1e-12, abs=0)
     assert res.status == "converged" and res.accuracy["met"], res.error
 
 

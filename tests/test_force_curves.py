@@ -148,12 +148,12 @@ def test_measured_contact_point_and_jump():
     z = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0]) * 1e-9
     f = np.array([3.0, 1.0, -1.0, -1.2, 0.1, -0.1])
     br = np.array(["approach"] * 6)
-    assert measured_contact(ForceCurve(z, f, br)) == pytest.approx(2.5e-9)
+    assert measured_contact(ForceCurve(z, f, br)) == pytest.approx(2.5e-9, rel=1e-6, abs=0)
     assert np.isnan(measured_contact(ForceCurve(z, -f, br)))
     f = np.array([-0.1, -0.2, -0.3, -5.0, -5.1, -5.2])
     (jump,) = measured_jumps(ForceCurve(z, f, br))
     assert jump[0] == "approach" and jump[2:] == (-0.3, -5.0)
-    assert jump[1] == pytest.approx(3.5e-9, rel=1e-12)
+    assert jump[1] == pytest.approx(3.5e-9, rel=1e-12, abs=0)
     assert measured_jumps(ForceCurve(z, np.linspace(0, 1, 6), br)) == []
 
 
@@ -180,7 +180,7 @@ def test_compare_writes_the_figure_and_reports_the_noise(fig3, tmp_path, capsys)
                  "--out", str(out), "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert 0.6 < rep["rms_residual_N"] / fig3.sigma < 1.4
-    assert rep["z_offset_m"] == pytest.approx(OFFSET_TRUE, rel=5e-3)
+    assert rep["z_offset_m"] == pytest.approx(OFFSET_TRUE, rel=5e-3, abs=0)
     assert rep["outside_simulated_range"] == 0 and rep["points"] == 2 * N_BRANCH
     for name in ("compare.png", "compare.csv", "compare.json"):
         assert (out / name).stat().st_size > 0
@@ -203,7 +203,7 @@ def test_fit_recovers_the_hamaker_constant(fig3):
     assert 0.002 < s / A_TRUE < 0.02
     assert abs(r.values[1] - OFFSET_TRUE) < 3 * r.stderr[1]
     assert r.keys == ["effects.lennard_jones.hamaker", "z_offset_m"]
-    assert r.rms == pytest.approx(np.sqrt(r.rss / r.n)) and r.runs <= 30
+    assert r.rms == pytest.approx(np.sqrt(r.rss / r.n), rel=1e-6, abs=0) and r.runs <= 30
     noisier = ForceCurve(fig3.curve.z, fig3.clean + 2 * (fig3.curve.force - fig3.clean),
                          fig3.curve.branch, "synthetic x2")
     r2 = fit_curve(fig3.scene, noisier, ["effects.lennard_jones.hamaker"], workers=1)
