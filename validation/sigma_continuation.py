@@ -10,7 +10,6 @@ import time
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
 
 from femadh.contact import trace  # noqa: E402
 from femadh.contact.forces import state_forces  # noqa: E402

@@ -404,20 +404,11 @@ def trace_sigma_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w
         step = max(step, ds_min)
         # the first constraint the tangent reaches, and the end of the sweep
         event, s_event = None, math.inf
-        closing = r_gap < 0
-        if np.any(closing):
-            s = np.where(closing, -np.maximum(gaps, 0.0) / np.where(closing, r_gap, 1.0),
-                         np.inf)
-            k = int(np.argmin(s))
-            if s[k] < s_event:
-                event, s_event = ("gap", int(pc.I[k])), float(s[k])
-        falling = r_lam < 0
-        if np.any(falling):
-            s = np.where(falling, -np.maximum(lams, 0.0) / np.where(falling, r_lam, 1.0),
-                         np.inf)
-            k = int(np.argmin(s))
-            if s[k] < s_event:
-                event, s_event = ("lambda", int(pc.A[k])), float(s[k])
+        for kind, values, rates, nodes in (("gap", gaps, r_gap, pc.I),
+                                           ("lambda", lams, r_lam, pc.A)):
+            k, s = _first_zero(values, rates)
+            if s < s_event:
+                event, s_event = (kind, int(nodes[k])), s
         if p.t_d * direction > 0 and (d_end - p.d) * direction >= 0:
             s = (d_end - p.d) / (p.t_d * scale)
             if s < s_event:
@@ -596,3 +587,14 @@ def path_w_at(curve, direction, d):
             if (pts[a].d - d) * (pts[a + 1].d - d) < 0:
                 return curve.point_at(a, d)
     return None
+
+
+def _first_zero(values, rates):
+    """(index, arclength) of the first of ``values`` (kept >= 0) that falls to zero along the
+    tangent at ``rates`` (linear), or (None, inf) if none falls."""
+    falling = rates < 0
+    if not np.any(falling):
+        return None, math.inf
+    s = np.where(falling, -np.maximum(values, 0.0) / np.where(falling, rates, 1.0), np.inf)
+    k = int(np.argmin(s))
+    return k, float(s[k])

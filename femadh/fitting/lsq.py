@@ -28,7 +28,6 @@ or a correlation beyond +-0.999 - is a :class:`FitError` naming it, not a number
 """
 from dataclasses import dataclass, field
 import math
-import os
 import time
 
 import numpy as np

@@ -82,23 +82,11 @@ class InstrumentPath:
         return "; ".join(p["incomplete"] for p in self.paths.values() if p["incomplete"]) \
             or None
 
-    def brackets(self, which=("turn", "land", "peak")):
-        """The intervals between computed states (branch, d_lo, d_hi) where the readout
-        interpolates: z's turning points ("turn": the jumps' positions and snap-off), the
-        landings ("land": where a jump ends, in the hysteresis) and the largest tension of the
-        retract path ("peak": the pull-off). Fresh states there sharpen it
-        (:func:`femadh.runner.instrument.refine_instrument`)."""
-        out = [b for j in self.jumps for kind, b in zip(("turn", "land"), j.get("brackets", ()))
-               if kind in which]
-        ret = self.paths.get("retract")
-        if "peak" in which and ret is not None and len(ret["F_N"]) > 2:
-            i = int(np.argmax(ret["F_N"]))
-            nb = [m for m in (i - 1, i, i + 1) if 0 <= m < len(ret["F_N"])
-                  and ret["kind"][m] == "point" and ret["branch_of"][m] == ret["branch_of"][i]]
-            if len(nb) > 1 and ret["kind"][i] == "point":
-                ds = ret["d_m"][nb]
-                out.append((ret["branch_of"][i], float(ds.min()), float(ds.max())))
-        return out
+    def brackets(self):
+        """The intervals between computed states (branch, d_lo, d_hi) around z's turning
+        points, where the readout interpolates the jumps' positions and the snap-off. Fresh
+        states there sharpen it (:func:`femadh.runner.instrument.refine_instrument`)."""
+        return [j["turn"] for j in self.jumps]
 
     def headline(self):
         """The numbers the instrument records (SI), and their readout resolution as
@@ -283,7 +271,7 @@ def _walk(pieces, k, branch, cols):
             # the jump is read; where it lands lies beyond the traced separations
             rows.append((zJ, dJ, FJ, "fold", p.branch))
             jumps.append(_jump(branch, zJ, dJ, math.nan, FJ, math.nan, rz, rd, rF, 0.0))
-            jumps[-1]["brackets"] = [turn]
+            jumps[-1]["turn"] = turn
             end = "start" if s > 0 else "stop"
             incomplete = (f"the instrument's {branch} jump at z = {zJ * 1e9:.6g} nm (d = "
                           f"{dJ * 1e9:.6g} nm, F = {FJ:.4g} N) lands beyond the traced "
@@ -297,7 +285,7 @@ def _walk(pieces, k, branch, cols):
             rows.append((zJ, dL, FL, "land", q.branch))
             jumps.append(_jump(branch, zJ, dJ, dL, FJ, FL, rz, rd, rF,
                                _landing_error(q, a, dL)))
-            jumps[-1]["brackets"] = [turn, (q.branch, q.d[a], q.d[a + 1])]
+            jumps[-1]["turn"] = turn
         else:
             rows.append((zJ, dL, FL, "seam", q.branch))
         # go on from the landing, on segment [a, a+1] of piece q, toward the drive's direction

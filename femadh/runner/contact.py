@@ -448,12 +448,12 @@ def _curve_state(problem, d, w, stable):
 def _trace_arclength(scene, problem, sink):
     """Trace the scene's equilibrium curve by arclength (every point streamed to
     equilibrium_curve.csv), then its displacement-controlled paths as branches."""
-    from ..contact.arclength import trace_curve
-
-    make_state = _curve_state
     if problem.sigma is not None:     # the sigma-gap's piecewise curve (its own states)
         from ..contact.sigma_arclength import curve_state as make_state
-        from ..contact.sigma_arclength import trace_sigma_curve as trace_curve
+        from ..contact.sigma_arclength import trace_sigma_curve as trace
+    else:
+        from ..contact.arclength import trace_curve as trace
+        make_state = _curve_state
     d = scene.d_values
     step = abs(d[1] - d[0])
     curve_rows = []
@@ -465,7 +465,7 @@ def _trace_arclength(scene, problem, sink):
             sink.writer.write_curve_point(i, point, st)
         interrupt.check()
     try:
-        curve = trace_curve(problem, d[0], d[-1], tol=scene.tolerance, scale=step, ds=1.0,
+        curve = trace(problem, d[0], d[-1], tol=scene.tolerance, scale=step, ds=1.0,
                             ds_max=1.0, on_point=on_point)
     finally:
         sink.result.equilibrium_curve = {

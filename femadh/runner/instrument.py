@@ -124,6 +124,7 @@ def refine_instrument(scene, res, problem, sink):
     states). Updates ``res.headline`` and ``res.instrument``; returns the fresh states'
     count."""
     from ..contact.forces import state_forces, tail_force
+    from ..instrument import read_instrument
     from .estimates import state_between
 
     spring = scene.instrument
@@ -149,7 +150,6 @@ def refine_instrument(scene, res, problem, sink):
         return next((st for st in pool.get(branch, ()) if st.d == d), None)
 
     for _ in range(REFINE_ROUNDS):
-        from ..instrument import read_instrument
         try:
             ip = read_instrument(arrays(), res.jumps, spring.stiffness,
                                  tuple(b for b in ("approach", "retract") if b in rows))
@@ -160,7 +160,7 @@ def refine_instrument(scene, res, problem, sink):
         added = 0
         # the turning points only: the pull-off is the run's own peak (below), a landing's
         # interpolation enters no headline number but the hysteresis, judged by its estimate
-        for branch, lo, hi in ip.brackets(("turn",)):
+        for branch, lo, hi in ip.brackets():
             if (branch, lo, hi) in done or hi - lo <= REFINE_MIN_FRACTION * step:
                 continue
             done.add((branch, lo, hi))

@@ -195,6 +195,8 @@ def instrument_summary(res):
         out["verdict"] = "stuck" if res.headline["instrument_stuck"] else "free"
         if "instrument_release_margin_m" in res.headline:
             out["release_margin_m"] = res.headline["instrument_release_margin_m"]
-    out["jumps"] = res.instrument["jumps"]
+    # each jump as recorded, less the readout's bookkeeping (the interval it refined)
+    out["jumps"] = [{k: v for k, v in j.items() if k != "turn"}
+                    for j in res.instrument["jumps"]]
     out["incomplete"] = res.instrument["incomplete"]
     return out
