@@ -26,6 +26,19 @@ def scene_from_dict(data, file=None):
 
 def run(scene, out_dir=None, **kwargs):
     """Solve a scene (writes into ``out_dir`` only if given); see
-    :func:`femadh.runner.contact.run`."""
+    :func:`femadh.runner.contact.run`.
+
+    A Ctrl-C stops the run at its next safe point (every completed state kept on disk,
+    ``summary.json`` says "interrupted", ``--resume`` continues it) and then raises
+    KeyboardInterrupt here, so that one Ctrl-C also stops a script's loop of runs (SIGTERM:
+    SystemExit with code 143)."""
+    import signal
+
     from .runner.contact import run as _run
-    return _run(scene, out_dir, **kwargs)
+    res = _run(scene, out_dir, **kwargs)
+    if res.status == "interrupted":
+        if getattr(res, "exit_code", 130) == 128 + signal.SIGTERM:
+            raise SystemExit(res.exit_code)
+        raise KeyboardInterrupt(f"{res.error}: the states computed before it are kept"
+                                + (f" in {res.out_dir}" if res.out_dir else ""))
+    return res

@@ -343,3 +343,30 @@ def test_contact_commands_on_a_meniscus_scene(tmp_path, capsys, cmd):
     assert main(argv + ["--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("femadh: error:") == 1 and "a contact scene" in err
+
+
+def test_one_ctrl_c_stops_a_python_loop_of_runs(tmp_path):
+    """In a script, Ctrl-C stops the current run at a safe point (its states kept, its summary
+    'interrupted') and then reaches the script as KeyboardInterrupt: one Ctrl-C ends a loop
+    of runs instead of only the run it fell into."""
+    scene = long_scene(tmp_path)
+    script = tmp_path / "loop.py"
+    script.write_text(
+        "import femadh\n"
+        f"sc = femadh.load_scene({str(scene)!r})\n"
+        "try:\n"
+        "    for i in range(5):\n"
+        f"        femadh.run(sc, {str(tmp_path)!r} + f'/run{{i}}', estimate=False,\n"
+        "                   figures=False, progress=False)\n"
+        "        print('run', i, 'done', flush=True)\n"
+        "except KeyboardInterrupt as exc:\n"
+        "    print('stopped:', exc, flush=True)\n")
+    p = subprocess.Popen([sys.executable, str(script)], cwd=ROOT, env=ENV,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wait_rows(tmp_path / "run0", 20, p)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert "stopped: interrupted by SIGINT" in out and "run 1 done" not in out, out + err
+    assert json.loads((tmp_path / "run0" / "summary.json").read_text())["status"] == \
+        "interrupted"
+    assert not (tmp_path / "run1").exists()
