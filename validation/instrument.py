@@ -128,7 +128,7 @@ def main(argv=None):
                      f"{f(hy, 1, '.4g')} | {f(ours, 1, '.3f')} | {jkr:.3f} | {note} |")
     lines += ["", "A soft spring's loop reaches beyond the traced separations (the jump-out "
               "lands ~F/k above the sweep's start): its hysteresis is not reported (a warning "
-              "says which [sweep] end to extend)."]
+              "says past which separation to extend the sweep)."]
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "instrument.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

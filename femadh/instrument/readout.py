@@ -272,11 +272,12 @@ def _walk(pieces, k, branch, cols):
             rows.append((zJ, dJ, FJ, "fold", p.branch))
             jumps.append(_jump(branch, zJ, dJ, math.nan, FJ, math.nan, rz, rd, rF, 0.0))
             jumps[-1]["turn"] = turn
-            end = "start" if s > 0 else "stop"
+            ends = [q.d[-1] if s > 0 else q.d[0] for q in pieces]
+            edge = max(ends) if s > 0 else min(ends)
             incomplete = (f"the instrument's {branch} jump at z = {zJ * 1e9:.6g} nm (d = "
                           f"{dJ * 1e9:.6g} nm, F = {FJ:.4g} N) lands beyond the traced "
-                          f"separations: extend [sweep] {end} to see where (the instrument's "
-                          "hysteresis is not reported)")
+                          f"separations: extend the sweep past d = {edge * 1e9:.4g} nm to see "
+                          "where (the instrument's hysteresis is not reported)")
             break
         if kind == "fold":
             # the landing's interpolation error: the line against the parabola through the

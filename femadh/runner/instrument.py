@@ -59,10 +59,6 @@ def instrument_numbers(res, spring, branches=None):
         res.warnings.append("instrument: the drive never presses the contact (its deepest "
                             f"state is still in tension, F = {app['F_N'][-1]:.4g} N): extend "
                             "[sweep] stop")
-    if directions == ("retract",):
-        # a retract-only sweep runs from start up to stop: its far end is [sweep] stop
-        res.warnings[:] = [w.replace("extend [sweep] start", "extend [sweep] stop")
-                           if w.startswith("instrument:") else w for w in res.warnings]
     out = {f"instrument_{k}": float(v) for k, v in hl.items() if k in INSTRUMENT_NUMBERS}
     if spring.rest_gap is not None:
         stuck = mems_verdict(ip.paths.get("retract"), spring.rest_gap, spring.stiffness)
@@ -70,9 +66,11 @@ def instrument_numbers(res, spring, branches=None):
             res.warnings.append("instrument: no verdict without a retract: add 'retract' to "
                                 "[sweep] directions")
         elif stuck is None:
+            # the retract's far end: [sweep] stop for a retract-only sweep, else start
+            far = "stop" if directions == ("retract",) else "start"
             res.warnings.append("instrument: the retract ends before the suspension's base is "
                                 f"back at its rest gap ({spring.rest_gap * 1e9:.4g} nm): no "
-                                "verdict; extend [sweep] start")
+                                f"verdict; extend [sweep] {far}")
         else:
             out["instrument_stuck"] = float(stuck)
         z_out = hl.get("jump_out_z_m")
