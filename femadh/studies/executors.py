@@ -181,7 +181,12 @@ def _worker_init():
 
 
 def _pool_init():
+    """Set-up of a local pool worker: a Ctrl-C in the terminal reaches every process of the
+    group; an idle worker ignores it (the driver stops it with SIGTERM, without a
+    KeyboardInterrupt traceback), while a run in progress takes it at its next safe point
+    (the run installs its own handlers and restores this one)."""
     _worker_init()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 _MALLOC_TUNED = False
@@ -290,6 +295,8 @@ def _execute_pool(todo, out, workers, estimate, stop, notes):
         queue, broken = [], False
         try:
             pending = set(futures)
+            # no iteration budget: each pass waits POLL_S at most and every future ends
+            # (a result, or BrokenProcessPool when a worker dies)
             while pending:
                 procs.update(getattr(ex, "_processes", None) or {})
                 if stop:
@@ -401,6 +408,22 @@ def _read_record(out, pid):
         return None
 
 
+@contextmanager
+def _children_ignore_sigint():
+    """Processes started in this block ignore SIGINT (an ignored signal stays ignored across
+    exec, and Python then installs no KeyboardInterrupt handler): a Ctrl-C in the terminal,
+    which reaches the whole process group, is the driver's to act on; Dask's nannies and
+    workers would otherwise each die with a KeyboardInterrupt traceback."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
 def _execute_dask(todo, out, scheduler, estimate, stop):
     try:
         from distributed import Client, LocalCluster, as_completed
@@ -410,8 +433,13 @@ def _execute_dask(todo, out, scheduler, estimate, stop):
     cluster = None
     if scheduler.startswith("local:"):
         n = int(scheduler.split(":", 1)[1])
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+        import logging
+
+        # silence_logs: the workers' warnings about the futures a signal cancels are no
+        # news to the user (the study says what it kept); errors still show
+        with _children_ignore_sigint():
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
         client = Client(cluster)
     else:
         client = Client(scheduler)
@@ -422,6 +450,8 @@ def _execute_dask(todo, out, scheduler, estimate, stop):
         by_key = {f.key: p for f, p in zip(futures, todo)}
         ac = as_completed(futures)
         left = len(futures)
+        # no iteration budget: each pass either takes finished futures or sleeps POLL_S,
+        # and every future ends (a result, an error, KilledWorker after Dask's retries)
         while left:
             if stop:
                 client.cancel(futures)
