@@ -78,9 +78,14 @@ def _parser():
                        description="Run every combination of the --vary values (or the "
                                    "scene's [study] table) and write study.csv, study.png and "
                                    "points/<id>/ (one run folder and record per point). "
-                                   "Running it again computes only the missing points.",
-                       epilog="VALUES: '0.5 nm,1 nm,2 nm' | 'lo..hi:n' | 'lo..hi:n:log', "
-                              "e.g. --vary effects.asperity_gap.sigma='0.3 nm..2 nm:10'")
+                                   "Running it again reuses the finished points and runs the "
+                                   "interrupted, crashed and missing ones. Exit 3 when points "
+                                   "failed (one line per reason); 130/143 on SIGINT/SIGTERM "
+                                   "(finished points kept).",
+                       epilog="VALUES: '0.5 nm,1 nm,2 nm' | 'lo..hi:n' | 'lo..hi:n:log', with "
+                              "units as in a scene file (a bare number is refused for a "
+                              "dimensional key), e.g. --vary "
+                              "effects.asperity_gap.sigma='0.3 nm..2 nm:10'")
     sw.add_argument("scene", help="scene file (TOML)")
     sw.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
                     help="a dotted scene key and its values (repeatable)")

@@ -34,7 +34,7 @@ from ..io.atomic import write_atomic
 from ..io.study_table import study_figure, write_table
 from .executors import (HEADLINE, _OPERATORS, _jsonable, _operator_key,  # noqa: F401
                         _tune_malloc, _worker_init, driver_signals, execute, finished,
-                        run_point)
+                        run_point, write_record)
 from .values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
 
 
@@ -201,12 +201,26 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         finally:
             if bar is not None:
                 bar.close()
+        for p in todo:
+            if p.id not in result.records or not _outcome(result.records[p.id]):
+                # an executor that ends without a point's outcome is a fault, never a row
+                # silently missing from the table: the point fails, unfinished (run again)
+                rec = {"id": p.id, "index": p.index, "changes": p.changes,
+                       "status": "failed", "finished": False,
+                       "error": "the study's executor ended without running this point"}
+                write_record(out / "points" / p.id, rec)
+                result.records[p.id] = rec
         write_table(points, result.records, out)
         result.figure = study_figure(points, result.records, out, quantity)
         result.failed = [result.records[p.id] for p in points
                          if result.records.get(p.id, {}).get("status") != "converged"]
         _timing(out, result, t0)
     return result
+
+
+def _outcome(rec):
+    """Whether a record holds an outcome (not a point still "running" or "interrupted")."""
+    return rec.get("status") in ("converged", "failed")
 
 
 def _timing(out, result, t0):
