@@ -1,0 +1,111 @@
+"""What a user sees: the progress display (one over a whole run, phases named, a sane width,
+quiet in pipes), the printed headline (one largest-adhesion number, notes in plain words),
+the figure files and the regime table."""
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from femadh.io import progress
+from femadh.runner.contact import run
+from validation.paper1 import scene as paper1_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class _Tty(io.StringIO):
+    """A stderr that says it is a terminal (of ``cols`` columns via COLUMNS)."""
+
+    def isatty(self):
+        return True
+
+    def fileno(self):
+        raise OSError("no file descriptor")
+
+
+def _small(sigma="0.5 nm", n=60):
+    sc = paper1_scene("paper1_fig3", n, sigma=sigma)
+    data = dict(sc.raw)
+    data["sweep"] = {"start": "1.6 nm", "stop": "0 nm", "step": "0.2 nm",
+                     "directions": ["approach", "retract"]}
+    from femadh.scene import scene_from_dict
+
+    return scene_from_dict(data, "test")
+
+
+def test_progress_is_quiet_when_stderr_is_not_a_terminal(capsys):
+    """A run in a pipe (pytest's captured stderr is no terminal) prints nothing on stderr."""
+    res = run(_small(sigma="1 nm", n=40))
+    assert res.status == "converged"
+    assert capsys.readouterr().err == ""
+
+
+def test_one_display_names_every_phase_of_a_run(monkeypatch):
+    """In a terminal a run shows one display whose label walks through the phases: the
+    operator, both branches with their counts, the estimate members (nested runs report into
+    the same display, no second bar), the peak search; the terminal reports 0 columns, so the
+    width is COLUMNS."""
+    tty = _Tty()
+    monkeypatch.setattr("sys.stderr", tty)
+    monkeypatch.setenv("COLUMNS", "120")
+    res = run(_small(sigma="1 nm", n=40), progress=True)
+    assert res.status == "converged"
+    text = re.sub(r"\x1b\[[0-9;]*[A-Za-z]", "", tty.getvalue())
+    labels = [p.strip() for p in re.split(r"[\r\n]", text) if p.strip()]
+    joined = "\n".join(labels)
+    for phase in ("› operator", "› approach: ", "› retract: ", "› estimate: N = 20",
+                  "› estimate: N = 20 › approach", "› estimate: N = 10", "› peak search"):
+        assert phase in joined, phase
+    assert all(lb.startswith("paper1-fig3") for lb in labels)   # one display, the run's name
+    assert max(len(lb) for lb in labels) <= 120             # the width it was given
+    assert progress._active is None                          # closed at the end
+
+
+def test_width_falls_back_when_the_terminal_reports_zero(monkeypatch):
+    monkeypatch.delenv("COLUMNS", raising=False)
+    assert progress.width(_Tty()) == progress.FALLBACK_COLUMNS == 80
+    monkeypatch.setenv("COLUMNS", "0")
+    assert progress.width(_Tty()) == 80
+
+
+def test_phase_and_advance_are_no_ops_without_a_display():
+    with progress.phase("anything"):
+        progress.begin("approach", 3)
+        progress.advance()
+    assert progress._active is None
+
+
+def test_headline_prints_one_max_adhesion_number_with_its_error():
+    """One 'max adhesion' line, with its ±; the branch lines count states and jumps and
+    carry no second (grid) adhesion value; lengths print in µm, not um."""
+    from femadh.runner.report import headline_lines
+
+    res = run(_small(n=100))
+    lines = headline_lines(res)
+    adhesion = [ln for ln in lines if "adhesion" in ln]
+    assert len(adhesion) == 1 and adhesion[0].startswith("max adhesion ") and "±" in adhesion[0]
+    assert re.match(r"approach: \d+ states from d = 1.6 nm to 0 nm, 1 jump$", lines[0])
+    assert not any(re.search(r"\bum\b", ln) for ln in lines)
+    # the N = 50 member stalls at this sigma (measured): its note says what that means
+    notes = [ln for ln in lines if ln.startswith("note: ")]
+    assert len(notes) == 1 and "member did not converge" in notes[0] and len(notes[0]) < 250
+
+
+def test_a_failed_estimate_member_is_a_note_in_plain_words():
+    """The note names the member, its reason's first clause, where the error comes from
+    instead (or that it lacks the grid part), in one short line."""
+    from femadh.runner.estimates import member_note
+    from femadh.runner.report import NOTE
+
+    long_error = ("continuation stalled at d = 1.1 nm: Newton residual 3e-09 m after 60 "
+                  "iterations (tolerance 1e-19 m); the landing after the fold could not be "
+                  "polished, a finer grid or a smaller step may help " * 2)
+    note = member_note("N = 50", long_error, "N = 200", ["N = 100"])
+    assert note.startswith(NOTE)
+    assert ("the N = 50 member did not converge (continuation stalled at d = 1.1 nm); the "
+            "grid error is taken from N = 200 and N = 100") in note
+    assert len(note) < 220                       # the old warning was 280+ characters
+    none = member_note("N = 100", long_error, "N = 200", [])
+    assert "lack the grid part" in none and "lower bounds" in none
