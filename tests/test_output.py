@@ -109,3 +109,36 @@ def test_a_failed_estimate_member_is_a_note_in_plain_words():
     assert len(note) < 220                       # the old warning was 280+ characters
     none = member_note("N = 100", long_error, "N = 200", [])
     assert "lack the grid part" in none and "lower bounds" in none
+
+
+def test_figures_are_named_for_what_they_show_and_the_loop_is_visible(tmp_path):
+    """A sigma-gap run with jumps writes force_curve.png and profiles_and_forces.png (no
+    fig3_panels.png); the hysteresis panel spans both folds, and each jump is at least a
+    quarter of its height (on the whole curve it is ~1 % of the force scale)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from femadh.io.plots import _hysteresis_loop, _with_folds, contact_figures, force_unit
+
+    res = run(_small(n=100), estimate="peak")
+    assert len(res.jumps) == 2
+    paths = contact_figures(res, tmp_path)
+    assert sorted(p.name for p in paths) == ["force_curve.png", "profiles_and_forces.png"]
+    assert all(p.stat().st_size > 20_000 for p in paths)
+    # the approach is drawn to its fold, broken, and continued from its landing
+    j = next(j for j in res.jumps if j["branch"] == "approach")
+    d, F = _with_folds(res, "approach", res.branches["approach"])
+    k = int(np.flatnonzero(d == j["d_fold_m"])[0])
+    assert F[k] == j["F_ex_before_N"] and np.isnan(d[k + 1]) and F[k + 2] == j["F_ex_after_N"]
+    assert np.all(np.diff(d[np.isfinite(d)]) <= 0)         # in the order it was traced
+    fig, ax = plt.subplots()
+    fs, _ = force_unit([res.headline["max_adhesion_N"]])
+    _hysteresis_loop(ax, res, fs, "µN")
+    lo, hi = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    for j in res.jumps:
+        assert lo < j["d_fold_m"] * 1e9 < hi
+        assert abs(j["F_ex_after_N"] - j["F_ex_before_N"]) * fs > 0.25 * (y1 - y0)
+    plt.close(fig)
