@@ -79,7 +79,8 @@ def render_run(run_dir, *, state=-1, field="von_mises", png=None, zoom=1.5):
     for branch in ("approach", "retract"):
         if (run_dir / f"{branch}.pvd").exists():
             entries += _pvd_entries(run_dir / f"{branch}.pvd")
-    hits = [rel for t, rel in entries if int(t) == state]
+    # a listed file that is gone (deleted by hand) is exported again
+    hits = [rel for t, rel in entries if int(t) == state and (run_dir / rel).exists()]
     if hits:
         rel = hits[0]
     else:
