@@ -23,7 +23,7 @@ from . import interrupt
 from .estimates import GuardError
 from .result import ContactResult
 from .result import contact_summary as summary
-from ..io.progress import advance, begin, phase
+from ..io.progress import advance, begin, display, phase
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
@@ -80,8 +80,6 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
                             overwrite=overwrite)
     if progress is None:
         progress = sys.stderr.isatty()
-    from ..io.progress import display
-
     with blas_threads(), display(scene.name, progress):
         if getattr(scene, "adaptive", False):
             from .adaptive import run_adaptive
