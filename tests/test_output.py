@@ -135,8 +135,9 @@ def test_figures_are_named_for_what_they_show_and_the_loop_is_visible(tmp_path):
     assert np.all(np.diff(d[np.isfinite(d)]) <= 0)         # in the order it was traced
     fig, ax = plt.subplots()
     fs, _ = force_unit([res.headline["max_adhesion_N"]])
-    _hysteresis_loop(ax, res, fs, "µN")
+    lo_m, hi_m = _hysteresis_loop(ax, res, fs, "µN")
     lo, hi = ax.get_xlim()
+    assert (lo, hi) == pytest.approx((lo_m * 1e9, hi_m * 1e9))   # the strip on the main axes
     y0, y1 = ax.get_ylim()
     for j in res.jumps:
         assert lo < j["d_fold_m"] * 1e9 < hi

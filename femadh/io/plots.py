@@ -200,16 +200,13 @@ def force_curve(res, path):
     ax.grid(alpha=0.3)
     if loop:
         zoom = fig.add_axes([0.545, 0.1, 0.25, 0.83])
-        _hysteresis_loop(zoom, res, fs, fl)
-        # where the zoom is on the whole curve
-        from matplotlib.patches import Rectangle
-
-        (x0, x1), (y0, y1) = zoom.get_xlim(), zoom.get_ylim()
-        lz = length_unit([abs(x) for x in zoom.get_xlim()])[0]
-        x0, x1 = x0 / lz * ls, x1 / lz * ls
-        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="0.3", lw=0.8))
-        ax.annotate("zoom →", xy=(x1, y1), xytext=(3, 3), textcoords="offset points",
-                    fontsize=7, color="0.3")
+        lo, hi = _hysteresis_loop(zoom, res, fs, fl)
+        # where the zoom is on the whole curve: a shaded strip of its separations (its
+        # force range is a few percent of this axis' and would not show as a box)
+        ax.axvspan(lo * ls, hi * ls, color="0.88", zorder=0)
+        ax.annotate("zoom →", xy=(hi * ls, 0.97), xycoords=("data", "axes fraction"),
+                    xytext=(3, 0), textcoords="offset points", fontsize=7, color="0.3",
+                    va="top")
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.805, 0.93),
                   bbox_transform=fig.transFigure, borderaxespad=0)
         ax.set_title(ax.get_title(), fontsize=10)
@@ -257,7 +254,8 @@ def _jump_arrows(ax, res, fs, ls, lw=1.2):
 def _hysteresis_loop(ax, res, fs, fl):
     """The loop between the jumps, zoomed: x from the first to the last fold padded by a
     sweep step (or the folds' spread), y over what both branches do there; the computed
-    states marked, the folds crossed, the jumps as arrows, the loop shaded."""
+    states marked, the folds crossed, the jumps as arrows, the loop shaded. Returns the
+    zoom's separation range (m)."""
     folds = [j["d_fold_m"] for j in res.jumps] + [j["d_land_m"] for j in res.jumps]
     lo, hi = min(folds), max(folds)
     d_all = np.concatenate([c["d_m"] for c in res.branches.values()])
@@ -304,6 +302,7 @@ def _hysteresis_loop(ax, res, fs, fl):
     ax.plot([], [], color="0.3", marker=r"$\rightarrow$", ls="", ms=12, label="jump")
     ax.legend(fontsize=7, loc="best")
     ax.grid(alpha=0.3)
+    return lo, hi
 
 
 def _finite_sorted(d, F):
