@@ -360,8 +360,12 @@ def _regime(args):
             f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
             if say else None, accuracy=args.accuracy or None, **kw)
         path = write_regime(pts, args.out)
-    print(path.read_text(), end="")
-    print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")
+    from .studies.regime import regime_table
+
+    # people get the short table; every column (errors, grids, timings) is in the csv
+    print(regime_table(pts))
+    print(f"results in {args.out}: {path.name} (every column), regime_map.png, "
+          f"regime_curves.png ({sum(p.wall_time for p in pts):.1f} s)")
     return 0
 
 

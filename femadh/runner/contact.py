@@ -23,6 +23,7 @@ from . import interrupt
 from .estimates import GuardError
 from .result import ContactResult
 from .result import contact_summary as summary
+from ..io.progress import advance, begin, display, phase
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
@@ -79,7 +80,7 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
                             overwrite=overwrite)
     if progress is None:
         progress = sys.stderr.isatty()
-    with blas_threads():
+    with blas_threads(), display(scene.name, progress):
         if getattr(scene, "adaptive", False):
             from .adaptive import run_adaptive
 
@@ -100,7 +101,8 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
             if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
                 from ..io.plots import contact_figures
 
-                res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
+                with phase("figures"):
+                    res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
                 folder.write_summary(summary(res))
             return res
 
@@ -138,7 +140,9 @@ def _timed(fn):
 def _run(scene, folder, *, progress, operator=None, estimate=True):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
-    say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
+    from ..io.progress import note
+
+    say = note if progress else None
     resuming = folder is not None and folder.previous
     resume = _resume_point(folder) if resuming and scene.continuation != "arclength" else None
     if resuming and scene.continuation == "arclength":
@@ -159,7 +163,8 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
             if folder is not None:
                 folder.write_summary(summary(res, status="running"))
             t1 = time.perf_counter()
-            problem = build_problem(scene, operator=operator, progress=say)
+            with phase("operator"):
+                problem = build_problem(scene, operator=operator, progress=say)
             res.timings["operator_s"] = time.perf_counter() - t1
             res.nodes = problem.grid.nodes.copy()
             g = problem.grid
@@ -216,7 +221,8 @@ def _finish(scene, res, problem, sink, estimate):
     t1 = time.perf_counter()
     res.headline = headline(res, problem)
     if estimate:
-        half = refine_peak(scene, res, problem, sink)
+        with phase("peak search"):
+            half = refine_peak(scene, res, problem, sink)
         if getattr(scene, "instrument", None) is not None and res.instrument is not None:
             from .instrument import refine_instrument
 
@@ -257,12 +263,7 @@ class Sink:
         """A branch of n states begins: which of them keep their surface profile."""
         self.profile_picks[branch] = set(np.linspace(0, n - 1, min(n, PROFILES)).round()
                                          .astype(int))
-        if self.progress:
-            from ..io.progress import bar
-
-            if self.bar is not None:
-                self.bar.close()
-            self.bar = bar(n, f"{self.result.name} {branch}")
+        begin(branch, n)        # the run's display, if one is shown
 
     def state(self, branch, st):
         from .estimates import check_state
@@ -282,8 +283,7 @@ class Sink:
         rows.append([float(v) if not isinstance(v, bool) else v for v in self._row(st)])
         if self.writer:
             self.writer.write_state(branch, st)
-        if self.bar is not None:
-            self.bar.update(1)
+        advance()
         self._publish(branch)
         interrupt.check()
 

@@ -148,8 +148,9 @@ SWEEP = Table("sweep", "The separations d of the sphere tip above the undeformed
 
 OUTPUT = Table("output", "Outputs.", (
     Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
-    Key("vtk", "bool", "VTK volume and surface files per state (FE only; default: true for "
-        "FE).", default=None),
+    Key("vtk", "bool", "VTK volume and surface files of every state as it converges (FE only; "
+        "default false: `femadh render RUN_DIR --state K` writes and draws the states you ask "
+        "for from fields.csv).", default=None),
 ))
 
 #: the largest Poisson ratio the FE body takes (its mixed formulation eliminates the pressure
@@ -385,7 +386,9 @@ def parse_contact(reader, data, file):
     if layers and method != "fe":
         reader.fail("solver.method", method, "\"fe\" for a layered substrate ([substrate] "
                     "layers): the Green function is the homogeneous half-space's")
-    vtk = ou["vtk"] if ou["vtk"] is not None else method == "fe"
+    # off by default: the body's fields cost ~1.2 s to set up and ~20 ms a state
+    # (validation/results/fe_pace.md); `femadh render` exports the states a user asks for
+    vtk = bool(ou["vtk"])
     if vtk is True and method != "fe":
         reader.fail("output.vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
                     "operator has no interior field to write)")
