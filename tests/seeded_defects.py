@@ -199,7 +199,7 @@ DEFECTS = [
       "femadh/scene/build.py",
       (("layers=scene.layers, sphere=scene.slider)", "layers=scene.layers, sphere=None)"),)),
     D("hankel_sphere_twice", "Hankel layered operator: the sphere's compliance counted twice",
-      "femadh/elastic/hankel.py",
+      "femadh/judges.py",
       (("+ GreenOperator(grid, sphere.plane_strain_modulus).compliance)",
         "+ 2 * GreenOperator(grid, sphere.plane_strain_modulus).compliance)"),)),
     D("layered_estimate_mesh", "layered estimate: the 'coarser' mesh is the same mesh",

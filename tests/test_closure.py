@@ -312,10 +312,10 @@ def test_closure_reproduces_the_papers_fig8():
     digits (+-5 % is the reading accuracy); femadh 0.0483 and 0.1490 mN (N = 100 and 200
     agree to 3e-4)."""
     from validation.paper1 import closure_sweeps, max_adhesion
-    from validation.roughness import _slider
+    from validation.roughness import slider_scene
 
     for rho, paper in ((100, 0.05), (179, 0.151)):
-        sc = _slider("8.211e-20 J", rho=rho).replace({"solver.nodes": 100})
+        sc = slider_scene("8.211e-20 J", rho=rho).replace({"solver.nodes": 100})
         p, sweeps, err = closure_sweeps(sc)
         assert err is None
         value = max(max_adhesion(p, sw)[0] for sw in sweeps.values())

@@ -13,7 +13,7 @@ import pytest
 
 import femadh
 from femadh.elastic import RadialGrid
-from femadh.elastic.hankel import HankelLayeredOperator
+from femadh.judges import HankelLayeredOperator
 from femadh.errors import MeshResolutionWarning, SceneError
 from femadh.runner.contact import run
 from femadh.studies.sweep import study_points

@@ -178,7 +178,7 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
     import warnings
 
     from femadh.runner.contact import run
-    from validation.roughness import _slider
+    from validation.roughness import slider_scene
 
     from conftest import observed_order
 
@@ -188,15 +188,15 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
             return run(sc, progress=False, estimate=False).headline["max_adhesion_N"]
 
     n100 = {"solver.nodes": 100}
-    lim = pull_off(_slider(rho=179).replace(n100))
+    lim = pull_off(slider_scene(rho=179).replace(n100))
     widths = np.array([0.02, 0.01, 0.005])
-    excess = np.array([pull_off(_slider(rho=179, smoothing=w).replace(n100)) - lim
+    excess = np.array([pull_off(slider_scene(rho=179, smoothing=w).replace(n100)) - lim
                        for w in widths])
     assert np.all(excess > 0) and np.all(np.diff(excess) < 0)
     assert observed_order(widths, excess) == pytest.approx(1.6, abs=0.3)
     ns = np.array([100, 200, 400])
-    extra = np.array([pull_off(_slider(rho=179).replace({"solver.nodes": n}))
-                      - pull_off(_slider(rho=0).replace({"solver.nodes": n})) for n in ns])
+    extra = np.array([pull_off(slider_scene(rho=179).replace({"solver.nodes": n}))
+                      - pull_off(slider_scene(rho=0).replace({"solver.nodes": n})) for n in ns])
     assert np.all(extra > 0)
     assert observed_order(1.0 / ns, extra) > 0.8
-    assert extra[-1] < 0.1 * pull_off(_slider(rho=0).replace(n100))   # 7 % at N = 400
+    assert extra[-1] < 0.1 * pull_off(slider_scene(rho=0).replace(n100))   # 7 % at N = 400
