@@ -186,7 +186,8 @@ def test_closure_reproduces_paper_fig4(fig4_closure):
     p, a, r = fig4_closure
     f = np.array([state_forces(p, s)[2] for s in a.states])
     assert f.max() == pytest.approx(0.3e-3, rel=0.10)
-    assert f.max() == pytest.approx(0.31095e-3, rel=2e-2)         # N = 100 vs 200: 1.7e-3
+    # the scene's N = 200 value at 2x its N-sensitivity (N = 100 vs 200: 1.7e-3)
+    assert f.max() == pytest.approx(0.31095e-3, rel=3.5e-3)
     rc = np.array([s.r_c for s in a.states])
     k = int(np.flatnonzero((f[:-1] > 0) & (f[1:] <= 0) & (rc[:-1] > 0))[0])
     r0 = rc[k] + f[k] / (f[k] - f[k + 1]) * (rc[k + 1] - rc[k])
