@@ -50,6 +50,7 @@ def test_rigid_sphere_limit_is_4_pi_R_gamma():
     assert errs[0] / errs[1] == pytest.approx(4.0, rel=0.05)
 
 
+@pytest.mark.slow
 def test_scene_with_capillary_writes_F_cap_and_includes_it_in_F_ex(tmp_path):
     import femadh
 

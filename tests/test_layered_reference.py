@@ -254,6 +254,7 @@ def test_quadrature_converged_under_refinement():
     assert rel_max(coarse.disk_displacement(r, A, P), fine.disk_displacement(r, A, P)) > 1e-10
 
 
+@pytest.mark.slow
 def test_remainder_matches_adaptive_scipy_quadrature():
     s = _bending_stack()
     scale = s.disk_displacement(0.0, A)

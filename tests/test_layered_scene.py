@@ -166,6 +166,7 @@ def mesh_triangles(sc):
     return len(read_mesh(cached_mesh(spec))[1])
 
 
+@pytest.mark.slow
 def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
     """The same scene on the Hankel-transform operator (no FE) differs only by the FE
     discretisation; the run's FE-mesh part estimates it. Measured (N = 100, soft 5-um layer):
@@ -195,6 +196,7 @@ def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
         assert abs(true) <= fe.headline[f"{k}_error"], k
 
 
+@pytest.mark.slow
 def test_a_softer_coating_lowers_the_contact_stiffness(tmp_path):
     """Physics through the CLI: a coating softer than the disk gives a smaller repulsive
     force at the deepest separation than the bare disk and a stiffer one a larger (the

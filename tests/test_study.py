@@ -43,6 +43,7 @@ def test_values_and_points_are_validated_before_anything_runs(tmp_path, capsys):
     assert not (tmp_path / "s" / "points").exists()
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_matches_the_process_pool_and_resumes(tmp_path):
     """4 points on a Dask LocalCluster of process workers and on the local pool: the same
     numbers to the last digit (same solver, same inputs); a rerun computes nothing."""
@@ -85,6 +86,7 @@ def test_killed_study_loses_no_completed_point(tmp_path):
     assert len(list(out.glob("points/*/record.json"))) == 6
 
 
+@pytest.mark.slow
 def test_results_are_light_and_picklable():
     """A result holds arrays and numbers only: the Fig 4 scene at N = 800 (in contact from
     d = -1 to -3 nm, 11 states a branch, the 12 surface profiles a branch keeps) pickles under
