@@ -113,8 +113,8 @@ def test_banded_family_members_are_at_the_ratio_richardson_uses():
     band = [float(g.nodes[1] - g.nodes[0]) for g in grids]
     assert len(band) == 3
     assert np.diff(np.log(band)) == pytest.approx([math.log(r)] * 2, rel=1e-6)
-    assert [g.radius for g in grids] == pytest.approx([25e-6] * 3, rel=1e-12)
-    assert all(g.fine_radius == pytest.approx(4e-6, rel=1e-3) for g in grids)
+    assert [g.radius for g in grids] == pytest.approx([25e-6] * 3, rel=1e-12, abs=0)
+    assert all(g.fine_radius == pytest.approx(4e-6, rel=1e-3, abs=0) for g in grids)
 
 
 # --------------------------------------------------------------------------- each part
@@ -158,7 +158,7 @@ def test_tail_part_is_the_laws_force_beyond_the_disk_at_the_quantitys_own_separa
     for k, d in (("max_adhesion_N", hl["d_at_max_adhesion_m"]),
                  ("F_LJ_deepest_N", hl["d_deepest_m"]), ("F_ex_deepest_N", hl["d_deepest_m"])):
         expect = -2 * math.pi * R * lj_energy(d + a * a / (2 * R))
-        assert res.estimates[k]["tail"] == pytest.approx(expect, rel=1e-9), k
+        assert res.estimates[k]["tail"] == pytest.approx(expect, rel=1e-9, abs=0), k
     assert hl["d_at_max_adhesion_m"] - hl["d_deepest_m"] > 5e-9   # the two d are apart
 
 
@@ -171,7 +171,7 @@ def test_tolerance_part_is_what_the_tolerance_moves_on_the_disk(wide_disk):
     stiff = HAMAKER / (2 * math.pi * sigma**4) * abs(1 - 3 * s)
     for k in ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N"):
         assert res.estimates[k]["tolerance"] == pytest.approx(
-            math.pi * a * a * tol * stiff, rel=1e-9), k
+            math.pi * a * a * tol * stiff, rel=1e-9, abs=0), k
 
 
 def test_resolution_part_is_the_peak_searchs_bracket(wide_disk):
@@ -179,7 +179,7 @@ def test_resolution_part_is_the_peak_searchs_bracket(wide_disk):
     steps, 0.4 nm) to 1e-4 of that bracket: its resolution part is 4e-14 m."""
     res, _ = wide_disk
     assert res.estimates["d_at_max_adhesion_m"]["resolution"] == pytest.approx(
-        1e-4 * 2 * 0.2e-9, rel=1e-6)
+        1e-4 * 2 * 0.2e-9, rel=1e-6, abs=0)
 
 
 def test_total_is_the_sum_of_the_parts_magnitudes(wide_disk):
@@ -191,7 +191,7 @@ def test_total_is_the_sum_of_the_parts_magnitudes(wide_disk):
     assert comp["grid"] < 0 < comp["tail"]         # the case a signed sum gets wrong
     for k, comp in res.estimates.items():
         parts = [v for name, v in comp.items() if name != "total"]
-        assert comp["total"] == pytest.approx(sum(abs(v) for v in parts), rel=1e-12), k
+        assert comp["total"] == pytest.approx(sum(abs(v) for v in parts), rel=1e-12, abs=0), k
         assert res.headline[f"{k}_error"] == comp["total"], k
 
 
@@ -233,7 +233,7 @@ def test_trapping_guard_on_both_sides_of_a_node_snapping_alone():
     check_state(pb, fake_state(pb, 0.0, gap_at(0.9)), None)
     with pytest.raises(TrappingError) as e:
         check_state(pb, fake_state(pb, 0.0, gap_at(1.1)), None)
-    assert e.value.ratio == pytest.approx(1.1, rel=1e-6)
+    assert e.value.ratio == pytest.approx(1.1, rel=1e-6, abs=0)
 
 
 def test_derjaguin_bound_guard_on_both_sides_of_the_bound_plus_the_error():

@@ -118,7 +118,7 @@ def test_scene_nu_limit_is_the_fe_bodys():
 
 def test_study_points_over_a_layer_thickness():
     pts = study_points(scene(), {"substrate.layers.0.thickness": "10 nm,100 nm,1 um"})
-    assert [p.scene.layers[0][0] for p in pts] == pytest.approx([1e-8, 1e-7, 1e-6], rel=1e-15)
+    assert [p.scene.layers[0][0] for p in pts] == pytest.approx([1e-8, 1e-7, 1e-6], rel=1e-15, abs=0)
     assert len({p.id for p in pts}) == 3
 
 
@@ -190,7 +190,7 @@ def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
     for k in ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N"):
         part = fe.estimates[k]["fe_mesh"]
         assert part == pytest.approx((fe.headline[k] - coarse.headline[k]) / (ratio**3 - 1),
-                                     rel=1e-9), k
+                                     rel=1e-9, abs=0), k
         true = ref.headline[k] - fe.headline[k]
         assert 0.5 <= part / true <= 5, (k, part / true)
         assert abs(true) <= fe.headline[f"{k}_error"], k
