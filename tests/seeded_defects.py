@@ -437,9 +437,6 @@ DEFECTS = [
       "femadh/contact/closure/trace.py",
       (("sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))",
         "sweep.jumps.append(Jump(branch, state.d, d_try, abs(grid_step), state, landed))"),)),
-    D("closure_transition_unchecked", "closure: a converged state on another branch accepted "
-      "as a step (no continuity check)", "femadh/contact/closure/trace.py",
-      (("and _continuous_transition(cs, state, new, tol, max_iter)):", "):"),)),
     D("arclength_unstable_folds_dropped", "arclength: only folds onto a stable piece recorded",
       "femadh/contact/arclength.py",
       (("        if folded:\n            fold.seg = tr.seg\n            curve.folds.append(fold)",

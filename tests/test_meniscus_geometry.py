@@ -16,10 +16,10 @@ def test_unit_geometry_sphere_points_and_smallest_filling_angle(D):
     (0, 1 + D), at (0, D) for phi = 0; below the flat (D < 0) the smallest filling angle puts
     it on the flat, z = 0 (and is 0 otherwise)."""
     geo = Geometry(-40.0, D)
-    assert geo.zc == pytest.approx(1.0 + D, rel=1e-15)
+    assert geo.zc == pytest.approx(1.0 + D, rel=1e-15, abs=0)
     for phi in (0.0, 0.2, 1.0):
         x, z = geo.sphere_point(phi)
-        assert math.hypot(x, z - (1 + D)) == pytest.approx(1.0, rel=1e-14)
+        assert math.hypot(x, z - (1 + D)) == pytest.approx(1.0, rel=1e-14, abs=0)
         assert x == pytest.approx(math.sin(phi), abs=1e-15)
     assert geo.sphere_point(0.0) == pytest.approx((0.0, D), abs=1e-15)
     if D < 0:

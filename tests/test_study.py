@@ -29,7 +29,7 @@ def small():
 
 def test_values_and_points_are_validated_before_anything_runs(tmp_path, capsys):
     assert parse_values("0.2 nm..2 nm:4") == ["0.2 nm", "0.8 nm", "1.4 nm", "2 nm"]
-    assert parse_values("1e-3..1e-1:3:log") == pytest.approx([1e-3, 1e-2, 1e-1], rel=1e-12)
+    assert parse_values("1e-3..1e-1:3:log") == pytest.approx([1e-3, 1e-2, 1e-1], rel=1e-12, abs=0)
     assert parse_values("100,200") == [100, 200]
     pts = study_points(small(), {"effects.asperity_gap.sigma": "0.5 nm,1 nm",
                                  "sphere.radius": "1 mm,2 mm"})
