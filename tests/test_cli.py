@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import femadh
 from femadh.cli import main
@@ -29,6 +30,7 @@ def test_keys_prints_the_reference(capsys):
     assert page.startswith("# Scene keys") and "## [effects.lennard_jones]" in page
 
 
+@pytest.mark.slow
 def test_render_an_fe_run_to_png(tmp_path):
     """femadh render on an FE run: a PNG of the deformed zone, read back: the size asked for
     and a picture (many distinct colours), not an empty canvas."""

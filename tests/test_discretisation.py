@@ -130,6 +130,7 @@ def test_adaptive_grid_is_much_smaller_than_the_uniform_it_beats(fig3_adaptive):
     assert res.grid["nodes"] < 200
 
 
+@pytest.mark.slow
 def test_trapping_caps_the_spacing_before_the_solve(monkeypatch):
     """A plan far too coarse for sigma = 0.5 nm (20 nodes across the band) is refined to
     the trapping-safe spacing before anything is solved, not refused: the run converges and
@@ -186,6 +187,7 @@ def test_grid_table_errors_are_one_line():
         scene_from_dict(raw, "s.toml", bare_numbers=False)
 
 
+@pytest.mark.slow
 def test_a_failed_landing_refines_instead_of_refusing():
     """The sigma = 0.5 nm slider's jump-out on a coarse member (the first member of a 0.1
     request, 24 nm band spacing): Newton cannot polish the landing after the fold (the

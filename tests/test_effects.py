@@ -32,11 +32,13 @@ def test_lj_identities():
     # scale of the law: A/z0^3 (Pa) and A/z0^4 (Pa/m); measured 0 and 5e-17 of them
     assert abs(LJ.pressure(Z0)) <= 1e-15 * HAMAKER / Z0**3                   # eq 3 at z0
     assert abs(LJ.dpressure(LJ.peak_gap)) <= 1e-15 * HAMAKER / Z0**4        # the peak
-    assert LJ.peak_gap == pytest.approx(0.198e-9, rel=1e-3)  # paper sec 5.1: 0.198 nm (3 digits)
-    assert -LJ.energy(Z0) == pytest.approx(HAMAKER / (16 * math.pi * Z0**2), rel=1e-14)  # eq 19
+    # paper sec 5.1: 0.198 nm (3 digits)
+    assert LJ.peak_gap == pytest.approx(0.198e-9, rel=1e-3, abs=0)
+    assert -LJ.energy(Z0) == pytest.approx(HAMAKER / (16 * math.pi * Z0**2), rel=1e-14,
+                                           abs=0)  # eq 19
     # far field: van der Waals A/(6 pi h^3) with the repulsive correction -(z0/h)^6 = -1e-12
     ratio = LJ.pressure(100 * Z0) / (HAMAKER / (6 * math.pi * (100 * Z0) ** 3))
-    assert ratio - 1 == pytest.approx(-1e-12, rel=1e-3)
+    assert ratio - 1 == pytest.approx(-1e-12, rel=1e-3, abs=0)
 
 
 def test_gap_rejects_unphysical():

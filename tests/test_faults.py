@@ -73,6 +73,7 @@ def csvrows(path):
         yield from csv.DictReader(f)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_signal_stops_cleanly_and_resume_completes(tmp_path, sig, code):
     scene = long_scene(tmp_path)
@@ -97,6 +98,7 @@ def test_signal_stops_cleanly_and_resume_completes(tmp_path, sig, code):
     assert_same_as_uninterrupted(scene, out)
 
 
+@pytest.mark.slow
 def test_fe_run_interrupted_keeps_its_vtk_consistent_and_resumes(tmp_path):
     """An FE run with VTK, stopped by SIGTERM and resumed: the .pvd collections list exactly
     the committed states (the resumed run keeps the earlier entries), every listed file
@@ -135,6 +137,7 @@ def test_fe_run_interrupted_keeps_its_vtk_consistent_and_resumes(tmp_path):
     assert_same_as_uninterrupted(scene, out)
 
 
+@pytest.mark.slow
 def test_arclength_run_interrupted_is_traced_again_on_resume(tmp_path):
     """An arclength trace stopped by SIGINT keeps its streamed points consistent; --resume
     traces the curve again from its start (its paths are read off the whole curve) and says
@@ -223,6 +226,7 @@ def test_whole_files_get_ordinary_permissions(tmp_path):
     assert (tmp_path / "b.vtu").stat().st_mode & 0o777 == mode
 
 
+@pytest.mark.slow
 def test_kill_9_loses_no_committed_state_and_resumes(tmp_path):
     scene = long_scene(tmp_path)
     out = tmp_path / "out"

@@ -190,6 +190,7 @@ def test_compare_writes_the_figure_and_reports_the_noise(fig3, tmp_path, capsys)
 
 # --------------------------------------------------------------------------- fit
 
+@pytest.mark.slow
 def test_fit_recovers_the_hamaker_constant(fig3):
     """Hamaker constant and offset from the 1 %-noise curve, starting at 1e-19 J (10 % off):
     within 2 % and 3 standard errors (measured: -0.15 %, 0.19 standard errors, the stderr

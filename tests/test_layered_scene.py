@@ -13,9 +13,10 @@ import pytest
 
 import femadh
 from femadh.elastic import RadialGrid
-from femadh.elastic.hankel import HankelLayeredOperator
+from femadh.judges import HankelLayeredOperator
 from femadh.errors import MeshResolutionWarning, SceneError
 from femadh.runner.contact import run
+from femadh.runner.estimates import variant
 from femadh.studies.sweep import study_points
 
 BASE = {
@@ -117,7 +118,7 @@ def test_scene_nu_limit_is_the_fe_bodys():
 
 def test_study_points_over_a_layer_thickness():
     pts = study_points(scene(), {"substrate.layers.0.thickness": "10 nm,100 nm,1 um"})
-    assert [p.scene.layers[0][0] for p in pts] == pytest.approx([1e-8, 1e-7, 1e-6], rel=1e-15)
+    assert [p.scene.layers[0][0] for p in pts] == pytest.approx([1e-8, 1e-7, 1e-6], rel=1e-15, abs=0)
     assert len({p.id for p in pts}) == 3
 
 
@@ -154,29 +155,48 @@ def test_layer_of_the_disk_material_is_the_homogeneous_green_solution():
         assert rl.headline[k] == pytest.approx(rg.headline[k], rel=1e-4), k  # 3x 3.6e-5
 
 
+def mesh_triangles(sc):
+    """Triangle count of a layered scene's FE mesh (built from its public mesh spec)."""
+    from femadh.elastic.fe.layers import as_layer
+    from femadh.elastic.fe.mesh import cached_mesh, read_mesh
+    from femadh.elastic.fe.operator import mesh_spec
+
+    spec = mesh_spec(RadialGrid.uniform(sc.analysis_radius, sc.nodes), sc.fe_settings,
+                     tuple(as_layer(x) for x in sc.layers), sc.disk)
+    return len(read_mesh(cached_mesh(spec))[1])
+
+
+@pytest.mark.slow
 def test_layered_run_estimates_bound_the_fe_error_against_the_hankel_operator():
     """The same scene on the Hankel-transform operator (no FE) differs only by the FE
-    discretisation; the run's estimated error covers it. Measured (N = 100, soft 5-um layer,
-    the coarser mesh 1.52x coarser by its triangle count): true |F_ex(-3 nm) difference|
-    1.9e-8 N vs estimated total 7.7e-7 N, fe_mesh part alone 7.6e-8 N (4x the true error);
-    max adhesion 1.8e-10 N vs fe_mesh 4.2e-10 N (total 3.7e-7 N: the grid part dominates)."""
+    discretisation; the run's FE-mesh part estimates it. Measured (N = 100, soft 5-um layer):
+    the next coarser mesh has 1950 triangles against 4530 (size ratio sqrt(4530/1950) = 1.524,
+    not the nominal 2); fe_mesh = (Q_fine - Q_coarse)/(1.524^3 - 1), signed like
+    Q_Hankel - Q_FE, with effectivity 2.35 (max adhesion), 4.35 (F_LJ), 3.97 (F_ex): asserted
+    inside accuracy.md's band [0.5, 5]. The total (7.7e-7 N for F_ex, 40x this FE error) adds
+    the grid part and the tail beyond the disk, which this comparison on the same nodes and
+    disk cannot see (they are judged on their own in tests/test_estimates.py)."""
     sc = scene()
     fe = quiet_run(sc)
     assert fe.status == "converged", fe.error
-    assert "fe_mesh" in fe.estimates["F_ex_deepest_N"]
     op = HankelLayeredOperator(RadialGrid.uniform(sc.analysis_radius, sc.nodes), sc.layers,
                                sc.disk, sc.slider)
     ref = quiet_run(sc, estimate="peak", operator=op)
+    coarse_scene = variant(sc, coarse_mesh=True)
+    coarse = quiet_run(coarse_scene, estimate="peak")
+    # the size ratio the Richardson step must use: h ~ n^(-1/2) of the triangle counts
+    ratio = (mesh_triangles(sc) / mesh_triangles(coarse_scene)) ** 0.5
+    assert 1.3 < ratio < 1.6                                         # measured 1.524
     for k in ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N"):
-        true = abs(fe.headline[k] - ref.headline[k])
-        assert true <= fe.headline[f"{k}_error"], (k, true, fe.headline[f"{k}_error"])
-    # and the mesh part alone is of the size of the true FE error (not a blanket bound)
-    # (measured ratios 4.0 for F_ex, 2.4 for max adhesion: an effectivity within [0.5, 10])
-    for k in ("F_ex_deepest_N", "max_adhesion_N"):
-        true = abs(fe.headline[k] - ref.headline[k])
-        assert 0.5 * true < abs(fe.estimates[k]["fe_mesh"]) < 10 * true, k
+        part = fe.estimates[k]["fe_mesh"]
+        assert part == pytest.approx((fe.headline[k] - coarse.headline[k]) / (ratio**3 - 1),
+                                     rel=1e-9, abs=0), k
+        true = ref.headline[k] - fe.headline[k]
+        assert 0.5 <= part / true <= 5, (k, part / true)
+        assert abs(true) <= fe.headline[f"{k}_error"], k
 
 
+@pytest.mark.slow
 def test_a_softer_coating_lowers_the_contact_stiffness(tmp_path):
     """Physics through the CLI: a coating softer than the disk gives a smaller repulsive
     force at the deepest separation than the bare disk and a stiffer one a larger (the

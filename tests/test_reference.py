@@ -76,10 +76,11 @@ def test_jkr_identities():
     # pull-off (load control) = 1.5 pi R dg at the minimum of the JKR load over a
     a = np.linspace(1e-9, 1e-7, 20001)
     loads = np.array([jkr_load(x, R, E, dg) for x in a])
-    assert -loads.min() == pytest.approx(jkr_pull_off(R, dg), rel=1e-6)
+    assert -loads.min() == pytest.approx(jkr_pull_off(R, dg), rel=1e-6, abs=0)
     # load-radius relation of paper 1 sec 4 is the inverse of jkr_load
     for x in (2e-8, 5e-8, 8e-8):  # the stable branch, beyond the pull-off radius 1.5e-8 m
-        assert jkr_contact_radius(jkr_load(x, R, E, dg), R, E, dg) == pytest.approx(x, rel=1e-9)
+        assert jkr_contact_radius(jkr_load(x, R, E, dg), R, E, dg) == pytest.approx(
+            x, rel=1e-9, abs=0)
     # load and approach in SI equal the JKR curve in Maugis' units (an independent form:
     # P = A^3 - sqrt(6 A^3), D = A^2 - (2/3) sqrt(6 A)); round-off only
     K = 4 * E / 3
@@ -88,7 +89,7 @@ def test_jkr_identities():
         P, D = jkr_curve(A)
         assert jkr_load(x, R, E, dg) / (math.pi * dg * R) == pytest.approx(float(P), rel=1e-12)
         D_si = jkr_approach(x, R, E, dg) * (K * K / (math.pi**2 * dg * dg * R)) ** (1 / 3)
-        assert D_si == pytest.approx(float(D), rel=1e-12)
+        assert D_si == pytest.approx(float(D), rel=1e-12, abs=0)
     # DMT: the contact closes exactly at the pull-off load -2 pi R dg and grows like F^(1/3)
     assert dmt_contact_radius(-2 * math.pi * R * dg, R, E, dg) == 0.0
     F1, F2 = 1e-7, 8e-7
@@ -105,13 +106,13 @@ def test_surface_energy_relations_eqs_17_19():
     lj = LennardJones(A, z0)
     for s in (z0, 1.5 * z0, 1e-9):
         assert surface_energy_from_hamaker(A, s, z0) == pytest.approx(-float(lj.energy(s)),
-                                                                      rel=1e-14)
+                                                                      rel=1e-14, abs=0)
     assert surface_energy_from_hamaker(A, z0, z0) == pytest.approx(A / (16 * math.pi * z0**2),
-                                                                   rel=1e-14)
+                                                                   rel=1e-14, abs=0)
     # eq 18: far from z0 the repulsive correction z0^6/(4 s^6) vanishes (2.5e-7 at 10 z0)
     s = 10 * z0
     assert surface_energy_from_hamaker(A, s, z0) / (A / (12 * math.pi * s**2)) - 1 == \
-        pytest.approx(-0.25e-6, rel=1e-6)
+        pytest.approx(-0.25e-6, rel=1e-6, abs=0)
     assert lj_dugdale_lambda(1.0) == pytest.approx(1.16, abs=0.005)  # Johnson & Greenwood 1997
 
 
@@ -123,6 +124,6 @@ def test_tabor_parameter_scales_with_its_definition():
     for i, factor in enumerate((2.0, 4.0, 0.25, 0.125)):   # R^1/3, dg^2/3, E*^-2/3, z0^-1
         args = list(base)
         args[i] *= 8
-        assert tabor_parameter(*args) == pytest.approx(mu0 * factor, rel=1e-13)
+        assert tabor_parameter(*args) == pytest.approx(mu0 * factor, rel=1e-13, abs=0)
     neck = (base[0] * base[1] ** 2 / base[2] ** 2) ** (1 / 3)
-    assert mu0 == pytest.approx(neck / base[3], rel=1e-14)
+    assert mu0 == pytest.approx(neck / base[3], rel=1e-14, abs=0)

@@ -24,7 +24,7 @@ def test_lj82_derivatives_by_finite_differences_and_its_minimum():
     scale = np.max(np.abs(law.pressure(h)))
     assert np.max(np.abs(fd_p - law.pressure(h))) < 1e-8 * scale
     assert np.max(np.abs(fd_dp - law.dpressure(h))) < 1e-8 * np.max(np.abs(law.dpressure(h)))
-    assert law.energy(0.3e-9) == pytest.approx(-0.05, rel=1e-14)
+    assert law.energy(0.3e-9) == pytest.approx(-0.05, rel=1e-14, abs=0)
     assert law.pressure(0.3e-9) == pytest.approx(0.0, abs=1e-14 * scale)
     lj = LennardJones(law.hamaker, law.z0)
     assert np.max(np.abs(law.pressure(h) - lj.pressure(h))) < 1e-13 * scale
@@ -96,9 +96,9 @@ def test_unresolved_grid_is_refused_with_the_setting_to_change():
 
 def _trace_only(mu, **res):
     """One traced curve and its read-out on the banded grid (no coarser member)."""
-    from femadh.studies.regime import R_DEFAULT, Resolution, _solve
+    from femadh.studies.regime import R_DEFAULT, Resolution, solve_point
 
-    return _solve(mu, R_DEFAULT, LennardJones(HAMAKER, Z0), Resolution(**res), 1e-19, None)
+    return solve_point(mu, R_DEFAULT, LennardJones(HAMAKER, Z0), Resolution(**res), 1e-19, None)
 
 
 def test_band_follows_the_edge_through_the_jump_out_fold():
@@ -119,10 +119,10 @@ def test_stability_flags_agree_with_the_hessian_through_four_folds():
     traced point away from a fold carries the Hessian's verdict, and the piece between the
     second and third fold is unstable (index 2, measured 2 negative eigenvalues)."""
     from femadh.contact.stability import is_positive_definite
-    from femadh.studies.regime import Resolution, _Setup, _trace
+    from femadh.studies.regime import Resolution, PointSetup, trace_point
 
-    setup = _Setup(5.0, R, LennardJones(HAMAKER, Z0), Resolution(spacing=0.1))
-    curve = _trace(setup, 1e-19, None)
+    setup = PointSetup(5.0, R, LennardJones(HAMAKER, Z0), Resolution(spacing=0.1))
+    curve = trace_point(setup, 1e-19, None)
     assert len(curve.folds) == 4
     near = {f.index + k for f in curve.folds for k in (0, 1)}
     checked = 0

@@ -17,7 +17,7 @@ def test_gw_integrals_match_quadrature(n):
     for t in (-2.5, -0.3, 0.7, 3.0):
         q = integrate.quad(lambda s: (s - t) ** n * math.exp(-s * s / 2) / math.sqrt(2 * math.pi),
                            t, np.inf, epsabs=1e-14, epsrel=1e-12)[0]
-        assert gw_integral(n, t) == pytest.approx(q, rel=1e-9)
+        assert gw_integral(n, t) == pytest.approx(q, rel=1e-9, abs=0)
 
 
 def test_corrected_eq26_is_normalised():
@@ -31,10 +31,11 @@ def test_paper1_table2_and_fig7_numbers():
     """Sec 6: composite sigma_a = 0.344 nm, z_m = 1.08 nm, R_a = 0.94 um; at p = 0.5 the real
     area ratios 0.013/0.04/0.073 and P_LJa 5.56/17.7/31.8 MPa; eq 22 bounds 1.05/0.49 nm."""
     r = paper1_table2_roughness(1.0)
-    assert (r.sigma_a, r.z_m, r.radius) == pytest.approx((0.344e-9, 1.08e-9, 0.94e-6), rel=2e-3)
+    assert (r.sigma_a, r.z_m, r.radius) == pytest.approx((0.344e-9, 1.08e-9, 0.94e-6),
+                                                         rel=2e-3, abs=0)
     for rho, ar, plj in ((31.3, 0.013, 5.56), (100, 0.04, 17.7), (179, 0.073, 31.8)):
         r = paper1_table2_roughness(rho * 1e12)
-        assert r.contact_probability(r.z_m) == pytest.approx(0.5, rel=1e-14)
+        assert r.contact_probability(r.z_m) == pytest.approx(0.5, rel=1e-14, abs=0)
         assert r.real_area_ratio(r.z_m) == pytest.approx(ar, rel=0.05)   # paper's 2 digits
         assert r.lj_pressure(r.z_m, 0.06) / 1e6 == pytest.approx(plj, rel=5e-3)
     assert mean_plane_dominance_bound(0.165e-9, 1e-6, 10e12) == pytest.approx(1.05e-9, rel=5e-3)
@@ -178,7 +179,7 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
     import warnings
 
     from femadh.runner.contact import run
-    from validation.roughness import _slider
+    from validation.roughness import slider_scene
 
     from conftest import observed_order
 
@@ -188,15 +189,15 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
             return run(sc, progress=False, estimate=False).headline["max_adhesion_N"]
 
     n100 = {"solver.nodes": 100}
-    lim = pull_off(_slider(rho=179).replace(n100))
+    lim = pull_off(slider_scene(rho=179).replace(n100))
     widths = np.array([0.02, 0.01, 0.005])
-    excess = np.array([pull_off(_slider(rho=179, smoothing=w).replace(n100)) - lim
+    excess = np.array([pull_off(slider_scene(rho=179, smoothing=w).replace(n100)) - lim
                        for w in widths])
     assert np.all(excess > 0) and np.all(np.diff(excess) < 0)
     assert observed_order(widths, excess) == pytest.approx(1.6, abs=0.3)
     ns = np.array([100, 200, 400])
-    extra = np.array([pull_off(_slider(rho=179).replace({"solver.nodes": n}))
-                      - pull_off(_slider(rho=0).replace({"solver.nodes": n})) for n in ns])
+    extra = np.array([pull_off(slider_scene(rho=179).replace({"solver.nodes": n}))
+                      - pull_off(slider_scene(rho=0).replace({"solver.nodes": n})) for n in ns])
     assert np.all(extra > 0)
     assert observed_order(1.0 / ns, extra) > 0.8
-    assert extra[-1] < 0.1 * pull_off(_slider(rho=0).replace(n100))   # 7 % at N = 400
+    assert extra[-1] < 0.1 * pull_off(slider_scene(rho=0).replace(n100))   # 7 % at N = 400

@@ -30,12 +30,12 @@ def variant(tmp_path, old, new):
 def test_fig3_scene_loads_in_si():
     s = femadh.load_scene(FIG3)
     # unit conversion by pint: exact up to round-off
-    assert s.sphere.radius == pytest.approx(2e-3, rel=1e-15)
+    assert s.sphere.radius == pytest.approx(2e-3, rel=1e-15, abs=0)
     assert s.e_star == pytest.approx(58.48e9, rel=1e-4)     # eq 2, paper: 58.5 GPa (4 digits)
-    assert s.gap.sigma == pytest.approx(1e-9, rel=1e-15)
-    assert s.tolerance == pytest.approx(1e-19, rel=1e-15)
-    assert len(s.d_values) == 36 and s.d_values[0] == pytest.approx(2e-9, rel=1e-15)
-    assert s.analysis_radius == pytest.approx((2 * 2e-3 * 10e-9) ** 0.5, rel=1e-15)
+    assert s.gap.sigma == pytest.approx(1e-9, rel=1e-15, abs=0)
+    assert s.tolerance == pytest.approx(1e-19, rel=1e-15, abs=0)
+    assert len(s.d_values) == 36 and s.d_values[0] == pytest.approx(2e-9, rel=1e-15, abs=0)
+    assert s.analysis_radius == pytest.approx((2 * 2e-3 * 10e-9) ** 0.5, rel=1e-15, abs=0)
 
 
 @pytest.mark.parametrize("old,new,key,expect", [

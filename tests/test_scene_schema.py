@@ -67,17 +67,17 @@ def test_offset_temperature_units(tmp_path):
         "b.toml"))
     # the Kelvin radius follows the temperature: the same scene at 25 degC and 298.15 K
     assert a.effects["capillary"].kelvin_radius == pytest.approx(
-        b.effects["capillary"].kelvin_radius, rel=1e-12)
+        b.effects["capillary"].kelvin_radius, rel=1e-12, abs=0)
 
 
 def test_replace_revalidates_and_recomputes_derived_values():
     sc = femadh.load_scene(FIG3)
     small = sc.replace({"sphere.radius": "1 mm"})
     # the analysis radius a = sqrt(2 R delta) follows R (delta = 10 nm): 4.47 um, not 6.32
-    assert small.analysis_radius == pytest.approx(math.sqrt(2 * 1e-3 * 10e-9), rel=1e-14)
-    assert sc.analysis_radius == pytest.approx(math.sqrt(2 * 2e-3 * 10e-9), rel=1e-14)
+    assert small.analysis_radius == pytest.approx(math.sqrt(2 * 1e-3 * 10e-9), rel=1e-14, abs=0)
+    assert sc.analysis_radius == pytest.approx(math.sqrt(2 * 2e-3 * 10e-9), rel=1e-14, abs=0)
     soft = sc.replace(effects__asperity_gap__sigma="0.5 nm")
-    assert soft.gap.sigma == pytest.approx(0.5e-9, rel=1e-14) and sc.gap.sigma == 1e-9
+    assert soft.gap.sigma == pytest.approx(0.5e-9, rel=1e-14, abs=0) and sc.gap.sigma == 1e-9
     with pytest.raises(SceneError) as e:
         sc.replace({"materials.disk.poisson_ratio": 0.5})
     assert e.value.key == "materials.disk.poisson_ratio"
@@ -179,9 +179,9 @@ def test_fast_unit_path_agrees_with_pint():
         mag, unit = units._split(text)
         ref = ureg.Quantity(float(mag), unit.replace("^", "**")).to(
             units.DIMENSIONS[dim][1].replace("^", "**")).magnitude
-        assert fast == pytest.approx(ref, rel=1e-15), text
+        assert fast == pytest.approx(ref, rel=1e-15, abs=0), text
         pint_only[text] = fast
     # anything else still goes through pint (offset temperatures, compound units)
     assert units._fast("25 degC", "temperature") is None
-    assert units.to_si("25 degC", "temperature") == pytest.approx(298.15, rel=1e-15)
+    assert units.to_si("25 degC", "temperature") == pytest.approx(298.15, rel=1e-15, abs=0)
     assert units._fast("2 mm", "pressure") is None          # wrong dimension: pint says why

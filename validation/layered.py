@@ -36,7 +36,7 @@ from femadh.contact.forces import state_forces  # noqa: E402
 from femadh.elastic import GreenOperator, RadialGrid  # noqa: E402
 from femadh.elastic.fe import FEOperator, FESettings  # noqa: E402
 from femadh.elastic.fe.layers import Layer  # noqa: E402
-from femadh.elastic.hankel import HankelLayeredOperator  # noqa: E402
+from femadh.judges import HankelLayeredOperator  # noqa: E402
 from femadh.elastic.operator import SurfaceOperator  # noqa: E402
 from femadh.indenter import Sphere  # noqa: E402
 from femadh.laws import LennardJones  # noqa: E402

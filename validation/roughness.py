@@ -86,8 +86,8 @@ def fig7():
     return "\n".join(lines), ms, bounds, r
 
 
-def _slider(A="1e-19 J", sigma="1.08 nm", rho=0, smoothing=None, model="complementarity",
-            gw=None, arclength=False, stop="0 nm"):
+def slider_scene(A="1e-19 J", sigma="1.08 nm", rho=0, smoothing=None, model="complementarity",
+                 gw=None, arclength=False, stop="0 nm"):
     """The paper's slider (Fig 3 scene) with sec 6's sigma = z_m, eq 20 asperity adhesion
     (exact on the contact set, or smoothed with a width ``smoothing`` x sigma), or the
     continuous Greenwood-Williamson laws (``gw`` = density)."""
@@ -128,9 +128,9 @@ def fig8():
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for A, label in hamakers:
         for rho in (0, 100, 179):
-            sc = _slider(A, rho=rho)
+            sc = slider_scene(A, rho=rho)
             pc, swc, errc = closure_sweeps(sc)
-            pm, swm, errm = complementarity_sweeps(_slider(A, rho=rho))
+            pm, swm, errm = complementarity_sweeps(slider_scene(A, rho=rho))
             if label.startswith("eq 19"):
                 for k, (p_, sw_, st) in enumerate(((pc, swc, "-"), (pm, swm, "--"))):
                     c = curve(p_, sw_["retract"]) if "retract" in sw_ else None
@@ -184,13 +184,13 @@ def eq20_limit(rho=179, A="1e-19 J"):
     exact) and the smoothed step converging to it as its width -> 0."""
     lines = ["| eq 20 in the complementarity model | width / σ | max adhesion, mN | "
              "− limit, mN |", "|---|---|---|---|"]
-    lim = run(_slider(A, rho=rho), progress=False)
+    lim = run(slider_scene(A, rho=rho), progress=False)
     f_lim = lim.headline["max_adhesion_N"] * 1e3
     rows = []
     for w in (0.04, 0.02, 0.01, 0.005, 0.0025):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # narrow steps: node stiffness warnings
-            res = run(_slider(A, rho=rho, smoothing=w), progress=False)
+            res = run(slider_scene(A, rho=rho, smoothing=w), progress=False)
         f = res.headline.get("max_adhesion_N", math.nan) * 1e3
         rows.append((w, f))
         lines.append(f"| smoothed step | {w:g} | {f:.5f} | {f - f_lim:+.5f} |")
@@ -204,8 +204,8 @@ def eq20_limit(rho=179, A="1e-19 J"):
               "|---|---|---|---|"]
     excess, spacing = [], []
     for n in (100, 200, 400, 800):
-        f_l = run(_slider(A, rho=rho).replace({"solver.nodes": n}), progress=False)
-        f_0 = run(_slider(A, rho=0).replace({"solver.nodes": n}), progress=False)
+        f_l = run(slider_scene(A, rho=rho).replace({"solver.nodes": n}), progress=False)
+        f_0 = run(slider_scene(A, rho=0).replace({"solver.nodes": n}), progress=False)
         a, b = f_l.headline["max_adhesion_N"] * 1e3, f_0.headline["max_adhesion_N"] * 1e3
         excess.append(a - b)
         spacing.append(1.0 / n)
@@ -227,14 +227,14 @@ def gw_models():
     rows = ["| Greenwood-Williamson (continuous), Δγ_a = 0.06 | A (J) | ρ (µm⁻²) | status | "
             "max adhesion, mN |", "|---|---|---|---|---|"]
     for rho in (31.3, 100, 179):
-        res = run(_slider(gw=rho), progress=False)
+        res = run(slider_scene(gw=rho), progress=False)
         rows.append(f"| stepping in d | 1e-19 | {rho} | {res.status} | "
                     f"{res.headline.get('max_adhesion_N', math.nan) * 1e3:.4f} |")
     for rho, stop in ((31.3, "0.6 nm"), (100, "0 nm")):
         t0 = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            res = run(_slider(gw=rho, arclength=True, stop=stop), progress=False)
+            res = run(slider_scene(gw=rho, arclength=True, stop=stop), progress=False)
         trap = [w for w in caught if "snap" in str(w.message)]
         note = (f"; {len(res.jumps)} jumps, mesh-dependent (node stiffness below the law's "
                 "softening)" if trap else f"; {len(res.jumps)} jumps")

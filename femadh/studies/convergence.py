@@ -46,13 +46,13 @@ def _try_sweep(problem, scene, shape):
 def judge(scene, nodes):
     """The exact operator a scene's FE body is judged against, on N = ``nodes``: the Green
     function of the homogeneous half-space, or for a layered scene the Hankel-transform
-    operator of its stack (:mod:`femadh.elastic.hankel`; seconds per N for layers much
+    operator of its stack (:mod:`femadh.judges`; seconds per N for layers much
     thinner than the analysis radius)."""
     from ..elastic import GreenOperator, RadialGrid
 
     grid = RadialGrid.uniform(scene.analysis_radius, nodes)
     if scene.layers:
-        from ..elastic.hankel import HankelLayeredOperator
+        from ..judges import HankelLayeredOperator
 
         return HankelLayeredOperator(grid, scene.layers, scene.disk, scene.slider)
     return GreenOperator(grid, scene.e_star)

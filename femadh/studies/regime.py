@@ -213,7 +213,7 @@ class RegimePoint:
     hysteresis_error = property(lambda self: self.error("hysteresis"))
 
 
-class _Setup:
+class PointSetup:
     """Physical problem of one map point and the grids of one resolution."""
 
     def __init__(self, mu, radius, law, res):
@@ -287,7 +287,22 @@ class _Setup:
         return None if self.res.legacy else self.band.regrid(problem, w, d)
 
 
-def _trace(setup, tol, progress):
+def trace_point(setup, tol, progress):
+    """The equilibrium curve of one map point (a :class:`PointSetup`) by pseudo-arclength
+    continuation on its moving band, from ``setup.d_start`` to its stop rule.
+
+    Parameters
+    ----------
+    setup : PointSetup
+    tol : float
+        Residual tolerance of each state (m).
+    progress : callable or None
+        Progress callback of :func:`femadh.contact.arclength.trace_curve`.
+
+    Returns
+    -------
+    The traced curve (points, folds, the problems of its grids).
+    """
     z0 = setup.z0
     return trace_curve(setup.problem(0.0), setup.d_start, setup.d_end, tol=tol, scale=z0,
                        ds=0.2, ds_max=setup.ds_max, progress=progress,
@@ -415,9 +430,26 @@ def _check_bounds(mu, q, errors):
                               f"tension on the curve {p:.6f}")
 
 
-def _solve(mu, radius, law, res, tol, progress):
-    setup = _Setup(mu, radius, law, res)
-    curve = _trace(setup, tol, progress)
+def solve_point(mu, radius, law, res, tol, progress):
+    """One map point at one resolution, without an error estimate: the traced curve's
+    headline quantities and diagnostics (dict; ``setup`` holds its :class:`PointSetup`).
+
+    Parameters
+    ----------
+    mu : float
+        Tabor parameter.
+    radius : float
+        Sphere radius (m).
+    law : LennardJones or Lj82
+        The gap law.
+    res : Resolution
+        Grid of this member.
+    tol : float
+        Residual tolerance (m).
+    progress : callable or None
+    """
+    setup = PointSetup(mu, radius, law, res)
+    curve = trace_point(setup, tol, progress)
     q = _read(setup, curve)
     q.update(setup=setup, n_points=len(curve.points), n_solves=curve.n_solves,
              n_folds=len(curve.folds), n_grids=len(curve.tracers))
@@ -429,7 +461,7 @@ def _coarse_member(mu, radius, law, res, tol):
     traced). Returns (result, ratio)."""
     for ratio in (COARSE_RATIO, 2.0):
         try:
-            return _solve(mu, radius, law, res.coarser(ratio), tol, None), ratio
+            return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio
         except (ConvergenceError, ValueError):
             continue
     raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x 1.5, x 2 of "
@@ -489,7 +521,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                                                                                law)))
     coarse, ratio = _coarse_member(mu, radius, law, res, tol)
     for attempt in range(MAX_REFINEMENTS + 1):
-        fine = _solve(mu, radius, law, res, tol, progress)
+        fine = solve_point(mu, radius, law, res, tol, progress)
         why = _unresolved(fine["setup"], fine)
         errors = _estimate(fine, coarse, ratio)
         name, rel = _worst(fine, errors)

@@ -1,5 +1,10 @@
-"""The layered half-space's surface operator from the Hankel-transform solution
+"""The judges in the form the contact solvers take: surface operators built on
+:mod:`femadh.reference`.
+
+The layered half-space's surface operator from the Hankel-transform solution
 (:class:`femadh.reference.layered.LayeredHalfSpace`): C = C_stack + C_sphere on a radial grid.
+It lives here, not in :mod:`femadh.elastic`, so that no solver package imports a judge
+(``tests/test_layout.py`` guards the floors): this module may import both.
 
 It is the independent judge of the layered FE body, in the form the contact solvers take: the
 same scene solved on both operators differs only by the FE discretisation (used by
@@ -7,8 +12,9 @@ same scene solved on both operators differs only by the FE discretisation (used 
 its cost grows steeply for layers much thinner than the analysis radius (t/a = 1e-3: ~7 s at
 N = 200, against ~0.05 s for t ~ a), where the FE body is the faster route.
 """
-from .green import GreenOperator
-from .operator import SurfaceOperator
+from .elastic.green import GreenOperator
+from .elastic.operator import SurfaceOperator
+from .reference.layered import LayeredHalfSpace
 
 
 class HankelLayeredOperator(SurfaceOperator):
@@ -28,8 +34,6 @@ class HankelLayeredOperator(SurfaceOperator):
     name = "layered-hankel"
 
     def __init__(self, grid, layers, substrate, sphere=None):
-        from ..reference.layered import LayeredHalfSpace
-
         self.grid = grid
         stack = [_triple(ly) for ly in layers]
         sub = (substrate if isinstance(substrate, tuple)
