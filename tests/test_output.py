@@ -120,7 +120,7 @@ def test_figures_are_named_for_what_they_show_and_the_loop_is_visible(tmp_path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from femadh.io.plots import _hysteresis_loop, _with_folds, contact_figures, force_unit
+    from femadh.io.plots import draw_hysteresis_loop, branch_with_folds, contact_figures, force_unit
 
     res = run(_small(n=100), estimate="peak")
     assert len(res.jumps) == 2
@@ -129,13 +129,13 @@ def test_figures_are_named_for_what_they_show_and_the_loop_is_visible(tmp_path):
     assert all(p.stat().st_size > 20_000 for p in paths)
     # the approach is drawn to its fold, broken, and continued from its landing
     j = next(j for j in res.jumps if j["branch"] == "approach")
-    d, F = _with_folds(res, "approach", res.branches["approach"])
+    d, F = branch_with_folds(res, "approach", res.branches["approach"])
     k = int(np.flatnonzero(d == j["d_fold_m"])[0])
     assert F[k] == j["F_ex_before_N"] and np.isnan(d[k + 1]) and F[k + 2] == j["F_ex_after_N"]
     assert np.all(np.diff(d[np.isfinite(d)]) <= 0)         # in the order it was traced
     fig, ax = plt.subplots()
     fs, _ = force_unit([res.headline["max_adhesion_N"]])
-    lo_m, hi_m = _hysteresis_loop(ax, res, fs, "µN")
+    lo_m, hi_m = draw_hysteresis_loop(ax, res, fs, "µN")
     lo, hi = ax.get_xlim()
     assert (lo, hi) == pytest.approx((lo_m * 1e9, hi_m * 1e9))   # the strip on the main axes
     y0, y1 = ax.get_ylim()

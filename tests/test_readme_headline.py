@@ -15,14 +15,14 @@ NUM = r"(-?[\d.]+(?:e-?\d+)?)"
 def printed():
     """The numbers of the README's printed block (strings, to keep their digits)."""
     text = (ROOT / "README.md").read_text()
-    block = text[text.index("The run prints its headline numbers"):]
+    block = text[text.index("prints its headline numbers"):]
     block = block[:block.index("results in out/paper1-fig3")]
     pats = {
         "adhesion": rf"max adhesion {NUM} ± {NUM} µN at d = {NUM} nm \(DMT 2πRW = {NUM} µN, "
                     rf"JKR 1.5πRW = {NUM} µN\)",
         "deepest": rf"F_ex\(d = -5 nm\) = {NUM} ± {NUM} mN, F_LJ = {NUM} ± {NUM} µN",
-        "grid": rf"accuracy {NUM} met: (\d+) nodes, band spacing {NUM} nm to {NUM} um, "
-                rf"analysis radius {NUM} um",
+        "grid": rf"accuracy {NUM} met: (\d+) nodes, band spacing {NUM} nm to {NUM} µm, "
+                rf"analysis radius {NUM} µm",
     }
     out = {}
     for name, pat in pats.items():

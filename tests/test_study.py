@@ -342,9 +342,9 @@ def test_typed_values_need_units_and_absurd_ones_are_refused(tmp_path, capsys):
 
 def test_study_progress_counts_done_failed_reused(capsys):
     """In a terminal the study's bar counts points done, failed and reused."""
-    from femadh.studies.sweep import _Progress
+    from femadh.studies.sweep import StudyProgress
 
-    bar = _Progress(4, 2, "demo")
+    bar = StudyProgress(4, 2, "demo")
     bar.point({"status": "failed"})
     bar.point({"status": "converged"})
     bar.bar.refresh()
@@ -357,9 +357,9 @@ def test_points_differing_in_the_modulus_do_not_share_an_operator(tmp_path):
     """A worker reuses the surface operator of an identical grid and body only: two points
     that differ in the disk's modulus (E* scales the Green function) each build their own,
     and a stiffer disk indents less: F_ex at the deepest separation differs (by ~E*)."""
-    from femadh.studies.executors import _OPERATORS, run_point
+    from femadh.studies.executors import OPERATOR_CACHE, run_point
 
-    _OPERATORS.clear()
+    OPERATOR_CACHE.clear()
     pts = study_points(small().replace({"sweep.stop": "-1 nm"}),
                        {"materials.disk.youngs_modulus": "100 GPa,400 GPa,100 GPa"})
     recs = [run_point(p, tmp_path, estimate=False) for p in pts]

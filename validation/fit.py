@@ -63,7 +63,7 @@ def _run_time(scene, repeat=3):
 
     times = []
     for _ in range(repeat):
-        sweep._OPERATORS.clear()             # a fit's runs with a new E build the operator
+        sweep.OPERATOR_CACHE.clear()             # a fit's runs with a new E build the operator
         t0 = time.perf_counter()
         simulate(scene)
         times.append(time.perf_counter() - t0)

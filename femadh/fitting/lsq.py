@@ -159,10 +159,10 @@ def simulate(scene):
             key = sweep._operator_key(scene)
             op = None
             if key is not None:
-                if key not in sweep._OPERATORS:
-                    sweep._OPERATORS.clear()          # one operator per worker
-                    sweep._OPERATORS[key] = build_operator(scene)
-                op = sweep._OPERATORS[key]
+                if key not in sweep.OPERATOR_CACHE:
+                    sweep.OPERATOR_CACHE.clear()          # one operator per worker
+                    sweep.OPERATOR_CACHE[key] = build_operator(scene)
+                op = sweep.OPERATOR_CACHE[key]
             res = run(scene, None, figures=False, progress=False, estimate=False,
                       operator=op)
     except FemadhError as exc:

@@ -170,7 +170,7 @@ def force_curve(res, path):
             if col not in c or (col != "F_ex_N" and not np.any(c[col])):
                 continue
             if col == "F_ex_N":
-                d, F = _with_folds(res, b, c)
+                d, F = branch_with_folds(res, b, c)
                 ax.plot(d * ls, -F * fs, styles.get(b, "-"), color=BRANCH_COLOURS.get(b, "k"),
                         lw=2, label=f"{label}, {b}")
                 continue
@@ -200,7 +200,7 @@ def force_curve(res, path):
     ax.grid(alpha=0.3)
     if loop:
         zoom = fig.add_axes([0.545, 0.1, 0.25, 0.83])
-        lo, hi = _hysteresis_loop(zoom, res, fs, fl)
+        lo, hi = draw_hysteresis_loop(zoom, res, fs, fl)
         # where the zoom is on the whole curve: a shaded strip of its separations (its
         # force range is a few percent of this axis' and would not show as a box)
         ax.axvspan(lo * ls, hi * ls, color="0.88", zorder=0)
@@ -224,7 +224,7 @@ EFFECT_COLOURS = ("tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:oli
                   "tab:cyan", "tab:pink")
 
 
-def _with_folds(res, branch, c):
+def branch_with_folds(res, branch, c):
     """(d, F_ex) of a branch in the order it was traced with each jump inserted: the fold
     state (where the branch ends) and a break (nan) before the landing state, so the line
     follows the branch to its fold and the jump is left to its arrow."""
@@ -251,7 +251,7 @@ def _jump_arrows(ax, res, fs, ls, lw=1.2):
                         j["branch"], "C3"), "lw": lw, "mutation_scale": 12})
 
 
-def _hysteresis_loop(ax, res, fs, fl):
+def draw_hysteresis_loop(ax, res, fs, fl):
     """The loop between the jumps, zoomed: x from the first to the last fold padded by a
     sweep step (or the folds' spread), y over what both branches do there; the computed
     states marked, the folds crossed, the jumps as arrows, the loop shaded. Returns the
@@ -267,7 +267,7 @@ def _hysteresis_loop(ax, res, fs, fl):
     ys = []
     traced = {}
     for b, c in res.branches.items():
-        d, F = _with_folds(res, b, c)
+        d, F = branch_with_folds(res, b, c)
         traced[b] = (d, F)
         ax.plot(d * ls, -F * fs, "-" if b == "approach" else "--",
                 color=BRANCH_COLOURS.get(b, "k"), lw=2, label=b)

@@ -51,7 +51,7 @@ NOT_PHYSICAL = (OutputError, DependencyError, Interrupted)
 
 # --------------------------------------------------------------------------- the worker
 
-_OPERATORS = {}
+OPERATOR_CACHE = {}
 _IN_POOL = False
 
 
@@ -113,12 +113,12 @@ def run_point(point, root, estimate=True):
             key = _operator_key(point.scene)
             op = None
             if key is not None:
-                if key in _OPERATORS:
+                if key in OPERATOR_CACHE:
                     rec["operator_reused"] = True
                 else:
-                    _OPERATORS.clear()          # one operator per worker: bounded memory
-                    _OPERATORS[key] = build_operator(point.scene)
-                op = _OPERATORS[key]
+                    OPERATOR_CACHE.clear()          # one operator per worker: bounded memory
+                    OPERATOR_CACHE[key] = build_operator(point.scene)
+                op = OPERATOR_CACHE[key]
             res = run(point.scene, folder, figures=False, progress=False, overwrite=True,
                       operator=op, estimate=estimate)
         rec["status"], rec["error"] = res.status, res.error

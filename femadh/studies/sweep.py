@@ -32,7 +32,7 @@ import time
 from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
 from ..io.study_table import study_figure, write_table
-from .executors import (HEADLINE, _OPERATORS, _jsonable, _operator_key,  # noqa: F401
+from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable, _operator_key,  # noqa: F401
                         _tune_malloc, _worker_init, driver_signals, execute, finished,
                         run_point, write_record)
 from .values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
@@ -181,7 +181,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
             {"scene_file": scene.path, "scene": scene.name, "vary": vary, "zip": zip_,
              "points": [{"index": p.index, "id": p.id, "changes": p.changes}
                         for p in points]}, indent=1, default=_jsonable) + "\n")
-        bar = _Progress(len(points), result.reused, scene.name) if progress else None
+        bar = StudyProgress(len(points), result.reused, scene.name) if progress else None
         t0 = time.perf_counter()
         try:
             with driver_signals() as stop:
@@ -256,7 +256,7 @@ def failure_reasons(records):
     return sorted(((g[0], g[1]) for g in groups.values()), key=lambda g: -len(g[1]))
 
 
-class _Progress:
+class StudyProgress:
     """The study's bar in a terminal: points done of all, with failed and reused counts."""
 
     def __init__(self, total, reused, name):
