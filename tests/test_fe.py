@@ -11,6 +11,7 @@ from femadh.contact import AsperityGap
 from femadh.laws import LennardJones
 from femadh.elastic import GreenOperator, RadialGrid, disk_displacement
 from femadh.elastic.fe import FEOperator, FESettings
+from femadh.elastic.fe.cache import cached_operator
 from femadh.indenter import Sphere
 from femadh.contact.forces import state_forces
 from femadh.reference import hertz_displacement
@@ -186,9 +187,9 @@ def test_cached_operator_equals_a_fresh_one_and_builds_its_body_on_demand(tmp_pa
     cache = _cache_env(tmp_path, monkeypatch)
     g = RadialGrid.uniform(6.32e-6, 40)
     fresh = FEOperator(g, E_STAR, 0.3)
-    miss = FEOperator.cached(g, E_STAR, 0.3)
+    miss = cached_operator(g, E_STAR, 0.3)
     assert not miss.cache_hit and len(list(cache.glob("fe-*.npz"))) == 1
-    hit = FEOperator.cached(g, E_STAR, 0.3)
+    hit = cached_operator(g, E_STAR, 0.3)
     assert hit.cache_hit and "assembly" not in hit.timings     # nothing assembled
     assert np.array_equal(hit.compliance, miss.compliance)
     # a separate condensation: same sparse LU, same bits here (allow round-off anyway)
@@ -209,9 +210,9 @@ def test_operator_cache_is_invalidated_by_a_changed_body(tmp_path, monkeypatch):
 
     cache = _cache_env(tmp_path, monkeypatch)
     g = RadialGrid.uniform(6.32e-6, 30)
-    base = FEOperator.cached(g, E_STAR, 0.3)
-    for other in (FEOperator.cached(g, 1.01 * E_STAR, 0.3), FEOperator.cached(g, E_STAR, 0.25),
-                  FEOperator.cached(g, E_STAR, 0.3, FESettings(1e4, growth=0.3))):
+    base = cached_operator(g, E_STAR, 0.3)
+    for other in (cached_operator(g, 1.01 * E_STAR, 0.3), cached_operator(g, E_STAR, 0.25),
+                  cached_operator(g, E_STAR, 0.3, FESettings(1e4, growth=0.3))):
         assert not other.cache_hit
         assert not np.array_equal(other.compliance, base.compliance)
     assert len(list(cache.glob("fe-*.npz"))) == 4
@@ -223,12 +224,12 @@ def test_operator_cache_is_invalidated_by_a_changed_body(tmp_path, monkeypatch):
     with open(meshes / src.name, "a") as f:
         f.write("\n")                                         # other bytes, same mesh
     monkeypatch.setenv("FEMADH_MESH_PATH", str(meshes))
-    moved = FEOperator.cached(g, E_STAR, 0.3)
+    moved = cached_operator(g, E_STAR, 0.3)
     assert moved._mesh_path != src and operator_key(moved) != operator_key(base)
     assert not moved.cache_hit
     # a sphere material on a layered-call body: the sphere's Green part is added on load
     sub = IsotropicMaterial(163e9, 0.3)
-    rigid = FEOperator.cached(g, substrate=sub)
-    soft = FEOperator.cached(g, substrate=sub, sphere=IsotropicMaterial(83e9, 0.21))
+    rigid = cached_operator(g, substrate=sub)
+    soft = cached_operator(g, substrate=sub, sphere=IsotropicMaterial(83e9, 0.21))
     assert soft.cache_hit and np.array_equal(soft.compliance_body, rigid.compliance_body)
     assert not np.array_equal(soft.compliance, rigid.compliance)

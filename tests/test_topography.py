@@ -17,7 +17,7 @@ from SurfaceTopography import Topography  # noqa: E402
 from SurfaceTopography.Generation import fourier_synthesis  # noqa: E402
 
 from femadh.cli import main  # noqa: E402
-from femadh.io.topography import read_topography  # noqa: E402
+from femadh.roughness.reading import read_topography  # noqa: E402
 from femadh.laws.gw import Summits  # noqa: E402
 from femadh.roughness import SpectralMoments, composite, mccool, profile_moments  # noqa: E402
 from femadh.roughness import table2_rule  # noqa: E402

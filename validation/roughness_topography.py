@@ -71,7 +71,7 @@ def make_surfaces(folder):
 
 
 def moments_table(surfaces):
-    from femadh.io.topography import read_topography
+    from femadh.roughness.reading import read_topography
     from femadh.roughness import profile_moments
 
     lines = ["| surface | scale | m0 (nm^2): femadh / analytic | m2 | m4 (um^-2) |",

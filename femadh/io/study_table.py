@@ -22,7 +22,7 @@ _NOT_COLUMNS = ("index", "pid", "wall_time_s", "signum", "operator_reused", "fin
 
 def table_rows(points, records):
     """(header, rows) of a study's table; rows of the points with an outcome, in order."""
-    from ..studies.values import si_columns, si_value
+    from ..scene.values import si_columns, si_value
 
     cols = si_columns(points)
     numbers = sorted({k for r in records.values() for k, v in r.items()
@@ -76,7 +76,7 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
     Returns the path, or None when there is nothing to draw (more than two keys, or no point
     with a finite value of the quantity: every point failed). No empty figure is written,
     and a study.png of an earlier run of the folder is removed rather than left standing."""
-    from ..studies.values import si_value
+    from ..scene.values import si_value
 
     keys = list(points[0].changes) if points else []
     vals = [(p, records[p.id].get(quantity, math.nan)) for p in points

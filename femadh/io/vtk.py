@@ -83,7 +83,7 @@ def saved_states(run_dir, problem, states):
     ``fields.csv`` (w, h and every pressure on every node, written as exact float reprs)."""
     import csv
 
-    from .writers import extra_outputs
+    from ..laws.registry import extra_outputs
 
     extra = extra_outputs(problem)
     want = set(int(k) for k in states)

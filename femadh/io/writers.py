@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..contact.forces import state_forces
-from ..laws.registry import outputs
+from ..laws.registry import extra_outputs  # noqa: F401  (the runner reads it here)
 from .atomic import RowLog
 
 CURVE_HEADER = ["state", "branch", "d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m",
@@ -33,15 +33,6 @@ SIGN_NOTE = ("Forces are on the disk, paper 1 eqs 11-13 with area weights: F_LJ 
              "F_ex = F_LJ + F_cap + F_LJa - F_ela - F_el over the analysis disk. The force on "
              "the sphere is -F_ex; adhesion shows as F_ex > 0. F_tail: the laws' force beyond "
              "the analysis radius on the undeformed sphere (the truncation, not in F_ex).")
-
-
-def extra_outputs(problem):
-    """The registered outputs of the laws a problem carries beyond LJ (and eq 20 on the
-    contact set), in registry order."""
-    names = set(problem.effects)
-    if problem.gap is not None and problem.gap.adhesion:
-        names.add("asperity_adhesion")
-    return [o for name, o in outputs().items() if name != "lj" and name in names]
 
 
 def _g(x):

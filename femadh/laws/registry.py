@@ -34,3 +34,12 @@ def outputs():
         for o in r.outputs:
             out.setdefault(o.name, o)
     return out
+
+
+def extra_outputs(problem):
+    """The registered outputs of the laws a problem carries beyond LJ (and eq 20 on the
+    contact set), in registry order."""
+    names = set(problem.effects)
+    if problem.gap is not None and problem.gap.adhesion:
+        names.add("asperity_adhesion")
+    return [o for name, o in outputs().items() if name != "lj" and name in names]

@@ -91,7 +91,7 @@ def profile_moments(topography, cutoff=None):
     Parameters
     ----------
     topography : SurfaceTopography Topography or UniformLineScan
-        Heights in m (see :func:`femadh.io.topography.read_topography`). Non-periodic data
+        Heights in m (see :func:`femadh.roughness.reading.read_topography`). Non-periodic data
         are Hann-windowed before the transform (SurfaceTopography's default; it keeps the
         mean square), periodic data are not.
     cutoff : float, optional

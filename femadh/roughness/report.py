@@ -47,7 +47,7 @@ def _check_cutoff(topo, cutoff, path, key, file):
 def _surface(path, stamp, cutoff, key, file):
     """One file's statistics (cached by path, modification stamp and cutoff: scenes are
     validated again for every study point and error estimate)."""
-    from ..io.topography import read_topography
+    from .reading import read_topography
 
     topo = read_topography(path, key=key, file=file)
     if cutoff is not None:

@@ -26,17 +26,17 @@ def build_operator(scene, progress=None, *, grid=None, settings=None):
 
     grid = grid or scene_grid(scene)
     if scene.method == "fe":
-        from ..elastic.fe import FEOperator
+        from ..elastic.fe.cache import cached_operator
 
         settings = settings or scene.fe_settings
         # the condensed body from the on-disk operator cache when it was built before (by
         # content: mesh, grid, materials, settings); its factorised body only on demand
         if scene.layers:
-            return FEOperator.cached(grid, settings=settings, progress=progress,
-                                     substrate=scene.disk, layers=scene.layers,
-                                     sphere=scene.slider)
-        return FEOperator.cached(grid, scene.e_star, scene.fe_poisson_ratio, settings,
-                                 progress=progress)
+            return cached_operator(grid, settings=settings, progress=progress,
+                                   substrate=scene.disk, layers=scene.layers,
+                                   sphere=scene.slider)
+        return cached_operator(grid, scene.e_star, scene.fe_poisson_ratio, settings,
+                               progress=progress)
     return GreenOperator(grid, scene.e_star)
 
 

@@ -6,7 +6,7 @@ point's content hash, resumable.
                              --vary effects.capillary.relative_pressure="0.05..0.95:10" \\
                              --out out/stiction-map [--zip] [--workers N | --scheduler ADDR]
 
-The values' grammar is :mod:`femadh.studies.values` (quantities with their unit, as in a
+The values' grammar is :mod:`femadh.scene.values` (quantities with their unit, as in a
 file); the product of all ``--vary`` by default, paired with ``--zip``. The same in a scene
 file::
 
@@ -35,7 +35,7 @@ from ..io.study_table import study_figure, write_table
 from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable, _operator_key,  # noqa: F401
                         _tune_malloc, _worker_init, driver_signals, execute, finished,
                         run_point, write_record)
-from .values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
+from ..scene.values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
 
 
 @dataclass(frozen=True)
@@ -139,7 +139,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
     scene : Scene or MeniscusScene
         The base scene.
     vary : dict
-        Dotted keys -> value specs (:func:`femadh.studies.values.parse_values`).
+        Dotted keys -> value specs (:func:`femadh.scene.values.parse_values`).
     out_dir : str or Path
         The study folder; its finished points are reused.
     workers : int, optional

@@ -27,6 +27,9 @@ import time
 
 import numpy as np
 
+from .mesh import cached_mesh
+from .operator import FEOperator, FESettings, mesh_spec
+
 #: bump when the condensation changes in a way the versions below do not capture
 FORMAT = 1
 
@@ -71,14 +74,14 @@ def operator_key(op):
     return hashlib.sha1(json.dumps(blob, sort_keys=True).encode()).hexdigest()[:20]
 
 
-def load_or_build(cls, grid, e_star, nu, settings, progress, *, substrate, layers, sphere,
-                  cache_dir=None):
-    """An FEOperator (``cls``) whose body compliance comes from the cache when present; see
-    :meth:`FEOperator.cached`."""
-    from .mesh import cached_mesh
-    from .operator import FESettings, mesh_spec
-
-    op = cls.__new__(cls)
+def cached_operator(grid, e_star=None, nu=0.3, settings=None, progress=None, *,
+                    substrate=None, layers=(), sphere=None, cache_dir=None):
+    """The :class:`FEOperator` of these arguments (as its constructor), its condensed
+    compliance read from the on-disk operator cache when an identical body was condensed
+    before, else built and stored there (keyed by content: the mesh file's bytes, the grid,
+    the materials, the settings). A cached operator builds its mesh, stiffness and
+    factorisation only when full fields are asked for."""
+    op = FEOperator.__new__(FEOperator)
     op.grid = grid
     op.settings = settings or FESettings()
     op._set_body(e_star, nu, substrate, layers, sphere)

@@ -251,19 +251,6 @@ class FEOperator(SurfaceOperator):
             return getattr(self, name)
         raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
 
-    @classmethod
-    def cached(cls, grid, e_star=None, nu=0.3, settings=None, progress=None, *, substrate=None,
-               layers=(), sphere=None, cache_dir=None):
-        """The operator of these arguments (as the constructor), its condensed compliance read
-        from the on-disk operator cache when an identical body was condensed before, else
-        built and stored there (:mod:`~femadh.elastic.fe.cache`, keyed by content: the mesh
-        file's bytes, the grid, the materials, the settings). A cached operator builds its
-        mesh, stiffness and factorisation only when full fields are asked for."""
-        from .cache import load_or_build
-
-        return load_or_build(cls, grid, e_star, nu, settings, progress, substrate=substrate,
-                             layers=layers, sphere=sphere, cache_dir=cache_dir)
-
     def _build(self):
         """Read the mesh, assemble the stiffness and load matrices, factorise (the body)."""
         from skfem import Basis, ElementTriP2, ElementTriP2B, ElementVector, MeshTri
