@@ -135,11 +135,12 @@ def peak_adhesion(problem, prev, best, nxt, scene):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
-    branch (within a quarter of every gap of the interpolation). Returns (F, d, half-width of
-    the final d bracket)."""
+    branch (within a quarter of every gap of the interpolation). The states may be
+    :class:`~femadh.runner.contact.Committed` records (d, w, active, r_c, f_ex) as the files
+    hold them. Returns (F, d, half-width of the final d bracket)."""
     from ..contact.forces import state_forces
 
-    f_best = state_forces(problem, best)[2]
+    f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
     found = {}
 
@@ -264,6 +265,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             g = None
         else:
             g = run(other, progress=False, estimate="peak")
+        _stop_if_stopped(g)
         if g is not None and g.status == "converged":
             for k, v in g.headline.items():
                 if isinstance(v, float) and isinstance(hl.get(k), float):
@@ -278,6 +280,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     ratio, members = coarser_members(scene, problem, green)
     for label, member in members:
         r = run(member, progress=False, estimate="peak")
+        _stop_if_stopped(r)
         if r.status != "converged":
             res.warnings.append(f"discretisation estimate: the coarse grid ({label}) failed: "
                                 f"{r.error}")
@@ -319,6 +322,22 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         comp["total"] = float(sum(abs(v) for v in comp.values()))
         hl[f"{k}_error"] = comp["total"]
     return parts
+
+
+def _stop_if_stopped(member):
+    """A member stopped by a signal or the time limit stops the run: its estimate would be
+    degraded, and the run must end "interrupted" (exit 130/143), never "converged" with a
+    warning."""
+    if member is None or member.status not in ("interrupted", "time limit"):
+        return
+    from ..errors import Interrupted, TimeLimitReached
+
+    code = getattr(member, "exit_code", 130)
+    if member.status == "time limit":
+        from .interrupt import time_limit
+
+        raise TimeLimitReached(time_limit() or 0.0)
+    raise Interrupted(code - 128)
 
 
 def _contact_gap(problem):
