@@ -75,7 +75,8 @@ def check_resources(scene):
 #: thread): the Fig 3 scene with uniform nodes, 72 states, --no-estimate, solve time / states
 #: (validation of the model: 1.9 / 10.3 / 36.6 / 184 ms per state at N = 200 / 400 / 800 /
 #: 1600; the two coefficients fitted to 800 and 1600, the model gives 1.9 / 8.0 ms at 200 /
-#: 400). Remeasure: python validation/fault_matrix.py --rates.
+#: 400; N = 3200, 3 states: 3.5 s measured, 6.2 s modelled). Remeasure: time femadh.run of
+#: that scene at those N with estimate=False and divide solve_s by the states.
 STATE_N2, STATE_N3 = 4.25e-8, 1.84e-11
 #: a floor per state (Python overhead, the writers): 1.7 ms measured at N = 100
 STATE_FLOOR = 1.7e-3
@@ -89,9 +90,10 @@ FE_OPERATOR_PER_NODE = 4.5e-3
 #: (N^2-N^3 scaling: 1/4..1/8 + 1/16..1/64, the peak search ~10 states)
 ESTIMATE_STATES = 10
 #: adaptive or accuracy runs: trials (each a run with its estimate) the budget allows
-#: (femadh.runner.adaptive.MAX_TRIALS); the estimate counts the first and says so
-#: a scene estimated beyond this many seconds is refused unless the user insists (--force)
-MAX_REASONABLE_S = 3600.0
+
+#: a scene estimated beyond this many seconds (30 min) is refused unless the user insists
+#: (--force)
+MAX_REASONABLE_S = 1800.0
 #: accuracy targets below this cannot be met within the node budget: the error falls like
 #: h^1.5, 1e-3 needs ~630 nodes (README, "Accuracy"), so 1e-5 would need ~13 000 (budget:
 #: femadh.runner.estimates.MAX_NODES = 3200)

@@ -1,0 +1,164 @@
+"""The fault matrix of a single run (validation/fault_matrix.py, in this process): SIGINT and
+SIGTERM at each phase end in exit 130/143, status "interrupted", promptly; --resume then ends
+with the summary.json of an uninterrupted run; a damaged folder is refused or repaired in
+one line; the time limit ends a run cleanly; femadh check estimates time."""
+import json
+import signal
+
+import pytest
+
+import femadh
+from femadh.cli import main
+from validation.fault_matrix import (DAMAGES, cli, curve_rows, damage_cell, differences,
+                                     short_scene, signal_cell, summary)
+
+#: the summary.json entries of a run resumed inside its sweep differ from the uninterrupted
+#: run's by the solver tolerance's effect (the resumed branch restarts from its last state
+#: re-solved from the saved surface): headline numbers measured <= 1.3e-11 relative, each
+#: error-estimate component <= 1.1e-14 N absolute against 1.6e-3 N (7e-12 of its quantity);
+#: allowed: 1e-9 of the quantity (~100x the measured)
+SWEEP_RESUME_REL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def ref(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("ref")
+    scene = short_scene(tmp)
+    assert cli("run", scene, "--out", tmp / "ref", "--quiet")[0] == 0
+    return scene, summary(tmp / "ref"), curve_rows(tmp / "ref")
+
+
+@pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+@pytest.mark.parametrize("phase", ["operator", "sweep", "peak search", "estimate", "figures"])
+def test_signal_at_each_phase_then_resume_equals_uninterrupted(ref, tmp_path, phase, sig,
+                                                              code):
+    scene, ref_summary, ref_rows = ref
+    out = tmp_path / "out"
+    c = signal_cell(scene, out, phase, sig)
+    assert (c["exit"], c["status"]) == (code, "interrupted"), c
+    # the solver checks between iterations: stopped well within a second (measured 1-20 ms)
+    assert c["latency_s"] < 1.0
+    assert "--resume" in c["stderr"] and f"--out {out}" in c["stderr"]
+    assert (c["resume_exit"], c["resume_status"]) == (0, "converged"), c
+    got = summary(out)
+    if phase != "sweep":
+        # the sweep was complete (or not begun): the same states, the same numbers, bit for bit
+        assert differences(ref_summary, got) == []
+        assert curve_rows(out) == ref_rows
+        return
+    assert len(curve_rows(out)) == len(ref_rows)
+    hl, hl_ref = got["headline"], ref_summary["headline"]
+    assert hl.keys() == hl_ref.keys()
+    for k, v in hl_ref.items():
+        if isinstance(v, float):
+            # an error estimate: to the allowance of its quantity
+            scale = abs(hl_ref[k[:-6]]) if k.endswith("_error") else abs(v)
+            assert hl[k] == pytest.approx(v, rel=0, abs=SWEEP_RESUME_REL * scale), k
+        else:
+            assert hl[k] == v, k
+    for q, parts in ref_summary["error_estimates"].items():
+        for part, v in parts.items():
+            assert got["error_estimates"][q][part] == pytest.approx(
+                v, abs=SWEEP_RESUME_REL * abs(hl_ref[q])), (q, part)
+    for k in ("jumps", "grid", "warnings", "run_id", "scene"):
+        assert differences(ref_summary[k], got[k]) == [] if isinstance(got[k], dict) \
+            else len(got[k]) == len(ref_summary[k])
+
+
+@pytest.mark.parametrize("name", list(DAMAGES))
+def test_damaged_folder_refused_or_repaired_in_one_line(ref, tmp_path, name):
+    scene = ref[0]
+    c = damage_cell(scene, tmp_path / "out", name)
+    lines = c["stderr"].splitlines()
+    assert len(lines) == 1 and "Traceback" not in c["stderr"], c
+    if name in ("duplicated last row", "garbage bytes in curve.csv",
+                "a changed digit in curve.csv"):
+        # the commit record itself is damaged: refused, naming the file and the row
+        assert c["exit"] == 4 and lines[0].startswith("femadh: error: curve.csv row ")
+        assert "--resume-from" in lines[0] and "--overwrite" in lines[0]
+        k = int(lines[0].split("--resume-from ")[1].split()[0])
+        code, err = cli("run", scene, "--out", tmp_path / "out", "--quiet", "--no-figures",
+                        "--no-estimate", "--resume-from", k)
+        assert code == 0, err
+    else:
+        assert c["exit"] == 0 and lines[0].startswith("femadh: note: resume: ")
+        assert c["status"] == "converged"
+    # repaired or resumed from a valid prefix: the full sweep, every row checked again
+    ref_run = femadh.run(femadh.load_scene(scene), progress=False, estimate=False)
+    n = sum(len(b["d_m"]) for b in ref_run.branches.values())
+    assert len(curve_rows(tmp_path / "out")) == n + 1
+
+
+def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
+    scene = short_scene(tmp_path, step="0.02 nm")
+    out = tmp_path / "out"
+    code, err = cli("run", scene, "--out", out, "--quiet", "--no-estimate", "--no-figures",
+                    "--time-limit", "0.3 s")
+    assert code == 6 and "time limit 0.3 s reached" in err and err.count("\n") == 1
+    s = summary(out)
+    assert s["status"] == "time limit"
+    assert 0 < len(curve_rows(out)) - 1 < 702
+    code, err = cli("run", scene, "--out", out, "--quiet", "--no-estimate", "--no-figures",
+                    "--resume")
+    assert code == 0, err
+    assert len(curve_rows(out)) == 703
+    # the scene key, with units; a bare number is refused like any dimensional key
+    text = scene.read_text().replace("[solver]\n", '[solver]\ntime_limit = "0.2 s"\n', 1)
+    scene.write_text(text)
+    assert cli("run", scene, "--out", tmp_path / "o2", "--quiet", "--no-estimate")[0] == 6
+    scene.write_text(text.replace('"0.2 s"', "2"))
+    code, err = cli("check", scene)
+    assert code == 2 and "solver.time_limit" in err and err.count("\n") == 1
+
+
+def test_check_estimates_time_and_refuses_absurd_cost(tmp_path, capsys):
+    import time
+
+    scene = short_scene(tmp_path, nodes=400)
+    assert main(["check", str(scene)]) == 0
+    said = capsys.readouterr().out
+    est = said.split("~")[2].split(" with")[0]        # e.g. "2 s"
+    t0 = time.perf_counter()
+    femadh.run(femadh.load_scene(scene), progress=False)
+    real = time.perf_counter() - t0
+    value = float(est.split()[0]) * {"s": 1, "min": 60, "h": 3600}[est.split()[1]]
+    # a rough figure (rates of one machine class): within 4x of the real time either way
+    assert real / 4 <= value <= 4 * real + 1, (said, real)
+    big = short_scene(tmp_path, nodes=5000, step="0.02 nm")       # ~1 h estimated
+    assert main(["check", str(big)]) == 2
+    err = capsys.readouterr().err
+    assert "solver.nodes" in err and "--force" in err and err.count("\n") == 1
+    assert main(["check", str(big), "--force"]) == 0
+    acc = short_scene(tmp_path, extra="")
+    acc.write_text(acc.read_text().replace("[solver]\n", "[solver]\naccuracy = 1e-9\n", 1))
+    assert main(["run", str(acc), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert "solver.accuracy" in capsys.readouterr().err
+
+
+def test_run_into_empty_folder_name_is_refused(tmp_path, monkeypatch):
+    from femadh.errors import OutputError
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError, match="empty"):
+        femadh.run(femadh.load_scene(short_scene(tmp_path)), "")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["short.toml"]
+
+
+def test_a_result_built_by_hand_is_running():
+    from femadh import ContactResult
+
+    assert ContactResult("x", None).status == "running"
+
+
+def test_resume_of_another_scene_without_summary_is_refused(tmp_path):
+    """summary.json lost: the rows' checksums (seeded with the scene id) tell this scene's
+    run from another's."""
+    a = short_scene(tmp_path)
+    out = tmp_path / "out"
+    damage_cell(a, out, "summary.json deleted")          # (repaired: converged)
+    (out / "summary.json").unlink()
+    other = tmp_path / "other.toml"
+    other.write_text(a.read_text().replace('"2 mm"', '"1 mm"', 1))
+    code, err = cli("run", other, "--out", out, "--quiet", "--resume")
+    assert code == 4 and "curve.csv row 1 does not match" in err and "another scene" in err
+    assert json.loads(json.dumps(err))
