@@ -573,10 +573,10 @@ def _resume_point(folder, scene, problem, run_id, prev, resume_from, res):
         # summary.json lost or unreadable: the checksum of the first row, seeded with the
         # scene id, is the proof that the folder holds this scene's run
         if k == 0:
-            raise DamagedFolder(f"{folder.path}: summary.json is {prev['status'][9:-1]} and "
+            raise DamagedFolder(f"{folder.path}: summary.json is missing or unreadable and "
                                 "curve.csv has no committed row to show it is this scene's "
                                 "run; use --overwrite")
-        notes.append(f"resume: summary.json was {prev['status'][9:-1]}; rewritten (curve.csv's "
+        notes.append("resume: summary.json was missing or unreadable; rewritten (curve.csv's "
                      "rows check with this scene)")
     if k:
         k, more = check_side_files(folder.path, rows, problem.grid.n)

@@ -89,8 +89,6 @@ FE_OPERATOR_PER_NODE = 4.5e-3
 #: error estimate: the coarser members (N/2, N/4) and the peak search, relative to the run
 #: (N^2-N^3 scaling: 1/4..1/8 + 1/16..1/64, the peak search ~10 states)
 ESTIMATE_STATES = 10
-#: adaptive or accuracy runs: trials (each a run with its estimate) the budget allows
-
 #: a scene estimated beyond this many seconds (30 min) is refused unless the user insists
 #: (--force)
 MAX_REASONABLE_S = 1800.0
