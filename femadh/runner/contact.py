@@ -211,7 +211,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
                             f"{rows('curve.csv')} branch states of the previous run replaced)")
         resuming = False
     resume = None
-    writer = None
+    writer = sink = None
 
     def write_summary(status=None):
         if folder is not None:
@@ -254,6 +254,8 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
             else:
                 _trace_steps(scene, problem, sink, resume)
             res.timings["solve_s"] = time.perf_counter() - t1
+            if folder is not None and (folder.path / CHECKPOINT).exists():
+                (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
             if res.status == "running":
                 res.status = "converged"
                 _finish(scene, res, problem, sink, estimate)
@@ -266,6 +268,8 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
         except Interrupted as exc:
             res.status, res.error = exc.status, str(exc)
             res.exit_code = exc.exit_code
+            if sink is not None and res.timings.get("solve_s") is None:
+                _save_checkpoint(folder, sink)       # stopped inside the sweep
         except BaseException as exc:
             # an output fault, a law error, a bug: the summary must not say "converged"
             res.status = "failed"
@@ -337,8 +341,10 @@ class Sink:
         self.scene = result.scene
         # the state of largest F_ex and its neighbours (the peak search needs them)
         self.peak, self._prev, self._need_next = None, None, False
-        # the last committed state of each branch (a resumed branch restarts from it)
+        # the last committed state of each branch (a resumed branch restarts from it), and
+        # the last one whole (state number, branch, State: the checkpoint of a stopped run)
         self.last = {}
+        self.last_state = None
         # an instrument's readout solves fresh states between the branch's own
         self.states, self.jump_states = {}, []
         self._keep = getattr(self.scene, "instrument", None) is not None
@@ -369,7 +375,8 @@ class Sink:
             self._profile(branch, st.d, st.w, st.p_effects.get("lj", 0 * st.w), st.p_contact)
         rows.append([float(v) if not isinstance(v, bool) else v for v in self._row(st)])
         if self.writer:
-            self.writer.write_state(branch, st)
+            k = self.writer.write_state(branch, st)
+            self.last_state = (k, branch, st)
         if self.bar is not None:
             self.bar.update(1)
         self._publish(branch)
@@ -465,6 +472,7 @@ class Sink:
                  + list(self.last.values()) if s is not None]
         wanted = {s.w for s in snaps} | {k for ks in picks.values() for k in ks}
         fields = field_states(folder, wanted)
+        self.last_k = {b: s.w for b, s in self.last.items()}
         for s in {id(s): s for s in snaps}.values():
             d, w, _, p_el = fields[s.w]
             s.w, s.active = w, p_el != 0
@@ -549,6 +557,11 @@ def _restart_state(problem, scene, sink, branch):
 
     last = sink.last[branch]
     d, w = last.d, last.w
+    if sink.writer is not None:
+        # stopped by a signal or its time limit: the state was saved whole (bit for bit)
+        st = _load_checkpoint(sink.writer.dir, getattr(sink, "last_k", {}).get(branch), d)
+        if st is not None:
+            return st
     kw = {}
     if problem.contact_model == "hertz-closure":
         kw["r_c0"] = float(sink.result.branches[branch]["r_c_m"][-1]) or None
@@ -652,3 +665,75 @@ def _once(path):
             continue
         out.append(e)
     return out
+
+
+#: the last committed state of a sweep stopped by a signal or its time limit, whole (its
+#: factorisation included): a resumed sweep continues from it bit for bit
+CHECKPOINT = "checkpoint.npz"
+
+
+def _save_checkpoint(folder, sink):
+    """Write the last committed state whole (npz, no pickle), if the sweep has one this
+    format holds (complementarity / smooth laws; the closure's states are re-solved)."""
+    from ..contact.linalg import TrailingLU
+    from ..io.atomic import save_atomic
+
+    if sink is None or sink.writer is None or sink.last_state is None:
+        return
+    k, branch, st = sink.last_state
+    if st.diagnostics or sink.problem.contact_model == "hertz-closure":
+        return
+    data = {"k": np.array(k), "branch": np.array(branch), "d": np.array(st.d), "w": st.w,
+            "h": st.h, "p_contact": st.p_contact, "active": st.active,
+            "r_c": np.array(st.r_c), "n_iter": np.array(st.n_iter),
+            "residual": np.array(st.residual), "flags": np.array([st.converged, st.stable]),
+            "effects": np.array(list(st.p_effects))}
+    data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
+    lu = st.lu
+    if lu is None:
+        data["lu_kind"] = np.array("none")
+    elif isinstance(lu, TrailingLU):
+        data.update(lu_kind=np.array("trailing"), lu=lu.lu, piv=lu.piv,
+                    dims=np.array([lu.n, lu.m0, lu.k_valid]))
+        if lu.scale is not None:
+            data["scale"] = lu.scale
+    elif isinstance(lu, tuple) and len(lu) == 2 and isinstance(lu[0], tuple):
+        data.update(lu_kind=np.array("dense"), lu=lu[0][0], piv=lu[0][1], lu_I=lu[1])
+    else:
+        return
+    def write(path):
+        with open(path, "wb") as f:
+            np.savez(f, **data)
+    save_atomic(folder.path / CHECKPOINT, write)
+
+
+def _load_checkpoint(folder, k, d):
+    """The whole state number k at separation d from the checkpoint, or None (absent, of
+    another state, unreadable: the caller re-solves the state from fields.csv)."""
+    from ..contact.linalg import TrailingLU
+
+    path = folder / CHECKPOINT
+    if not path.exists():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if int(z["k"]) != k or float(z["d"]) != d:
+                return None
+            kind = str(z["lu_kind"])
+            if kind == "trailing":
+                lu = TrailingLU.__new__(TrailingLU)
+                lu.n, lu.m0, lu.k_valid = (int(x) for x in z["dims"])
+                lu.lu, lu.piv = z["lu"], z["piv"]
+                lu.scale = z["scale"] if "scale" in z.files else None
+                lu._block = (None, None)
+            elif kind == "dense":
+                lu = ((z["lu"], z["piv"]), z["lu_I"])
+            else:
+                lu = None
+            conv, stable = (bool(x) for x in z["flags"])
+            return State(float(z["d"]), z["w"], z["h"],
+                         {str(n): z[f"pe_{n}"] for n in z["effects"]}, z["p_contact"],
+                         z["active"], float(z["r_c"]), int(z["n_iter"]),
+                         float(z["residual"]), conv, stable, lu)
+    except (OSError, ValueError, KeyError):
+        return None
