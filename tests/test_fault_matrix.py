@@ -177,3 +177,33 @@ def test_resume_of_another_scene_without_summary_is_refused(tmp_path):
     code, err = cli("run", other, "--out", out, "--quiet", "--resume")
     assert code == 4 and "curve.csv row 1 does not match" in err and "another scene" in err
     assert json.loads(json.dumps(err))
+
+
+def test_accuracy_run_stopped_in_its_second_trial_resumes_to_the_uninterrupted(tmp_path):
+    """An accuracy run (trials on ever finer grids in one folder) stopped by SIGTERM inside
+    its second trial: --resume recognises the folder (claimed under the user's scene),
+    runs the first trial again (the folder holds the second's rows, which do not check with
+    the first's id) and continues; summary.json and curve.csv as uninterrupted, bit for
+    bit."""
+    import femadh.runner.contact as contact
+    from validation.fault_matrix import Signal
+
+    scene = short_scene(tmp_path, nodes=50, step="0.5 nm")
+    scene.write_text(scene.read_text().replace("[solver]\n", "[solver]\naccuracy = 5e-3\n", 1))
+    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-figures")[0] == 0
+    ref = summary(tmp_path / "ref")
+    assert [s["nodes"] for s in ref["accuracy"]["steps"]] == [50, 200]   # two trials
+    out = tmp_path / "out"
+    s = Signal(signal.SIGTERM, after=2 * 15 + 20)      # trial 1 has 30 states
+    real = contact.Sink.state
+    contact.Sink.state = s.wrap(real)
+    try:
+        assert cli("run", scene, "--out", out, "--quiet", "--no-figures")[0] == 143
+    finally:
+        contact.Sink.state = real
+    stopped = summary(out)
+    assert stopped["status"] == "interrupted" and stopped["scene"]["solver"]["nodes"] == 200
+    code, err = cli("run", scene, "--out", out, "--quiet", "--no-figures", "--resume")
+    assert code == 0, err
+    assert differences(ref, summary(out)) == []
+    assert curve_rows(out) == curve_rows(tmp_path / "ref")
