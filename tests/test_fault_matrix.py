@@ -194,9 +194,11 @@ def test_accuracy_run_stopped_in_its_second_trial_resumes_to_the_uninterrupted(t
     ref = summary(tmp_path / "ref")
     assert [s["nodes"] for s in ref["accuracy"]["steps"]] == [50, 200]   # two trials
     out = tmp_path / "out"
-    s = Signal(signal.SIGTERM, after=2 * 15 + 20)      # trial 1 has 30 states
+    s = Signal(signal.SIGTERM)
     real = contact.Sink.state
-    contact.Sink.state = s.wrap(real)
+    # at the 11th state of the second trial's own sweep (200 nodes; its members have fewer)
+    contact.Sink.state = s.wrap(real, when=lambda sink, branch, st: sink.problem.grid.n == 200
+                                and len(sink.rows.get(branch, ())) >= 10)
     try:
         assert cli("run", scene, "--out", out, "--quiet", "--no-figures")[0] == 143
     finally:
