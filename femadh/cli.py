@@ -235,9 +235,12 @@ def _require_contact(scene, what):
 
 def _check(scene, path):
     if scene.kind == "meniscus":
+        from .scene.resources import _hms, meniscus_time
+
         n = len(scene.liquids) * len(scene.radii) * len(scene.methods) * len(scene.p_ratios)
         print(f"{path}: ok (meniscus: {len(scene.liquids)} liquids, {len(scene.radii)} radii, "
-              f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves)")
+              f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves, "
+              f"~{_hms(meniscus_time(scene)[0])} at rates measured on a 2-core machine)")
         return 0
     from .scene.resources import _hms, memory_estimate, time_estimate
 

@@ -209,3 +209,20 @@ def test_accuracy_run_stopped_in_its_second_trial_resumes_to_the_uninterrupted(t
     assert code == 0, err
     assert differences(ref, summary(out)) == []
     assert curve_rows(out) == curve_rows(tmp_path / "ref")
+
+
+def test_meniscus_sweep_beyond_reason_is_refused(tmp_path, capsys):
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"
+            / "paper2_ethanol_100nm.toml").read_text()
+    p = tmp_path / "m.toml"
+    p.write_text(text)
+    assert main(["check", str(p)]) == 0
+    assert "solves, ~" in capsys.readouterr().out
+    p.write_text(text.replace("relative_pressure = [0.05, 0.1, 0.15, 0.2, 0.4, 0.6, 0.8, 0.95]",
+                              "relative_pressure = { start = 0.01, stop = 0.99, num = 100000 }"))
+    assert main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "meniscus.relative_pressure" in err and "--force" in err and err.count("\n") == 1
+    assert not (tmp_path / "o").exists()
