@@ -226,3 +226,35 @@ def test_meniscus_sweep_beyond_reason_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "meniscus.relative_pressure" in err and "--force" in err and err.count("\n") == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_a_signal_stops_the_state_being_solved_not_after_it(ref, tmp_path):
+    """The solver checks for a signal between its iterations: a signal that arrives in the
+    first Newton iteration of the 21st state leaves that state uncommitted (stopping only
+    between states would commit it first)."""
+    import os
+
+    import femadh.contact.complementarity as cp
+    import femadh.runner.contact as contact
+
+    scene = ref[0]
+    out = tmp_path / "out"
+    committed = []
+    real_state, real_residual = contact.Sink.state, cp._residual
+
+    def state(self, branch, st):
+        committed.append(st.d)
+        return real_state(self, branch, st)
+
+    def residual(*a):
+        if len(committed) == 20 and not getattr(residual, "sent", False):
+            residual.sent = True
+            os.kill(os.getpid(), signal.SIGTERM)
+        return real_residual(*a)
+    contact.Sink.state, cp._residual = state, residual
+    try:
+        code, err = cli("run", scene, "--out", out, "--quiet", "--no-estimate")
+    finally:
+        contact.Sink.state, cp._residual = real_state, real_residual
+    assert code == 143, err
+    assert len(committed) == 20 and len(curve_rows(out)) == 21     # header + 20 states
