@@ -258,3 +258,15 @@ def test_a_signal_stops_the_state_being_solved_not_after_it(ref, tmp_path):
         contact.Sink.state, cp._residual = real_state, real_residual
     assert code == 143, err
     assert len(committed) == 20 and len(curve_rows(out)) == 21     # header + 20 states
+
+
+@pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_in_an_estimate_member_without_figures_is_an_interrupt(ref, tmp_path, sig,
+                                                                      code):
+    """Without figures nothing after the estimate would notice a pending signal: a member
+    stopped by it stops the run (never exit 0 "converged" with a degraded estimate)."""
+    scene, ref_summary, _ = ref
+    c = signal_cell(scene, tmp_path / "out", "estimate", sig, "--no-figures")
+    assert (c["exit"], c["status"]) == (code, "interrupted"), c
+    assert (c["resume_exit"], c["resume_status"]) == (0, "converged")
+    assert summary(tmp_path / "out")["headline"] == ref_summary["headline"]

@@ -263,6 +263,9 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
                     from ..io.writers import write_instrument
 
                     write_instrument(folder.path, res)
+                # a signal that arrived after the last safe point is still a stop: the run
+                # never ends "converged" once the user has asked it to stop
+                interrupt.check()
         except (ConvergenceError, GuardError) as exc:
             res.status, res.error = "failed", str(exc)
         except Interrupted as exc:
