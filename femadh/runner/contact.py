@@ -212,6 +212,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
         resuming = False
     resume = None
     writer = sink = None
+    checked = False         # a resumed folder's record has been checked (and is kept)
 
     def write_summary(status=None):
         if folder is not None:
@@ -229,6 +230,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
                 # every committed row checked before anything is appended (refused in one
                 # line, or the side files cut back to what is complete in all of them)
                 resume = _resume_point(folder, scene, problem, run_id, prev, resume_from, res)
+                checked = True
             if resuming:
                 write_summary("running")
             res.nodes = problem.grid.nodes.copy()
@@ -277,7 +279,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
             # an output fault, a law error, a bug: the summary must not say "converged"
             res.status = "failed"
             res.error = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
-            if resume is None and resuming and isinstance(exc, OutputError):
+            if resuming and not checked and isinstance(exc, OutputError):
                 # refused while checking the folder: it is left as it was
                 folder = None
             raise
@@ -450,7 +452,8 @@ class Sink:
         from ..io.resume_check import field_states
 
         rows = resume["rows"]
-        head = (folder / "curve.csv").open().readline().strip().split(",")
+        with open(folder / "curve.csv") as f:
+            head = f.readline().strip().split(",")
         col = [head.index(c) for c in self.columns]
         per_branch = {}
         # the peak bookkeeping replayed over the committed rows (state numbers stand in for
