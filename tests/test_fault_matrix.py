@@ -299,3 +299,24 @@ def test_sweep_with_jumps_stopped_after_its_jump_in_resumes_bit_for_bit(tmp_path
     assert differences(ref, summary(out)) == []
     for name in ("curve.csv", "jumps.csv", "diagnostics.csv", "fields.csv"):
         assert (out / name).read_bytes() == (tmp_path / "ref" / name).read_bytes(), name
+
+
+def test_instrument_scene_resumed_equals_uninterrupted_but_for_its_note(tmp_path):
+    """A stepping scene with an [instrument]: its readout refines between every state and
+    its jumps' fold and landing states (not in the files), so --resume computes the sweep
+    again and says so; every other summary field equals the uninterrupted run's."""
+    from validation.fault_matrix import ROOT
+
+    text = (ROOT / "validation" / "scenes" / "afm_tip_cantilever.toml").read_text()
+    scene = tmp_path / "ins.toml"
+    scene.write_text(text.replace('continuation = "arclength"', 'continuation = "steps"')
+                     .replace("nodes = 150", "nodes = 60"))
+    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-figures")[0] == 0
+    c = signal_cell(scene, tmp_path / "out", "estimate", signal.SIGTERM, "--no-figures")
+    assert (c["exit"], c["resume_exit"]) == (143, 0)
+    got, ref = summary(tmp_path / "out"), summary(tmp_path / "ref")
+    assert differences(ref, got) == ["warnings"]
+    assert [w for w in got["warnings"] if w not in ref["warnings"]] == [
+        "resume: the sweep was computed again from its start (an instrument's readout needs "
+        "every state of it in memory)"]
+    assert got["instrument"] == ref["instrument"]

@@ -210,6 +210,12 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
                             f"({rows('equilibrium_curve.csv')} curve points and "
                             f"{rows('curve.csv')} branch states of the previous run replaced)")
         resuming = False
+    elif resuming and getattr(scene, "instrument", None) is not None:
+        # an instrument's readout refines between the sweep's own states and its jumps'
+        # fold and landing states, which the files do not hold: the sweep is run again
+        res.warnings.append("resume: the sweep was computed again from its start (an "
+                            "instrument's readout needs every state of it in memory)")
+        resuming = False
     resume = None
     writer = sink = None
     checked = False         # a resumed folder's record has been checked (and is kept)
