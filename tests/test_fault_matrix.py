@@ -320,3 +320,30 @@ def test_instrument_scene_resumed_equals_uninterrupted_but_for_its_note(tmp_path
         "resume: the sweep was computed again from its start (an instrument's readout needs "
         "every state of it in memory)"]
     assert got["instrument"] == ref["instrument"]
+
+
+def test_a_lock_taken_on_a_removed_lock_file_is_taken_again(tmp_path, monkeypatch):
+    """A run that opened the lock file just before the previous run removed it (as it ends)
+    would lock a removed file, and a third run could lock the new one: both would run. The
+    claim checks that the file it locked is still the folder's, and locks again if not."""
+    import fcntl
+    import os
+
+    import femadh.io.run_folder as rf
+
+    real = fcntl.flock
+    calls = []
+
+    def flock(fd, op):
+        real(fd, op)
+        if not calls:                         # the previous run's release, just now
+            os.unlink(tmp_path / rf.LOCK)
+        calls.append(fd)
+    monkeypatch.setattr(rf.fcntl, "flock", flock)
+    folder = rf.RunFolder(tmp_path, "id", "x", "new")
+    try:
+        assert len(calls) == 2                # taken again, on the folder's current file
+        assert os.fstat(folder.lock_fd).st_ino == os.stat(tmp_path / rf.LOCK).st_ino
+    finally:
+        folder.release()
+    assert not (tmp_path / rf.LOCK).exists()
