@@ -240,15 +240,17 @@ def _check(scene, path):
         n = len(scene.liquids) * len(scene.radii) * len(scene.methods) * len(scene.p_ratios)
         print(f"{path}: ok (meniscus: {len(scene.liquids)} liquids, {len(scene.radii)} radii, "
               f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves, "
-              f"~{_hms(meniscus_time(scene)[0])} at rates measured on a 2-core machine)")
+              f"about {_hms(meniscus_time(scene)[0])} at rates measured on a 2-core machine)")
         return 0
     from .scene.resources import _hms, memory_estimate, time_estimate
 
     mem, _ = memory_estimate(scene)
     t, what = time_estimate(scene)
     print(f"{path}: ok ({len(scene.d_values)} separations, {', '.join(scene.directions)}, "
-          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB, ~{_hms(t)} with "
-          f"its error estimate: {what}, at rates measured on a 2-core machine)")
+          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB, "
+          f"{'' if t < 1 else '~'}{_hms(t)} with "
+          f"its error estimate: {what}, at rates measured on a 2-core machine; folds and "
+          "jumps can take up to ~10x more)")
     return 0
 
 
