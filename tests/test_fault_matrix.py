@@ -125,22 +125,21 @@ def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
 
 
 def test_check_estimates_time_and_refuses_absurd_cost(tmp_path, capsys):
-    from femadh.scene.resources import _state_time
+    from femadh.scene.resources import time_estimate
 
-    (tmp_path / "large").mkdir()
-    small, large = short_scene(tmp_path, nodes=200), short_scene(tmp_path / "large", nodes=800)
+    small = short_scene(tmp_path, nodes=200)
     assert main(["check", str(small)]) == 0
     said = capsys.readouterr().out
     assert " with its error estimate: 72 states of 200 nodes, at rates measured" in said
-    # the model's growth in N of a state's cost against this machine's, now (a loaded
-    # machine slows both runs alike; the absolute rates are those of an idle one): measured
-    # 19.7x idle and 21.8x under a load of 6 on 2 cores, the model's 19.8x; allowed 2x
-    real = []
-    for p in (small, large):
-        res = femadh.run(femadh.load_scene(p), progress=False, estimate=False)
-        real.append(res.timings["solve_s"])
-    ratio = (_state_time(800) / _state_time(200)) / (real[1] / real[0])
-    assert 0.5 <= ratio <= 2.0, real
+    # the estimate counts the sweep's states and grows with the nodes (its rates and their
+    # accuracy against real runs are measured in femadh/scene/resources.py: a timing
+    # assertion here would judge the CI machine's load, not the model)
+    est = {n: time_estimate(femadh.load_scene(short_scene(tmp_path, nodes=n)))[0]
+           for n in (200, 800, 3200)}
+    assert est[200] < est[800] < est[3200]
+    finer = short_scene(tmp_path, nodes=800, step="0.1 nm")
+    # twice the states (the first state and the peak search do not double)
+    assert 1.5 * est[800] < time_estimate(femadh.load_scene(finer))[0] < 2 * est[800]
     big = short_scene(tmp_path, nodes=5000, step="0.02 nm")       # ~1 h estimated
     assert main(["check", str(big)]) == 2
     err = capsys.readouterr().err
