@@ -92,9 +92,14 @@ def _parser():
                        description="Run every combination of the --vary values (or the "
                                    "scene's [study] table) and write study.csv, study.png and "
                                    "points/<id>/ (one run folder and record per point). "
-                                   "Running it again computes only the missing points.",
-                       epilog="VALUES: '0.5 nm,1 nm,2 nm' | 'lo..hi:n' | 'lo..hi:n:log', "
-                              "e.g. --vary effects.asperity_gap.sigma='0.3 nm..2 nm:10'")
+                                   "Running it again reuses the finished points and runs the "
+                                   "interrupted, crashed and missing ones. Exit 3 when points "
+                                   "failed (one line per reason); 130/143 on SIGINT/SIGTERM "
+                                   "(finished points kept).",
+                       epilog="VALUES: '0.5 nm,1 nm,2 nm' | 'lo..hi:n' | 'lo..hi:n:log', with "
+                              "units as in a scene file (a bare number is refused for a "
+                              "dimensional key), e.g. --vary "
+                              "effects.asperity_gap.sigma='0.3 nm..2 nm:10'")
     sw.add_argument("scene", help="scene file (TOML)")
     sw.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
                     help="a dotted scene key and its values (repeatable)")
@@ -332,7 +337,7 @@ def _study(scene, args):
 
 
 def _sweep(scene, args):
-    from .studies.sweep import run_study
+    from .studies.sweep import _indices, failure_reasons, finished, run_study
 
     vary = {}
     for item in args.vary:
@@ -347,16 +352,31 @@ def _sweep(scene, args):
     if args.workers is not None and args.workers < 1:
         raise SceneError("command line", "--workers", args.workers, "an integer >= 1")
     out = args.out or f"{scene.output_dir}/study"
-    points, records = run_study(scene, vary, out, zip_=zip_, workers=args.workers,
-                                scheduler=args.scheduler,
-                                progress=not args.quiet and sys.stderr.isatty(),
-                                quantity=args.quantity)
-    failed = [r for r in records.values() if r["status"] != "converged"]
-    print(f"{len(points)} points ({len(points) - len(failed)} converged, {len(failed)} "
-          f"failed) in {out}: study.csv, study.png, points/<id>/")
-    for r in failed[:5]:
-        print(f"femadh: note: point {r['index']} ({r['changes']}): {r['error']}",
-              file=sys.stderr)
+    try:
+        study = run_study(scene, vary, out, zip_=zip_, workers=args.workers,
+                          scheduler=args.scheduler,
+                          progress=not args.quiet and sys.stderr.isatty(),
+                          quantity=args.quantity)
+    except Interrupted as exc:
+        st = exc.study
+        kept = sum(finished(r) for r in st.records.values())
+        _error(f"study {exc}: {kept} of {len(st.points)} points finished and kept in {out} "
+               "(study.csv); run the same command again to compute the others")
+        return exc.exit_code
+    n, failed = len(study.points), study.failed
+    for note in study.notes:
+        print(f"femadh: note: {note}", file=sys.stderr)
+    print(f"{n} points ({n - len(failed)} converged, {len(failed)} failed; reused "
+          f"{study.reused}, redone {study.redone}, new {study.new}) in {out}: study.csv"
+          + (", study.png" if study.figure else "") + ", points/<id>/")
+    if failed:
+        _error(f"{len(failed)} of {n} points failed:")
+        for reason, idx in failure_reasons(failed):
+            _error(f"  {len(idx)} point{'s' if len(idx) > 1 else ''} ({_indices(idx)}): "
+                   f"{reason}")
+        if study.figure is None and len(failed) == n:
+            _error("no figure: every point failed (study.csv has each point's reason)")
+        return EXIT_SOLVE
     return 0
 
 
@@ -387,8 +407,12 @@ def _regime(args):
             f"mu = {p.mu:.3g}: pull-off {p.pull_off:.4f} pi R dg ({i + 1}/{len(mus)})"))
             if say else None, accuracy=args.accuracy or None, **kw)
         path = write_regime(pts, args.out)
-    print(path.read_text(), end="")
-    print(f"results in {args.out} ({sum(p.wall_time for p in pts):.1f} s)")
+    from .studies.regime import regime_table
+
+    # people get the short table; every column (errors, grids, timings) is in the csv
+    print(regime_table(pts))
+    print(f"results in {args.out}: {path.name} (every column), regime_map.png, "
+          f"regime_curves.png ({sum(p.wall_time for p in pts):.1f} s)")
     return 0
 
 

@@ -5,6 +5,9 @@ from pathlib import Path
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # the tests run on the committed FE mesh ladder (fixed meshes whatever gmsh is installed)
 os.environ.setdefault("FEMADH_MESH_PATH", str(Path(__file__).resolve().parents[1] / "meshes"))
+# condensed FE operators cached per test process, not in the user's ~/.cache
+os.environ.setdefault("FEMADH_OPERATOR_CACHE", __import__("tempfile").mkdtemp(
+    prefix="femadh-operators-"))
 
 import numpy as np
 import pytest

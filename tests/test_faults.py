@@ -106,6 +106,7 @@ def test_fe_run_interrupted_keeps_its_vtk_consistent_and_resumes(tmp_path):
     text = (ROOT / "validation" / "scenes" / "paper1_fig3_fe.toml").read_text()
     text = text.replace("nodes = 200", "nodes = 60").replace('step = "0.2 nm"',
                                                               'step = "0.05 nm"')
+    text += "vtk = true\n"                 # [output]: every state's VTK as it converges
     scene = tmp_path / "fe.toml"
     scene.write_text(text)
     out = tmp_path / "out"
@@ -245,6 +246,7 @@ def test_previous_run_refused_overwrite_cleans_it(tmp_path, capsys):
     text = fe.read_text().replace("nodes = 200", "nodes = 40")
     text = text.replace('stop = "-5 nm"', 'stop = "0 nm"').replace('step = "0.2 nm"',
                                                                     'step = "1 nm"')
+    text += "vtk = true\n"                 # [output]: every state's VTK as it converges
     (tmp_path / "fe.toml").write_text(text)
     assert main(["run", str(tmp_path / "fe.toml"), "--out", str(out), "--quiet",
                  "--no-figures"]) == 0

@@ -142,6 +142,7 @@ def test_vtk_output_opens_in_pyvista(tmp_path):
     data = dict(sc.raw)
     data["solver"] = dict(data["solver"], method="fe", nodes=40)
     data["sweep"] = {"start": "1 nm", "stop": "-1 nm", "step": "1 nm", "directions": ["approach"]}
+    data["output"] = dict(data.get("output", {}), vtk=True)
     sc = scene_from_dict(data, "test")
     res = run(sc, str(tmp_path), figures=False, progress=False)
     assert res.status == "converged" and sc.vtk
@@ -169,3 +170,65 @@ def test_coarse_nodes_warn_about_lj_stiffness(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", MeshResolutionWarning)
         run(load("paper1_fig3", 200), progress=False)  # the bundled default: quiet
+
+
+def _cache_env(tmp_path, monkeypatch):
+    monkeypatch.setenv("FEMADH_OPERATOR_CACHE", str(tmp_path / "ops"))
+    return tmp_path / "ops"
+
+
+def test_cached_operator_equals_a_fresh_one_and_builds_its_body_on_demand(tmp_path,
+                                                                          monkeypatch):
+    """The operator cache: a miss condenses and stores, a hit returns the stored compliance
+    (float64 npz: the same bits as the fresh condensation, so equal to round-off is exact),
+    and the hit's factorised body (full fields, VTK) is built only when asked for, giving the
+    fresh operator's full field."""
+    cache = _cache_env(tmp_path, monkeypatch)
+    g = RadialGrid.uniform(6.32e-6, 40)
+    fresh = FEOperator(g, E_STAR, 0.3)
+    miss = FEOperator.cached(g, E_STAR, 0.3)
+    assert not miss.cache_hit and len(list(cache.glob("fe-*.npz"))) == 1
+    hit = FEOperator.cached(g, E_STAR, 0.3)
+    assert hit.cache_hit and "assembly" not in hit.timings     # nothing assembled
+    assert np.array_equal(hit.compliance, miss.compliance)
+    # a separate condensation: same sparse LU, same bits here (allow round-off anyway)
+    assert np.allclose(hit.compliance, fresh.compliance, rtol=1e-12, atol=0)
+    p = np.linspace(1e6, 0, 40)
+    u = hit.full_field(p)                                      # builds the body now
+    assert "assembly" in hit.timings
+    assert np.allclose(u, fresh.full_field(p), rtol=1e-12, atol=1e-30)
+
+
+def test_operator_cache_is_invalidated_by_a_changed_body(tmp_path, monkeypatch):
+    """Another material, Poisson ratio, mesh setting or mesh file is another key (a new
+    condensation); the sphere's compliance is added on load, not cached."""
+    import shutil
+
+    from femadh.elastic.fe.cache import operator_key
+    from femadh.materials import IsotropicMaterial
+
+    cache = _cache_env(tmp_path, monkeypatch)
+    g = RadialGrid.uniform(6.32e-6, 30)
+    base = FEOperator.cached(g, E_STAR, 0.3)
+    for other in (FEOperator.cached(g, 1.01 * E_STAR, 0.3), FEOperator.cached(g, E_STAR, 0.25),
+                  FEOperator.cached(g, E_STAR, 0.3, FESettings(1e4, growth=0.3))):
+        assert not other.cache_hit
+        assert not np.array_equal(other.compliance, base.compliance)
+    assert len(list(cache.glob("fe-*.npz"))) == 4
+    # the same spec but a different mesh file (rebuilt, replaced): another key
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    src = base._mesh_path
+    shutil.copy(src, meshes / src.name)
+    with open(meshes / src.name, "a") as f:
+        f.write("\n")                                         # other bytes, same mesh
+    monkeypatch.setenv("FEMADH_MESH_PATH", str(meshes))
+    moved = FEOperator.cached(g, E_STAR, 0.3)
+    assert moved._mesh_path != src and operator_key(moved) != operator_key(base)
+    assert not moved.cache_hit
+    # a sphere material on a layered-call body: the sphere's Green part is added on load
+    sub = IsotropicMaterial(163e9, 0.3)
+    rigid = FEOperator.cached(g, substrate=sub)
+    soft = FEOperator.cached(g, substrate=sub, sphere=IsotropicMaterial(83e9, 0.21))
+    assert soft.cache_hit and np.array_equal(soft.compliance_body, rigid.compliance_body)
+    assert not np.array_equal(soft.compliance, rigid.compliance)

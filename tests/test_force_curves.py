@@ -36,7 +36,7 @@ def fig3(tmp_path_factory):
     text = text.replace('dir = "out/paper1-fig3"', f'dir = "{tmp / "out"}"')
     (tmp / "fig3.toml").write_text(text)
     scene = load_scene(tmp / "fig3.toml")
-    sim, err = simulate(scene.replace({"effects.lennard_jones.hamaker": A_TRUE}))
+    sim, err = simulate(scene.replace({"effects.lennard_jones.hamaker": A_TRUE}, si=True))
     assert err is None
     d = np.linspace(1.9, -0.3, N_BRANCH) * 1e-9 + 0.037e-9
     d = np.r_[d, d[::-1]]

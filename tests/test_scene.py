@@ -78,7 +78,7 @@ def test_cli_run_writes_outputs_and_keeps_header(tmp_path):
     assert check_curve_against_fields(out) == len(c["d_m"])
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "converged" and summary["femadh_version"] == femadh.__version__
-    assert (out / "fig3_panels.png").stat().st_size > 10_000
+    assert (out / "profiles_and_forces.png").stat().st_size > 10_000
     assert (out / "fields.csv").exists()
 
 

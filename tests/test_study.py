@@ -15,11 +15,25 @@ import pytest
 import femadh
 from conftest import fig3_uniform_text
 from femadh.cli import main
+from femadh.errors import SceneError
 from femadh.studies.sweep import parse_values, run_study, study_points
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+
+
+def _finished(out):
+    """The ids of the points whose record says they finished."""
+    ids = set()
+    for f in Path(out).glob("points/*/record.json"):
+        try:
+            rec = json.loads(f.read_text())
+        except ValueError:
+            continue            # (records are written atomically; a race with the glob)
+        if rec.get("finished"):
+            ids.add(rec["id"])
+    return ids
 
 
 def small():
@@ -31,6 +45,12 @@ def test_values_and_points_are_validated_before_anything_runs(tmp_path, capsys):
     assert parse_values("0.2 nm..2 nm:4") == ["0.2 nm", "0.8 nm", "1.4 nm", "2 nm"]
     assert parse_values("1e-3..1e-1:3:log") == pytest.approx([1e-3, 1e-2, 1e-1], rel=1e-12)
     assert parse_values("100,200") == [100, 200]
+    # a quantity needs its unit on the command line as in a file: bare numbers for a length
+    # are refused with the file's error (never 0.8 m), one line for the whole range
+    with pytest.raises(SceneError) as exc:
+        study_points(small(), {"effects.asperity_gap.sigma": "0.8..1.2:3"})
+    assert len(str(exc.value).splitlines()) == 1
+    assert "bare number has no unit" in str(exc.value) and "3 of 3 points" in str(exc.value)
     pts = study_points(small(), {"effects.asperity_gap.sigma": "0.5 nm,1 nm",
                                  "sphere.radius": "1 mm,2 mm"})
     assert len(pts) == 4 and len({p.id for p in pts}) == 4
@@ -58,9 +78,13 @@ def test_dask_local_cluster_matches_the_process_pool_and_resumes(tmp_path):
     run_study(sc, vary, tmp_path / "pool", workers=2, estimate=False)
     assert json.loads((tmp_path / "pool" / "timing.json").read_text())["computed"] == 0
     assert time.perf_counter() - t0 < 5
-    rows = (tmp_path / "pool" / "study.csv").read_text().splitlines()
-    assert len(rows) == 5 and rows[0].startswith("index,id,effects.asperity_gap.sigma,"
-                                                 "sphere.radius,status")
+    rows = _table(tmp_path / "pool")
+    # the varied values in SI, the unit in the header; the text in the label
+    assert len(rows) == 5 and rows[0][:7] == ["index", "id", "label",
+                                              "effects.asperity_gap.sigma_m", "sphere.radius_m",
+                                              "status", "error"]
+    assert rows[1][2:5] == ["effects.asperity_gap.sigma = 0.5 nm, sphere.radius = 1 mm",
+                            repr(0.5e-9), repr(1e-3)]
 
 
 def test_killed_study_loses_no_completed_point(tmp_path):
@@ -68,20 +92,24 @@ def test_killed_study_loses_no_completed_point(tmp_path):
     scene.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60"))
     out = tmp_path / "study"
     cmd = [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary",
-           "effects.asperity_gap.sigma=0.4 nm..2 nm:6", "--out", str(out), "--workers", "1",
+           "effects.asperity_gap.sigma=0.8 nm..2 nm:6", "--out", str(out), "--workers", "1",
            "--quiet"]
     p = subprocess.Popen(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE)
     t0 = time.time()
-    while not list(out.glob("points/*/record.json")) and time.time() - t0 < 60:
+    while not _finished(out) and time.time() - t0 < 60:
         time.sleep(0.05)
     p.send_signal(signal.SIGKILL)
     p.communicate()
-    done = {f.parent.name for f in out.glob("points/*/record.json")}
+    done = {f.parent.name for f in out.glob("points/*/record.json")
+            if json.loads(f.read_text())["finished"]}
     assert 1 <= len(done) < 6
     r = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
-    assert json.loads((out / "timing.json").read_text())["computed"] == 6 - len(done)
+    timing = json.loads((out / "timing.json").read_text())
+    # the point the kill cut short has a record that never finished: it is redone
+    assert timing["computed"] == 6 - len(done) and timing["reused"] == len(done)
+    assert timing["redone"] >= 1
     assert len(list(out.glob("points/*/record.json"))) == 6
 
 
@@ -114,3 +142,226 @@ def test_mesh_cache_is_safe_with_concurrent_writers(tmp_path):
     assert len(n) == 1 and int(n.pop()) > 10
     files = list(tmp_path.iterdir())
     assert len(files) == 1 and files[0].suffix == ".msh"
+
+
+# --------------------------------------------------------------------------- nothing lost
+
+SIGMAS = "effects.asperity_gap.sigma=0.8 nm..2 nm:8"    # 8 points that all converge
+
+
+def _descendants(pid):
+    """Every live process below ``pid`` (from /proc: the study's workers, Dask's nannies)."""
+    parent = {}
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                stat = (d / "stat").read_text()
+            except OSError:
+                continue
+            fields = stat.rsplit(")", 1)[1].split()
+            if fields[0] != "Z":                        # a zombie is gone, only not reaped
+                parent[int(d.name)] = int(fields[1])
+    out, frontier = set(), {pid}
+    for _ in range(10):                                  # the tree is 3 deep at most
+        frontier = {c for c, p in parent.items() if p in frontier} - out
+        if not frontier:
+            break
+        out |= frontier
+    return out
+
+
+def _alive(pids):
+    alive = set()
+    for pid in pids:
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if state != "Z":
+            alive.add(pid)
+    return alive
+
+
+@pytest.fixture(scope="module")
+def study_scene(tmp_path_factory):
+    """The 60-node Fig 3 scene and its 8-point study run uninterrupted (the reference, in
+    this process: the same solver and inputs as a pool's workers, the same numbers)."""
+    tmp = tmp_path_factory.mktemp("study")
+    scene = tmp / "s.toml"
+    scene.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60"))
+    ref = tmp / "ref"
+    assert main(_cmd(scene, ref, "--workers", "1")[3:]) == 0
+    return scene, ref
+
+
+def _cmd(scene, out, *extra):
+    return [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary", SIGMAS,
+            "--out", str(out), "--quiet", *extra]
+
+
+def _table(out):
+    """study.csv as a list of rows of cells (text as written)."""
+    import csv
+
+    with open(Path(out) / "study.csv", newline="") as f:
+        return list(csv.reader(f))
+
+
+@pytest.mark.parametrize("sig, executor", [(signal.SIGINT, "pool"), (signal.SIGTERM, "pool"),
+                                           (signal.SIGTERM, "dask")])
+def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, tmp_path, sig,
+                                                                  executor):
+    """SIGINT/SIGTERM to the driver mid-way: exit 130/143 within seconds, no process left,
+    the finished points kept; the interrupted points are redone by the next run, whose
+    study.csv equals the uninterrupted study's cell by cell (same solver, same inputs)."""
+    scene, ref = study_scene
+    out = tmp_path / "study"
+    extra = ("--workers", "2") if executor == "pool" else ("--scheduler", "local:2")
+    p = subprocess.Popen(_cmd(scene, out, *extra), cwd=ROOT, env=ENV,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    kids, t0 = set(), time.time()
+    while len(_finished(out)) < 2 and p.poll() is None and time.time() - t0 < 120:
+        kids |= _descendants(p.pid)
+        time.sleep(0.05)
+    assert p.poll() is None, "the study ended before the signal"
+    kids |= _descendants(p.pid)
+    t_sig = time.time()
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=60)
+    stop_s = time.time() - t_sig
+    assert p.returncode == 128 + sig, err
+    assert f"interrupted by {signal.Signals(sig).name}" in err and "run the same" in err
+    assert stop_s < 15, stop_s            # measured 0.2 s (pool) and 1.0 s (Dask)
+    t0 = time.time()
+    while _alive(kids) and time.time() - t0 < 10:
+        time.sleep(0.1)
+    assert kids and not _alive(kids), _alive(kids)
+    kept = _finished(out)
+    assert 2 <= len(kept) < 8
+    # study.csv after the signal holds exactly the finished points
+    assert {row[1] for row in _table(out)[1:]} == kept
+    # the rest in one process (no pool to start: the same solver, the same numbers)
+    r = subprocess.run(_cmd(scene, out, "--workers", "1"), cwd=ROOT, env=ENV,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    timing = json.loads((out / "timing.json").read_text())
+    assert timing["reused"] == len(kept) and timing["redone"] + timing["new"] == 8 - len(kept)
+    assert f"reused {len(kept)}" in r.stdout
+    assert _table(out) == _table(ref)
+
+
+def test_killed_worker_is_noticed_and_its_point_requeued(study_scene, tmp_path):
+    """kill -9 of one pool worker mid-point: the driver notices (a note names the point),
+    re-queues that point once on a fresh pool, and the study ends complete, exit 0, equal
+    to the uninterrupted study."""
+    scene, ref = study_scene
+    out = tmp_path / "study"
+    p = subprocess.Popen(_cmd(scene, out, "--workers", "2"), cwd=ROOT, env=ENV,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    victim, t0 = None, time.time()
+    while victim is None and p.poll() is None and time.time() - t0 < 60:
+        for f in out.glob("points/*/record.json"):
+            try:
+                rec = json.loads(f.read_text())
+            except ValueError:
+                continue
+            if rec["status"] == "running" and rec["pid"] != p.pid:
+                victim = rec
+                break
+        time.sleep(0.02)
+    assert victim is not None
+    os.kill(victim["pid"], signal.SIGKILL)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    assert f"point {victim['index']}: its worker (pid {victim['pid']}) died (signal 9); " \
+           "re-queued" in err
+    assert _table(out) == _table(ref)
+
+
+def test_unfinished_records_are_redone_and_failed_points_exit_3(tmp_path, capsys):
+    """A record that says "interrupted" (or a point whose worker crashed) is run again,
+    a finished one reused; a study with failed points exits 3 with one line per distinct
+    reason; a study whose every point failed draws no figure and says so."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60"))
+    out = tmp_path / "st"
+    # sigma = 0.4 nm on 60 nodes is lattice trapping (a physical failure, final); 1 nm runs
+    args = ["study", "sweep", str(scene), "--vary", "effects.asperity_gap.sigma=0.4 nm,1 nm",
+            "--out", str(out), "--workers", "1"]
+    assert main(args) == 3
+    cap = capsys.readouterr()
+    assert "1 of 2 points failed:" in cap.err and "1 point (0): " in cap.err
+    assert "lattice trapping" in cap.err and "reused 0, redone 0, new 2" in cap.out
+    recs = {json.loads(f.read_text())["index"]: f for f in out.glob("points/*/record.json")}
+    failed = json.loads(recs[0].read_text())
+    assert failed["status"] == "failed" and failed["finished"]
+    ok = json.loads(recs[1].read_text())
+    recs[1].write_text(json.dumps({**ok, "status": "interrupted", "finished": False}))
+    assert main(args) == 3
+    assert "reused 1, redone 1, new 0" in capsys.readouterr().out
+    assert json.loads(recs[1].read_text())["status"] == "converged"
+    # every point failed: no empty figure
+    allbad = tmp_path / "bad"
+    assert main(["study", "sweep", str(scene), "--vary",
+                 "effects.asperity_gap.sigma=0.3 nm,0.4 nm", "--out", str(allbad),
+                 "--workers", "1"]) == 3
+    err = capsys.readouterr().err
+    assert "2 of 2 points failed" in err and "no figure: every point failed" in err
+    assert len([ln for ln in err.splitlines() if ln.startswith("femadh: error:   ")]) == 1
+    assert not (allbad / "study.png").exists() and (out / "study.png").exists()
+
+
+def test_typed_values_need_units_and_absurd_ones_are_refused(tmp_path, capsys):
+    """scene.replace and --vary refuse a bare number for a length with the scene file's
+    error; a sigma larger than the sphere or the sweep, a step longer than the sweep, are
+    refused before anything runs in one line; a key that is no string is a scene error."""
+    sc = small()
+    with pytest.raises(SceneError, match="bare number has no unit"):
+        sc.replace({"effects.asperity_gap.sigma": 0.6})
+    assert sc.replace({"effects.asperity_gap.sigma": 0.6e-9}, si=True).gap.sigma == 0.6e-9
+    assert sc.replace({"effects.asperity_gap.sigma": "0.6 nm"}).gap.sigma == 0.6e-9
+    with pytest.raises(SceneError, match="dotted scene key"):
+        sc.replace({1: 2})
+    file_err = tmp_path / "f.toml"
+    file_err.write_text(fig3_uniform_text().replace('sigma = "1.0 nm"', "sigma = 0.8"))
+    with pytest.raises(SceneError) as from_file:
+        femadh.load_scene(file_err)
+    # the same words as the file's error (its value 0.8 is the range's first)
+    for vary, words in (("effects.asperity_gap.sigma=0.8..1.2:3", from_file.value.expected),
+                        ("effects.asperity_gap.sigma=0.8 m..1.2 m:3", "below the sphere radius"),
+                        ("effects.asperity_gap.sigma=8 nm,9 nm", "within the sweep's range"),
+                        ("sweep.step=10 nm", "no longer than the sweep")):
+        out = tmp_path / "s"
+        assert main(["study", "sweep", str(FIG3), "--vary", vary, "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and words in err[0], (vary, err)
+        assert not out.exists()
+
+
+def test_study_progress_counts_done_failed_reused(capsys):
+    """In a terminal the study's bar counts points done, failed and reused."""
+    from femadh.studies.sweep import _Progress
+
+    bar = _Progress(4, 2, "demo")
+    bar.point({"status": "failed"})
+    bar.point({"status": "converged"})
+    bar.bar.refresh()
+    bar.close()
+    err = capsys.readouterr().err
+    assert "4/4" in err and "failed 1, reused 2" in err
+
+
+def test_points_differing_in_the_modulus_do_not_share_an_operator(tmp_path):
+    """A worker reuses the surface operator of an identical grid and body only: two points
+    that differ in the disk's modulus (E* scales the Green function) each build their own,
+    and a stiffer disk indents less: F_ex at the deepest separation differs (by ~E*)."""
+    from femadh.studies.executors import _OPERATORS, run_point
+
+    _OPERATORS.clear()
+    pts = study_points(small().replace({"sweep.stop": "-1 nm"}),
+                       {"materials.disk.youngs_modulus": "100 GPa,400 GPa,100 GPa"})
+    recs = [run_point(p, tmp_path, estimate=False) for p in pts]
+    assert [r["status"] for r in recs] == ["converged"] * 3
+    assert [r["operator_reused"] for r in recs] == [False, False, False]
+    assert recs[2]["F_ex_deepest_N"] == recs[0]["F_ex_deepest_N"]
+    assert recs[1]["F_ex_deepest_N"] != pytest.approx(recs[0]["F_ex_deepest_N"], rel=1e-2)

@@ -47,7 +47,7 @@ def _data(scene, true, d, seed, offset=3e-9, noise=0.01):
     from femadh.fitting.lsq import simulate
     from femadh.io.force_curve import ForceCurve
 
-    sim, err = simulate(scene.replace(true))
+    sim, err = simulate(scene.replace(true, si=True))
     assert err is None, err
     d = np.r_[d, d[::-1]]
     branch = np.array(["approach"] * (d.size // 2) + ["retract"] * (d.size // 2))
@@ -81,7 +81,7 @@ def recovery():
     rows = []
     for workers in (2, 1):
         # the single run's time just before the fit: the machine's load changes (other jobs)
-        t_run = _run_time(scene.replace(true))
+        t_run = _run_time(scene.replace(true, si=True))
         load = os.getloadavg()
         r = fit_curve(scene, curve, keys, workers=workers)
         rows.append((workers, r, load, t_run))

@@ -176,11 +176,13 @@ def main():
               "from the first micro-fold straight to the free surface. Its last fold is "
               "then a few 1e-13 m further out; the hysteresis differs by less than the "
               "stepping resolution's bound.",
-              "- Fig 8 with the smoothed eq 20 law: the curve has a jump-in fold (near "
-              "1.376 nm) that the stepping solver does not report: its step from 1.4 to "
-              "1.2 nm is accepted onto the contact branch (the corrector moved no gap by "
-              "more than MAX_CORRECTION_FRACTION of it), so its hysteresis lacks the "
-              "jump-in's energy; the states at the grid separations agree.",
+              "- Fig 8 with the smoothed eq 20 law: the jump-in (near 1.376 nm) lies inside "
+              "one 0.2-nm grid step and moves no gap by more than MAX_CORRECTION_FRACTION, so "
+              "the corrector alone lands on the contact branch in one step; the stepping "
+              "solver finds it by the step's energy (it releases more than the trapezoid "
+              "rule can miss along one branch: `stepping.crossed_fold`), halves down to the "
+              "fold and lands there. Before that check it reported no jump-in and a "
+              "hysteresis short by the jump-in's energy.",
               "- The largest tension on the whole curve exceeds the displacement-controlled "
               "pull-off where the curve has an unstable JKR side (Fig 4); on Fig 3 (no "
               "folds) the difference is the peak between the 0.2-nm grid states.",

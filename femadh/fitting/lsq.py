@@ -130,11 +130,11 @@ def check_keys(scene, keys):
         except SceneError as exc:
             if exc.value == "(not set)":
                 # an unknown key: the scene reader's message (with its did-you-mean) says more
-                scene.replace({k: 1.0})
+                scene.replace({k: 1.0}, si=True)
             raise
         if not (math.isfinite(v) and v > 0):
             raise SceneError(scene.path, k, v, "a positive value to fit (relative steps)")
-        scene.replace({k: v})
+        scene.replace({k: v}, si=True)
         values.append(v)
     return values
 
@@ -182,7 +182,8 @@ class Evaluator:
 
     def scene_at(self, theta):
         try:
-            return self.scene.replace({k: float(v) for k, v in zip(self.keys, theta)})
+            return self.scene.replace({k: float(v) for k, v in zip(self.keys, theta)},
+                                      si=True)
         except SceneError as exc:
             raise FitError(f"trial point {_label(self.keys, theta)} is not a valid scene: "
                            f"{exc}") from None

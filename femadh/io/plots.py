@@ -1,11 +1,14 @@
 """Figures a researcher would draw for a run (matplotlib, Agg backend, PNG, written atomically).
 
 - every contact scene: ``force_curve.png`` - force on the sphere against separation, approach
-  and retract, each active effect's force, the jumps, a zoom on the adhesion peak, the DMT and
-  JKR pull-off of the scene's own work of adhesion; for arclength runs the traced equilibrium
-  curve with its unstable branch;
-- sigma-gap LJ scenes (paper 1 Figs 3-4): ``fig3_panels.png`` - the paper's panels (deformation,
-  LJ and contact pressure profiles, forces, contact radius with JKR/DMT, iterations);
+  and retract in two colours, each active effect's force, the jumps as arrows, a zoom on the
+  adhesion peak, the DMT and JKR pull-off of the scene's own work of adhesion; for arclength
+  runs the traced equilibrium curve with its unstable branch. A run with jumps gets a second
+  panel, the hysteresis loop zoomed to the folds (on the whole curve the jumps of paper 1
+  Fig 4 are 50 uN on a 3-mN scale, 0.07 nm apart on a 7-nm sweep: invisible);
+- sigma-gap LJ scenes (paper 1 Figs 3-4): ``profiles_and_forces.png`` - the paper's panels
+  (deformation, LJ and contact pressure profiles, forces, contact radius with JKR/DMT,
+  iterations);
 - meniscus scenes: ``meniscus_force.png`` (paper 2 Fig 1 style); regime maps: their figures.
 Units are chosen from the magnitudes (nm or um, pN ... mN).
 """
@@ -53,7 +56,7 @@ def contact_figures(res, folder):
     paths = [force_curve(res, folder / "force_curve.png")]
     sc = res.scene
     if "lj" in sc.effects and sc.gap is not None and res.profiles:
-        paths.append(paper1_panels(res, folder / "fig3_panels.png"))
+        paths.append(paper1_panels(res, folder / "profiles_and_forces.png"))
     if getattr(res, "instrument", None) is not None:
         paths.append(instrument_figure(res, folder / "instrument.png"))
     return paths
@@ -156,26 +159,30 @@ def force_curve(res, path):
     alld = np.concatenate([c["d_m"] for c in res.branches.values()])
     fs, fl = force_unit(allF)
     ls, ll = length_unit(alld)
-    fig, ax = plt.subplots(figsize=(11, 5.2))
+    loop = bool(res.jumps)
+    fig = plt.figure(figsize=(15 if loop else 11, 5.2))
+    # fixed layout (tight_layout draws the figure twice): the legend right of the axes
+    ax = fig.add_axes([0.06, 0.1, 0.42, 0.83] if loop else [0.08, 0.1, 0.62, 0.83])
     styles = {"approach": "-", "retract": "--"}
     lines = _effect_lines(res)
     for i, (col, sign, label) in enumerate(lines):
         for b, c in res.branches.items():
             if col not in c or (col != "F_ex_N" and not np.any(c[col])):
                 continue
+            if col == "F_ex_N":
+                d, F = _with_folds(res, b, c)
+                ax.plot(d * ls, -F * fs, styles.get(b, "-"), color=BRANCH_COLOURS.get(b, "k"),
+                        lw=2, label=f"{label}, {b}")
+                continue
             ax.plot(c["d_m"] * ls, sign * c[col] * fs, styles.get(b, "-"),
-                    color="k" if col == "F_ex_N" else f"C{i}",
-                    lw=2 if col == "F_ex_N" else 1,
+                    color=EFFECT_COLOURS[(i - 1) % len(EFFECT_COLOURS)], lw=1,
                     label=f"{label}, {b}")
     if res.equilibrium_curve is not None and len(res.equilibrium_curve["d_m"]):
         e = res.equilibrium_curve
         Fu = np.where(~e["stable"], -e["F_ex_N"], np.nan)
         ax.plot(e["d_m"] * ls, Fu * fs, ":", color="grey", lw=1.5,
                 label="unstable equilibria (traced)")
-    for j in res.jumps:
-        ax.annotate("", xy=(j["d_land_m"] * ls, -j["F_ex_after_N"] * fs),
-                    xytext=(j["d_fold_m"] * ls, -j["F_ex_before_N"] * fs),
-                    arrowprops={"arrowstyle": "->", "color": "C3", "lw": 1.2})
+    _jump_arrows(ax, res, fs, ls)
     hl = res.headline
     if hl.get("work_of_adhesion_J_per_m2"):
         W = hl["work_of_adhesion_J_per_m2"]
@@ -190,13 +197,120 @@ def force_curve(res, path):
                  + (f", σ = {sc.gap.sigma * 1e9:g} nm ({sc.gap.contact_model})"
                     if sc.gap else ", smooth sphere"))
     _adhesion_zoom(ax, res, fs, ls, fl, ll)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     ax.grid(alpha=0.3)
-    # a fixed layout (tight_layout draws the figure twice): the legend right of the axes
-    fig.subplots_adjust(left=0.08, right=0.70, bottom=0.1, top=0.93)
+    if loop:
+        zoom = fig.add_axes([0.545, 0.1, 0.25, 0.83])
+        lo, hi = _hysteresis_loop(zoom, res, fs, fl)
+        # where the zoom is on the whole curve: a shaded strip of its separations (its
+        # force range is a few percent of this axis' and would not show as a box)
+        ax.axvspan(lo * ls, hi * ls, color="0.88", zorder=0)
+        ax.annotate("zoom →", xy=(hi * ls, 0.97), xycoords=("data", "axes fraction"),
+                    xytext=(3, 0), textcoords="offset points", fontsize=7, color="0.3",
+                    va="top")
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.805, 0.93),
+                  bbox_transform=fig.transFigure, borderaxespad=0)
+        ax.set_title(ax.get_title(), fontsize=10)
+    else:
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     _save(fig, path)
     plt.close(fig)
     return path
+
+
+#: approach and retract: two colours (and solid / dashed) wherever a figure shows both
+BRANCH_COLOURS = {"approach": "tab:blue", "retract": "tab:red"}
+#: each effect's force: colours that are neither branch's
+EFFECT_COLOURS = ("tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:olive",
+                  "tab:cyan", "tab:pink")
+
+
+def _with_folds(res, branch, c):
+    """(d, F_ex) of a branch in the order it was traced with each jump inserted: the fold
+    state (where the branch ends) and a break (nan) before the landing state, so the line
+    follows the branch to its fold and the jump is left to its arrow."""
+    d, F = list(c["d_m"]), list(c["F_ex_N"])
+    sign = -1.0 if branch == "approach" else 1.0     # the approach runs towards smaller d
+    pts = [(sign * x, 1, x, f) for x, f in zip(d, F)]
+    for j in res.jumps:
+        if j["branch"] != branch:
+            continue
+        pts.append((sign * j["d_fold_m"], 0, j["d_fold_m"], j["F_ex_before_N"]))
+        pts.append((sign * j["d_land_m"], 0.5, np.nan, np.nan))
+        pts.append((sign * j["d_land_m"], 0.7, j["d_land_m"], j["F_ex_after_N"]))
+    pts.sort(key=lambda p: (p[0], p[1]))
+    return np.array([p[2] for p in pts]), np.array([p[3] for p in pts])
+
+
+def _jump_arrows(ax, res, fs, ls, lw=1.2):
+    """Each jump as an arrow from its fold state to its landing state, in its branch's
+    colour."""
+    for j in res.jumps:
+        ax.annotate("", xy=(j["d_land_m"] * ls, -j["F_ex_after_N"] * fs),
+                    xytext=(j["d_fold_m"] * ls, -j["F_ex_before_N"] * fs),
+                    arrowprops={"arrowstyle": "-|>", "color": BRANCH_COLOURS.get(
+                        j["branch"], "C3"), "lw": lw, "mutation_scale": 12})
+
+
+def _hysteresis_loop(ax, res, fs, fl):
+    """The loop between the jumps, zoomed: x from the first to the last fold padded by a
+    sweep step (or the folds' spread), y over what both branches do there; the computed
+    states marked, the folds crossed, the jumps as arrows, the loop shaded. Returns the
+    zoom's separation range (m)."""
+    folds = [j["d_fold_m"] for j in res.jumps] + [j["d_land_m"] for j in res.jumps]
+    lo, hi = min(folds), max(folds)
+    d_all = np.concatenate([c["d_m"] for c in res.branches.values()])
+    steps = np.diff(np.unique(d_all))
+    step = float(np.median(steps)) if steps.size else (hi - lo)
+    pad = max(step, hi - lo, 1e-12)
+    lo, hi = lo - pad, hi + pad
+    ls, ll = length_unit([abs(lo), abs(hi), hi - lo])
+    ys = []
+    traced = {}
+    for b, c in res.branches.items():
+        d, F = _with_folds(res, b, c)
+        traced[b] = (d, F)
+        ax.plot(d * ls, -F * fs, "-" if b == "approach" else "--",
+                color=BRANCH_COLOURS.get(b, "k"), lw=2, label=b)
+        on = (c["d_m"] >= lo) & (c["d_m"] <= hi)
+        ax.plot(c["d_m"][on] * ls, -c["F_ex_N"][on] * fs, "o", ms=4,
+                color=BRANCH_COLOURS.get(b, "k"))
+        sel = np.isfinite(d) & (d >= lo) & (d <= hi)
+        ys.append(-F[sel] * fs)
+    for j in res.jumps:
+        ax.plot([j["d_fold_m"] * ls], [-j["F_ex_before_N"] * fs], "x", ms=7, mew=2,
+                color=BRANCH_COLOURS.get(j["branch"], "k"))
+        ys.append(np.array([-j["F_ex_before_N"] * fs, -j["F_ex_after_N"] * fs]))
+    _jump_arrows(ax, res, fs, ls, lw=2.0)
+    y = np.concatenate(ys)
+    span = float(y.max() - y.min()) or abs(float(y.max())) or 1.0
+    ax.set_xlim(lo * ls, hi * ls)
+    ax.set_ylim(y.min() - 0.12 * span, y.max() + 0.12 * span)
+    if "approach" in traced and "retract" in traced:
+        # the loop: between the two branches over the folds' interval
+        grid = np.linspace(min(folds), max(folds), 200)
+        fa = np.interp(grid, *_finite_sorted(*traced["approach"]))
+        fr = np.interp(grid, *_finite_sorted(*traced["retract"]))
+        ax.fill_between(grid * ls, -fa * fs, -fr * fs, color="0.85", zorder=0,
+                        label="hysteresis loop")
+    hl = res.headline
+    energy = (f", energy lost per cycle {hl['hysteresis_J']:.3g} J" if "hysteresis_J" in hl
+              else "")
+    ax.set(xlabel=f"separation d ({ll})", ylabel=f"force on the sphere ({fl})")
+    ax.set_title(f"hysteresis loop (zoom){energy}", fontsize=9)
+    ax.plot([], [], "o", color="0.3", ms=4, label="computed state (lines join them)")
+    ax.plot([], [], "x", color="0.3", label="fold (the branch ends)")
+    ax.plot([], [], color="0.3", marker=r"$\rightarrow$", ls="", ms=12, label="jump")
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    return lo, hi
+
+
+def _finite_sorted(d, F):
+    """A branch's finite points in increasing d (for interpolation across its fold: the
+    branch up to the fold, then the landing branch)."""
+    ok = np.isfinite(d)
+    order = np.argsort(d[ok], kind="stable")
+    return d[ok][order], F[ok][order]
 
 
 def _adhesion_zoom(ax, res, fs, ls, fl, ll):
@@ -211,7 +325,7 @@ def _adhesion_zoom(ax, res, fs, ls, fl, ll):
     for b, c in res.branches.items():
         sel = np.abs(c["F_ex_N"]) <= 3 * abs(peak)
         ins.plot(c["d_m"][sel] * ls, -c["F_ex_N"][sel] * fs, "-" if b == "approach" else "--",
-                 color="k", lw=1.2)
+                 color=BRANCH_COLOURS.get(b, "k"), lw=1.2)
     ins.axhline(0, color="k", lw=0.5)
     hl = res.headline
     if hl.get("work_of_adhesion_J_per_m2"):

@@ -1,18 +1,177 @@
-"""Progress bars for long work (tqdm), on stderr, and only where a person watches: callers
-pass ``enabled`` (default: stderr is a terminal), so pipes, logs and tests stay quiet."""
+"""Progress on stderr, and only where a person watches.
+
+A run shows **one** display from its start to its end (:func:`display`): a tqdm line whose
+label names the phase - ``paper1-fig4 › operator``, ``› approach 12/36``, ``› estimate:
+N = 100 › retract``, ``› refinement 2``, ``› figures`` - and whose counter restarts with each
+phase that has a known number of steps. Code that runs inside a run (its branches, its
+estimate members, the refinements of an adaptive run) names its part with :func:`phase` and
+:func:`begin` / :func:`advance`; these are no-ops when no display is shown, so pipes, logs,
+tests and nested runs stay quiet. Callers decide ``enabled`` (default: stderr is a
+terminal).
+
+The width is the terminal's, asked again at each phase; a terminal that reports 0 columns
+(some CI runners, ``docker exec`` without a tty size) gets 80 (or ``COLUMNS``), not a bar of
+width 0 that tqdm would not draw at all.
+"""
+import contextlib
+import os
 import sys
+import time
 
+#: the display of the run in progress (one per process), or None
+_active = None
 
-def bar(total, desc, enabled=True, unit="state"):
-    """A tqdm bar of ``total`` steps (of ``unit``), or None when disabled."""
-    if not enabled:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stderr,
-                dynamic_ncols=True)
+#: width used when the terminal reports none
+FALLBACK_COLUMNS = 80
 
 
 def terminal():
     """Whether progress should be shown by default (stderr is a terminal)."""
     return sys.stderr.isatty()
+
+
+def width(stream=None):
+    """Columns of the terminal behind ``stream`` (default stderr); COLUMNS or 80 when it
+    reports 0 or none."""
+    stream = stream or sys.stderr
+    try:
+        cols = os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, OSError, ValueError):
+        cols = 0
+    if cols <= 0:
+        try:
+            cols = int(os.environ.get("COLUMNS", "0"))
+        except ValueError:
+            cols = 0
+    return cols if cols > 0 else FALLBACK_COLUMNS
+
+
+class Display:
+    """One tqdm line for a whole run; see the module docstring."""
+
+    def __init__(self, name, stream=None):
+        from tqdm import tqdm
+
+        self.stream = stream or sys.stderr
+        self.name = name
+        self.frames = []          # labels of the open phases, outermost first
+        self.leaf = None          # the current step's label inside the innermost phase
+        self.t0 = time.perf_counter()
+        self.bar = tqdm(total=None, desc=name, file=self.stream, leave=False,
+                        ncols=width(self.stream), dynamic_ncols=False, unit="state",
+                        bar_format="{desc}")
+
+    def label(self, room=None):
+        """The phase path, its middle elided when it would not leave ``room`` columns for
+        the counter (the innermost part and the run's name are what a reader needs)."""
+        parts = [self.name] + self.frames + ([self.leaf] if self.leaf else [])
+        text = " › ".join(parts)
+        while room is not None and len(text) > room and len(parts) > 2:
+            parts = [parts[0], "…"] + parts[2 + (parts[1] == "…"):]
+            text = " › ".join(parts)
+            if parts[1] == "…" and len(parts) == 3:
+                break
+        return text
+
+    def _redraw(self, total=None):
+        cols = width(self.stream)
+        self.bar.ncols = cols
+        self.bar.reset(total=total)
+        # a phase without a count shows its name; the time is the whole run's so far
+        self.bar.bar_format = ("{desc}: {n_fmt}/{total_fmt}{postfix}" if total
+                               else "{desc}{postfix}")
+        self.bar.set_postfix_str(self._elapsed(), refresh=False)
+        self.bar.set_description_str(self.label(room=cols - 22), refresh=True)
+
+    def _elapsed(self):
+        return f"{time.perf_counter() - self.t0:.1f} s"
+
+    def push(self, label):
+        self.frames.append(label)
+        self.leaf = None
+        self._redraw()
+
+    def pop(self):
+        if self.frames:
+            self.frames.pop()
+        self.leaf = None
+        self._redraw()
+
+    def begin(self, label, total=None):
+        self.leaf = label
+        self._redraw(total)
+
+    def advance(self, n=1):
+        self.bar.set_postfix_str(self._elapsed(), refresh=False)
+        self.bar.update(n)
+
+    def note(self, msg):
+        self.bar.write(msg, file=self.stream)
+
+    def close(self):
+        self.bar.close()
+
+
+@contextlib.contextmanager
+def display(name, enabled=None):
+    """The run's display while the block runs: created by the outermost run when
+    ``enabled`` (default: stderr is a terminal); a nested run (an estimate member, a trial of
+    an adaptive run) reports into the one already shown. Yields the display or None."""
+    global _active
+    if enabled is None:
+        enabled = terminal()
+    if _active is not None or not enabled:
+        yield _active
+        return
+    _active = Display(name)
+    try:
+        yield _active
+    finally:
+        _active.close()
+        _active = None
+
+
+@contextlib.contextmanager
+def phase(label):
+    """Name a part of the run (``operator``, ``estimate: N = 100``, ``figures``) while the
+    block runs; nothing when no display is shown."""
+    d = _active
+    if d is None:
+        yield
+        return
+    d.push(label)
+    try:
+        yield
+    finally:
+        d.pop()
+
+
+def begin(label, total=None):
+    """A step of ``total`` counted items (a branch of n states) inside the current phase."""
+    if _active is not None:
+        _active.begin(label, total)
+
+
+def advance(n=1):
+    """Count ``n`` items of the current step."""
+    if _active is not None:
+        _active.advance(n)
+
+
+def note(msg):
+    """A line above the display (or on stderr when none is shown)."""
+    if _active is not None:
+        _active.note(msg)
+    else:
+        print(msg, file=sys.stderr)
+
+
+def bar(total, desc, enabled=True, unit="state"):
+    """A standalone tqdm bar of ``total`` steps (of ``unit``), or None when disabled (studies,
+    convergence ladders: work that is not one run)."""
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stderr,
+                ncols=width(), dynamic_ncols=False)

@@ -22,7 +22,7 @@ LOCK = ".femadh.lock"
 OUTPUTS = ("summary.json", "curve.csv", "diagnostics.csv", "fields.csv", "jumps.csv",
            "equilibrium_curve.csv", "checkpoint.npz", "meniscus.csv", "profiles.csv",
            "vtk", "approach.pvd", "retract.pvd", "force_curve.png", "fig3_panels.png",
-           "meniscus_force.png", "render.png")
+           "profiles_and_forces.png", "meniscus_force.png", "render.png")
 
 
 def previous_run(path):

@@ -29,6 +29,8 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
     """Run ``scene`` (with ``run``, :func:`femadh.runner.contact.run`) on ever finer grids
     until its estimated error meets ``scene.accuracy``; see the module docstring."""
 
+    from ..io.progress import phase
+
     target = scene.accuracy
     nodes, delta = scene.nodes, scene.analysis_radius**2 / (2 * scene.sphere.radius)
     steps = []
@@ -38,8 +40,9 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
         trial = variant(scene, nodes=nodes, delta=delta)
         # claimed under the user's scene: --resume and --overwrite recognise the folder
         # whichever trial it holds
-        res = run(trial, out_dir, figures=figures, progress=progress, estimate=True,
-                  folder_id=scene_id(scene), **mode)
+        with phase(f"{'refinement ' + str(i) if i else 'grid'} (N = {nodes})"):
+            res = run(trial, out_dir, figures=figures, progress=progress, estimate=True,
+                      folder_id=scene_id(scene), **mode)
         mode = {"overwrite": True, "resume": False}       # later trials replace earlier ones
         grid, tail = _relative(res) if res.status == "converged" else (math.inf, 0.0)
         steps.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,

@@ -84,6 +84,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     """Run ``scene`` on its adaptive grid (see the module docstring) with ``run``
     (:func:`femadh.runner.contact.run`); with ``estimate`` not True, one run on the planned
     member (its accuracy unjudged)."""
+    from ..io.progress import phase
     from ..scene import scene_id
     from .estimates import variant
 
@@ -107,8 +108,9 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                        f"{h * 1e9:.3g} nm over {family.band * 1e6:.3g} um)")
             break
         trial = variant(scene, grid=family.as_dict(h), radius=family.radius)
-        res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
-                  operator=op, folder_id=scene_id(scene), **mode)
+        with phase(f"{'refinement ' + str(i) if i else 'grid'} ({op.grid.n} nodes)"):
+            res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
+                      operator=op, folder_id=scene_id(scene), **mode)
         mode = {"overwrite": True, "resume": False}      # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
                           else (math.nan, math.nan))
@@ -204,7 +206,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                 from .contact import draw_figures
 
                 # a signal stops the figures at once: the run ends "interrupted"
-                draw_figures(res, folder)
+                with phase("figures"):
+                    draw_figures(res, folder)
             folder.write_summary(summary(res))
     return res
 

@@ -24,6 +24,7 @@ from . import interrupt
 from .estimates import GuardError
 from .result import ContactResult
 from .result import contact_summary as summary
+from ..io.progress import advance, begin, display, phase
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
@@ -91,7 +92,11 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     limit = _time_limit(scene, time_limit)
     if progress is None:
         progress = sys.stderr.isatty()
-    with blas_threads(), interrupt.interruptible(limit):
+    from contextlib import nullcontext
+
+    # one display over the whole run (a meniscus run has its own bar)
+    shown = nullcontext() if scene.kind == "meniscus" else display(scene.name, progress)
+    with blas_threads(), interrupt.interruptible(limit), shown:
         if scene.kind == "meniscus":
             from .meniscus import run_meniscus
 
@@ -117,7 +122,8 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
                        resume_from=resume_from)
             if figures and res.status in ("converged", "failed") and any(
                     len(next(iter(b.values()))) for b in res.branches.values()):
-                draw_figures(res, folder)
+                with phase("figures"):
+                    draw_figures(res, folder)
                 folder.write_summary(summary(res))
             return res
 
@@ -185,7 +191,9 @@ def _timed(fn):
 def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
-    say = (lambda msg: print(msg, file=sys.stderr)) if progress else None
+    from ..io.progress import note
+
+    say = note if progress else None
     run_id = scene_id(scene)
     # an adaptive run's trial claims the folder under the user's scene: its summary says
     # so (a trial's "converged" is not the run's end: --resume may continue the run)
@@ -229,7 +237,8 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
             if not resuming:
                 write_summary("running")
             t1 = time.perf_counter()
-            with interrupt.immediate():      # the build writes nothing but whole cache files
+            # the build writes nothing but whole cache files: a signal stops it at once
+            with phase("operator"), interrupt.immediate():
                 problem = build_problem(scene, operator=operator, progress=say)
             res.timings["operator_s"] = time.perf_counter() - t1
             if resuming:
@@ -305,7 +314,8 @@ def _finish(scene, res, problem, sink, estimate):
     t1 = time.perf_counter()
     res.headline = headline(res, problem)
     if estimate:
-        half = refine_peak(scene, res, problem, sink)
+        with phase("peak search"):
+            half = refine_peak(scene, res, problem, sink)
         if getattr(scene, "instrument", None) is not None and res.instrument is not None:
             from .instrument import refine_instrument
 
@@ -365,12 +375,7 @@ class Sink:
         them keep their surface profile."""
         total = n if total is None else total
         self.profile_picks[branch] = _picks(total)
-        if self.progress:
-            from ..io.progress import bar
-
-            if self.bar is not None:
-                self.bar.close()
-            self.bar = bar(n, f"{self.result.name} {branch}")
+        begin(branch, n)        # the run's display, if one is shown
 
     def state(self, branch, st):
         from .estimates import check_state
@@ -388,8 +393,7 @@ class Sink:
         if self.writer:
             k = self.writer.write_state(branch, st)
             self.last_state = (k, branch, st)
-        if self.bar is not None:
-            self.bar.update(1)
+        advance()
         self._publish(branch)
         interrupt.check()
 

@@ -264,7 +264,8 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 "estimated")
             g = None
         else:
-            g = run(other, progress=False, estimate="peak")
+            with _phase("estimate: " + ("Green function" if green else "coarser mesh")):
+                g = run(other, progress=False, estimate="peak")
         _stop_if_stopped(g)
         if g is not None and g.status == "converged":
             for k, v in g.headline.items():
@@ -274,16 +275,20 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             if not layered:
                 fine_hl = dict(g.headline)       # the grid part: the Green function's in N
         elif g is not None:
-            res.warnings.append(f"FE mesh estimate: the {'coarser mesh' if layered else 'Green'}"
-                                f" run failed: {g.error}")
+            other_run = "coarser-mesh run" if layered else "Green-function run on the same nodes"
+            res.warnings.append(f"{NOTE}the {other_run} did not converge "
+                                f"({_short(g.error)}); the FE mesh part of the error is not "
+                                "estimated: the stated errors lack it")
     levels = []
     ratio, members = coarser_members(scene, problem, green)
-    for label, member in members:
-        r = run(member, progress=False, estimate="peak")
+    for i, (label, member) in enumerate(members):
+        with _phase(f"estimate: {label}"):
+            r = run(member, progress=False, estimate="peak")
         _stop_if_stopped(r)
         if r.status != "converged":
-            res.warnings.append(f"discretisation estimate: the coarse grid ({label}) failed: "
-                                f"{r.error}")
+            res.warnings.append(member_note(label, r.error, _fine_label(scene, problem),
+                                            [lb for lb, _ in members[:i]]))
+            res.grid["failed_member"] = {"member": label, "error": r.error}
             break
         levels.append(dict(r.headline))
     res.grid["member_ratio"] = ratio
@@ -338,6 +343,45 @@ def _stop_if_stopped(member):
 
         raise TimeLimitReached(time_limit() or 0.0)
     raise Interrupted(code - 128)
+
+
+def _phase(label):
+    """The run's progress display names this part of the estimate (a no-op when none)."""
+    from ..io.progress import phase
+
+    return phase(label)
+
+
+def _fine_label(scene, problem):
+    """The run's own grid as the members are labelled: "N = 200" or "spacing 25.1 nm"."""
+    g = problem.grid
+    if g.fine_radius is None:
+        return f"N = {g.n}"
+    return f"spacing {float(g.nodes[1]) * 1e9:.4g} nm"
+
+
+#: the prefix report.py prints as "note:" (see femadh.runner.report.NOTE)
+NOTE = "error estimate: "
+
+
+def _short(error):
+    """The first clause of a solver error (what stopped, without the numbers)."""
+    why = str(error).split(":")[0].split(";")[0].strip()
+    return why if len(why) <= 60 else why[:57].rstrip() + "..."
+
+
+def member_note(label, error, fine, used):
+    """What a failed coarse member means for the estimate, in plain words: which member did
+    not converge (the first clause of its error), where the grid part of the error comes
+    from instead, and whether the stated error still holds."""
+    why = _short(error)
+    head = f"{NOTE}the {label} member did not converge ({why})"
+    if used:
+        return (f"{head}; the grid error is taken from {fine} and {' and '.join(used)} "
+                "at first order (the cautious order when no third member shows the observed "
+                "one)")
+    return (f"{head}; no coarser member converged, so the stated errors lack the grid part "
+            "(tail, resolution and tolerance only): treat them as lower bounds")
 
 
 def _contact_gap(problem):

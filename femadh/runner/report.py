@@ -12,17 +12,25 @@ def _force(x, err=None):
     return f"{x * s:.5g} {unit}"
 
 
+def _nm(x):
+    return f"{x * 1e9:.4g} nm"
+
+
 def headline_lines(res):
-    """Human-readable summary lines of a ContactResult."""
+    """Human-readable summary lines of a ContactResult.
+
+    One largest-adhesion number with its estimated error (the peak located between the
+    computed separations; the per-branch lines count states and jumps and show no second
+    adhesion value), the forces at the deepest separation, the accuracy reached, the jumps,
+    and notes in plain words: what failed and what that means for the stated errors."""
     out = []
     hl = res.headline
     for b, c in res.branches.items():
         if not len(c["d_m"]):
             continue
-        k = int(np.argmax(c["F_ex_N"]))
-        out.append(f"{b}: {len(c['d_m'])} states, max adhesion F_ex = {_force(c['F_ex_N'][k])} "
-                   f"at d = {c['d_m'][k] * 1e9:.4g} nm, F_LJ(d = {c['d_m'][-1] * 1e9:.4g} nm) "
-                   f"= {_force(c['F_LJ_N'][-1])}")
+        n_j = sum(j["branch"] == b for j in res.jumps)
+        out.append(f"{b}: {len(c['d_m'])} states from d = {_nm(c['d_m'][0])} to "
+                   f"{_nm(c['d_m'][-1])}" + (f", {n_j} jump{'s' * (n_j > 1)}" if n_j else ""))
     if "max_adhesion_N" in hl:
         out.append(f"max adhesion {_force(hl['max_adhesion_N'], hl.get('max_adhesion_N_error'))}"
                    f" at d = {hl['d_at_max_adhesion_m'] * 1e9:.4g} nm"
@@ -35,10 +43,10 @@ def headline_lines(res):
     if res.accuracy:
         a = res.accuracy
         grid = (f"{a['nodes']} nodes, band spacing {a['spacing_m'] * 1e9:.3g} nm to "
-                f"{a['band_m'] * 1e6:.3g} um" if a.get("adaptive") and a.get("spacing_m")
+                f"{a['band_m'] * 1e6:.3g} µm" if a.get("adaptive") and a.get("spacing_m")
                 else f"N = {a['nodes']}")
         out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}, "
-                   f"analysis radius {a['analysis_radius_m'] * 1e6:.4g} um after "
+                   f"analysis radius {a['analysis_radius_m'] * 1e6:.4g} µm after "
                    f"{len(a['steps'])} run(s)")
     for j in res.jumps:
         where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else
@@ -49,8 +57,13 @@ def headline_lines(res):
     if res.instrument is not None:
         out += _instrument_lines(res)
     for w in res.warnings:
-        out.append(f"warning: {w}")
+        out.append(f"note: {w[len(NOTE):]}" if w.startswith(NOTE) else f"warning: {w}")
     return out
+
+
+#: warnings that are notes on the error estimate (printed as "note: ...", the prefix
+#: dropped; summary.json keeps them whole)
+NOTE = "error estimate: "
 
 
 def _instrument_lines(res):

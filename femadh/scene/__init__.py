@@ -1,8 +1,10 @@
 """Scene files (TOML) -> validated scenes: the user-facing contract.
 
 Quantities are strings with units ("2 mm", "25 degC"); in scene *files* a bare number for a
-dimensional key is an error (``radius = 2`` would silently mean 2 m), in scenes built in code
-(:meth:`Scene.from_dict`, :meth:`Scene.replace`) it is taken as SI. Every problem of a scene -
+dimensional key is an error (``radius = 2`` would silently mean 2 m), and so it is in the keys
+a person types into :meth:`Scene.replace` and a study's ``--vary`` (the same one-line error);
+in scenes built in code (:func:`scene_from_dict`, :meth:`Scene.from_dict`, and
+``Scene.replace(..., si=True)``) it is taken as SI. Every problem of a scene -
 unknown keys (with a "did you mean"), missing keys, wrong units, values out of range - is
 reported at once, each naming the file, the key, the value and what was expected
 (:class:`~femadh.errors.SceneError`). A scene with a ``[meniscus]`` table is a capillary
@@ -62,13 +64,14 @@ def load_scene(path):
     return scene_from_dict(data, str(path), bare_numbers=False)
 
 
-def scene_from_dict(data, file=None, *, bare_numbers=True):
+def scene_from_dict(data, file=None, *, bare_numbers=True, strict=()):
     """Validate a scene given as a dict (the parsed TOML); see :func:`load_scene`.
     ``bare_numbers``: whether plain numbers are SI for dimensional keys (code) or errors
-    (files)."""
+    (files); ``strict``: dotted keys where a bare number is an error all the same (the keys
+    of :meth:`Scene.replace`)."""
     from .liquids import read_isotherm, read_liquid
 
-    reader = Reader(file, bare_numbers=bare_numbers,
+    reader = Reader(file, bare_numbers=bare_numbers, strict=strict,
                     kinds={"liquid": read_liquid, "isotherm": read_isotherm})
     if not isinstance(data, dict):
         reader.fail("(top level)", data, "a table of tables")
@@ -79,11 +82,23 @@ def scene_from_dict(data, file=None, *, bare_numbers=True):
     return scene
 
 
-def apply_overrides(raw, changes):
+def apply_overrides(raw, changes, file=None):
     """A deep copy of a scene dict with dotted keys set (``"effects.asperity_gap.sigma"``);
-    intermediate tables are created. The result is a dict, to be validated."""
+    intermediate tables are created. The result is a dict, to be validated.
+
+    Raises
+    ------
+    SceneError
+        For a key that is not a dotted string (``{1: 2}``), or an index past a list's end.
+    """
+    if not isinstance(changes, dict):
+        raise SceneError(file, "(changes)", changes, "a dict of dotted scene keys to values, "
+                         "e.g. {'sphere.radius': '1 um'}")
     data = copy.deepcopy(raw)
     for dotted, value in changes.items():
+        if not isinstance(dotted, str) or not dotted.strip(".") or ".." in dotted:
+            raise SceneError(file, repr(dotted), value, "a dotted scene key such as "
+                             "'sphere.radius' (see `femadh keys`)")
         parts = dotted.split(".")
         node = data
         for i, p in enumerate(parts):
@@ -91,7 +106,7 @@ def apply_overrides(raw, changes):
             if isinstance(node, list):
                 # a list element by its index: "substrate.layers.0.thickness"
                 if not (p.isdigit() and int(p) < len(node)):
-                    raise SceneError(None, ".".join(parts[:i + 1]), value,
+                    raise SceneError(file, ".".join(parts[:i + 1]), value,
                                      f"an index 0..{len(node) - 1} into "
                                      f"[{'.'.join(parts[:i])}]")
                 p = int(p)
@@ -102,6 +117,17 @@ def apply_overrides(raw, changes):
             else:
                 node = node[p]
     return data
+
+
+def replace_scene(scene, changes, kw, si):
+    """Shared body of :meth:`Scene.replace` and :meth:`MeniscusScene.replace`."""
+    if changes is None or isinstance(changes, dict):
+        changes = {**(changes or {}), **{k.replace("__", "."): v for k, v in kw.items()}}
+    data = apply_overrides(scene.raw, changes, scene.path)
+    # the typed keys refuse a bare number for a dimensional value (as a file does); the
+    # rest of the scene keeps what it was built with (SI numbers in code-built scenes)
+    return scene_from_dict(data, scene.path, bare_numbers=True,
+                           strict=() if si else tuple(changes))
 
 
 def reference_page():

@@ -29,11 +29,14 @@ def build_operator(scene, progress=None, *, grid=None, settings=None):
         from ..elastic.fe import FEOperator
 
         settings = settings or scene.fe_settings
+        # the condensed body from the on-disk operator cache when it was built before (by
+        # content: mesh, grid, materials, settings); its factorised body only on demand
         if scene.layers:
-            return FEOperator(grid, settings=settings, progress=progress, substrate=scene.disk,
-                              layers=scene.layers, sphere=scene.slider)
-        return FEOperator(grid, scene.e_star, scene.fe_poisson_ratio, settings,
-                          progress=progress)
+            return FEOperator.cached(grid, settings=settings, progress=progress,
+                                     substrate=scene.disk, layers=scene.layers,
+                                     sphere=scene.slider)
+        return FEOperator.cached(grid, scene.e_star, scene.fe_poisson_ratio, settings,
+                                 progress=progress)
     return GreenOperator(grid, scene.e_star)
 
 

@@ -152,8 +152,9 @@ SWEEP = Table("sweep", "The separations d of the sphere tip above the undeformed
 
 OUTPUT = Table("output", "Outputs.", (
     Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
-    Key("vtk", "bool", "VTK volume and surface files per state (FE only; default: true for "
-        "FE).", default=None),
+    Key("vtk", "bool", "VTK volume and surface files of every state as it converges (FE only; "
+        "default false: `femadh render RUN_DIR --state K` writes and draws the states you ask "
+        "for from fields.csv).", default=None),
 ))
 
 #: the largest Poisson ratio the FE body takes (its mixed formulation eliminates the pressure
@@ -294,15 +295,18 @@ class Scene:
             raise TypeError("the dict describes a meniscus scene, not a contact scene")
         return sc
 
-    def replace(self, changes=None, **kw):
+    def replace(self, changes=None, /, *, si=False, **kw):
         """A new scene with keys changed, validated like a file: ``changes`` maps dotted keys
         to values (``{"sphere.radius": "1 um", "effects.asperity_gap.sigma": "0.5 nm"}``);
-        keywords use ``__`` for the dots (``sphere__radius="1 um"``)."""
-        from . import apply_overrides, scene_from_dict
+        keywords use ``__`` for the dots (``sphere__radius="1 um"``).
 
-        data = apply_overrides(self.raw, {**(changes or {}),
-                                          **{k.replace("__", "."): v for k, v in kw.items()}})
-        return scene_from_dict(data, self.path, bare_numbers=True)
+        A dimensional value needs its unit, as in a file (``0.6`` for a length is refused
+        with the file's one-line error); ``si=True`` takes bare numbers as SI (code that
+        holds SI floats, e.g. a fit's parameter vector). Raises SceneError for any bad key
+        or value (a key that is not a dotted string included)."""
+        from . import replace_scene
+
+        return replace_scene(self, changes, kw, si)
 
     @property
     def resolved(self):
@@ -387,7 +391,9 @@ def parse_contact(reader, data, file):
     if layers and method != "fe":
         reader.fail("solver.method", method, "\"fe\" for a layered substrate ([substrate] "
                     "layers): the Green function is the homogeneous half-space's")
-    vtk = ou["vtk"] if ou["vtk"] is not None else method == "fe"
+    # off by default: the body's fields cost ~1.2 s to set up and ~20 ms a state
+    # (validation/results/fe_pace.md); `femadh render` exports the states a user asks for
+    vtk = bool(ou["vtk"])
     if vtk is True and method != "fe":
         reader.fail("output.vtk", vtk, "false unless [solver] method = \"fe\" (the Green "
                     "operator has no interior field to write)")
@@ -536,6 +542,10 @@ def _separations(reader, sw, raw):
                     f"({raw.get('start')}) for a retract-only sweep")
         return BAD
     n_steps = abs(stop - start) / step
+    if n_steps < 1:
+        reader.fail("sweep.step", raw.get("step"), f"a step no longer than the sweep "
+                    f"|stop - start| = {abs(stop - start):.6g} m")
+        return BAD
     if n_steps > MAX_SEPARATIONS:
         reader.fail("sweep.step", raw.get("step"), f"a step giving at most "
                     f"{MAX_SEPARATIONS} separations (this one gives {n_steps:.3g})")
@@ -594,6 +604,19 @@ def _cross_checks(reader, data, gap, effects, so, sw, d_values, sphere, a):
         reader.fail("sweep.start", data["sweep"].get("start"), "a positive separation for a "
                     "smooth sphere (no [effects.asperity_gap]): the sweep starts from the "
                     "undeformed surface, which the tip must not touch")
+    if gap not in (None, BAD) and sphere not in (None, BAD):
+        # a sigma-gap wider than the sphere, or than the whole sweep, is a unit slip (a bare
+        # number typed as metres, "0.8" for 0.8 nm), never a scene: refuse it in one line
+        # before anything runs instead of letting every Newton step fail
+        raw_sigma = ((data.get("effects") or {}).get("asperity_gap") or {}).get("sigma")
+        span = (abs(d_values[0] - d_values[-1]) if d_values is not BAD and d_values
+                else None)
+        if not gap.sigma < sphere.radius:
+            reader.fail("effects.asperity_gap.sigma", raw_sigma, f"a sigma below the sphere "
+                        f"radius {sphere.radius:.4g} m (this one is {gap.sigma:.4g} m)")
+        elif span and gap.sigma > span:
+            reader.fail("effects.asperity_gap.sigma", raw_sigma, f"a sigma within the sweep's "
+                        f"range |stop - start| = {span:.4g} m (this one is {gap.sigma:.4g} m)")
     cap = effects.get("capillary")
     if cap is not None and a is not BAD and sphere is not None:
         delta_a = a * a / (2 * sphere.radius)

@@ -136,14 +136,18 @@ class MeniscusScene:
 
     kind = "meniscus"
 
-    def replace(self, changes=None, **kw):
-        """A new scene with dotted keys changed, validated like a file (see
-        :meth:`femadh.scene.Scene.replace`)."""
-        from . import apply_overrides, scene_from_dict
+    def replace(self, changes=None, /, *, si=False, **kw):
+        """A new scene with keys changed, validated like a file: ``changes`` maps dotted keys
+        to values (``{"sphere.radius": "1 um", "effects.asperity_gap.sigma": "0.5 nm"}``);
+        keywords use ``__`` for the dots (``sphere__radius="1 um"``).
 
-        data = apply_overrides(self.raw, {**(changes or {}),
-                                          **{k.replace("__", "."): v for k, v in kw.items()}})
-        return scene_from_dict(data, self.path, bare_numbers=True)
+        A dimensional value needs its unit, as in a file (``0.6`` for a length is refused
+        with the file's one-line error); ``si=True`` takes bare numbers as SI (code that
+        holds SI floats, e.g. a fit's parameter vector). Raises SceneError for any bad key
+        or value (a key that is not a dotted string included)."""
+        from . import replace_scene
+
+        return replace_scene(self, changes, kw, si)
 
     @property
     def resolved(self):

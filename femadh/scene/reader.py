@@ -33,14 +33,24 @@ class Reader:
         (scene files: ``radius = 2`` would silently mean 2 m).
     kinds : dict, optional
         ``kind -> parse(reader, raw, path)`` for structured key kinds ("liquid", "isotherm").
+    strict : iterable of str, optional
+        Dotted keys (and the tables under them) where a bare number is refused even when
+        ``bare_numbers`` is true: the keys a person just typed (:meth:`Scene.replace`, a
+        study's ``--vary``), while the rest of a code-built scene stays SI.
     """
 
-    def __init__(self, file, *, bare_numbers=False, kinds=None):
+    def __init__(self, file, *, bare_numbers=False, kinds=None, strict=()):
         self.file, self.bare_numbers = file, bare_numbers
+        self.strict = tuple(strict)
         # parsers of the structured kinds ("liquid", "isotherm": scene.liquids), given by the
         # caller so that this base reader imports no table of its own
         self.kinds = dict(kinds or {})
         self.errors = []
+
+    def bare_ok(self, path):
+        """Whether a bare number is SI (not an error) at the dotted ``path``."""
+        return self.bare_numbers and not any(
+            path == s or path.startswith(s + ".") for s in self.strict)
 
     def fail(self, path, value, expected):
         """Record an error; returns BAD."""
@@ -117,7 +127,7 @@ class Reader:
         if key.kind in DIMENSIONS:
             try:
                 x = to_si(raw, key.kind, file=self.file, key=path,
-                          bare_numbers=self.bare_numbers or default)
+                          bare_numbers=self.bare_ok(path) or default)
             except SceneError as exc:
                 self.errors.append(exc)
                 return BAD
@@ -138,7 +148,7 @@ def _words(key):
 def quantity(reader, raw, path, dimension, *, positive=True):
     """A one-off quantity outside a Table (list items, sub-tables of custom keys)."""
     try:
-        x = to_si(raw, dimension, file=reader.file, key=path, bare_numbers=reader.bare_numbers)
+        x = to_si(raw, dimension, file=reader.file, key=path, bare_numbers=reader.bare_ok(path))
     except SceneError as exc:
         reader.errors.append(exc)
         return BAD

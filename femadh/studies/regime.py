@@ -634,3 +634,37 @@ def write_regime(pts, out_dir):
     if good:
         regime_figures(good, out)
     return out / "regime.csv"
+
+
+def regime_table(pts):
+    """A short table for people (the CLI prints it; regime.csv holds every column): per
+    point mu, the pull-off / (pi R dg) with its estimated error beside Maugis-Dugdale's, the
+    jump-in and jump-out d / z0, the hysteresis / (pi R dg z0), the nodes, and why a point
+    failed."""
+    def pm(v, e):
+        if v is None or not math.isfinite(v):
+            return "-"
+        return f"{v:.4f}" + (f" ± {e:.1g}" if e is not None and math.isfinite(e) else "")
+
+    def num(v, fmt=".3f"):
+        return "-" if v is None or not math.isfinite(v) else format(v, fmt)
+
+    head = ["mu", "pull-off/πRΔγ", "Maugis-Dugdale", "jump-in d/z0", "jump-out d/z0",
+            "hysteresis", "nodes"]
+    rows = []
+    for p in pts:
+        if p.failed is not None:
+            rows.append([f"{p.mu:.3g}", f"failed: {p.failed.split(':')[0][:50]}"])
+            continue
+        rows.append([f"{p.mu:.3g}", pm(p.pull_off, p.error("pull_off")), f"{p.maugis:.4f}",
+                     num(p.jump_in), num(p.jump_out),
+                     num(p.hysteresis, ".3g") if p.hysteresis > 0 else "0", str(p.nodes)])
+    widths = [max([len(head[i])] + [len(r[i]) for r in rows if len(r) == len(head) or i == 0])
+              for i in range(len(head))]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths))]
+    for r in rows:
+        if len(r) == 2:
+            lines.append(r[0].rjust(widths[0]) + "  " + r[1])
+        else:
+            lines.append("  ".join(c.rjust(w) for c, w in zip(r, widths)))
+    return "\n".join(lines)

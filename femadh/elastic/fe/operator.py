@@ -221,7 +221,8 @@ class FEOperator(SurfaceOperator):
     formulation : str
         "displacement" or "mixed" (the one used).
     timings : dict
-        Seconds spent in mesh, assembly, factorisation and condensation.
+        Seconds spent in mesh, assembly, factorisation and condensation (an operator read
+        from the cache: ``cache_read``, and the body's parts once it is built).
     n_dofs : int
     """
 
@@ -229,16 +230,49 @@ class FEOperator(SurfaceOperator):
 
     def __init__(self, grid: RadialGrid, e_star=None, nu=0.3, settings=None, mesh_path=None,
                  progress=None, *, substrate=None, layers=(), sphere=None):
-        from skfem import Basis, ElementTriP2, ElementTriP2B, ElementVector, MeshTri
-
         self.grid = grid
         self.settings = settings or FESettings()
         self._set_body(e_star, nu, substrate, layers, sphere)
-        a = grid.radius
-        t = {}
-        t0 = time.perf_counter()
         self.spec = mesh_spec(grid, self.settings, self.layers, self.substrate)
-        path = mesh_path or cached_mesh(self.spec, progress=progress)
+        self._mesh_path = mesh_path or cached_mesh(self.spec, progress=progress)
+        self.timings = {}
+        self._build()
+        self._set_compliance(self._condense())
+
+    #: attributes of the assembled, factorised body: an operator read from the cache
+    #: (:meth:`cached`) builds them on first use (full fields, VTK, render)
+    _BODY = frozenset(("mesh", "region", "basis", "free", "fixed", "uD", "K_full", "B", "_lu",
+                       "_Kfd", "surface_vertices", "_pressure", "_pbasis"))
+
+    def __getattr__(self, name):
+        # only reached when normal lookup fails: a cached operator's body is built lazily
+        if name in FEOperator._BODY and not self.__dict__.get("_built", False):
+            self._build()
+            return getattr(self, name)
+        raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
+
+    @classmethod
+    def cached(cls, grid, e_star=None, nu=0.3, settings=None, progress=None, *, substrate=None,
+               layers=(), sphere=None, cache_dir=None):
+        """The operator of these arguments (as the constructor), its condensed compliance read
+        from the on-disk operator cache when an identical body was condensed before, else
+        built and stored there (:mod:`~femadh.elastic.fe.cache`, keyed by content: the mesh
+        file's bytes, the grid, the materials, the settings). A cached operator builds its
+        mesh, stiffness and factorisation only when full fields are asked for."""
+        from .cache import load_or_build
+
+        return load_or_build(cls, grid, e_star, nu, settings, progress, substrate=substrate,
+                             layers=layers, sphere=sphere, cache_dir=cache_dir)
+
+    def _build(self):
+        """Read the mesh, assemble the stiffness and load matrices, factorise (the body)."""
+        from skfem import Basis, ElementTriP2, ElementTriP2B, ElementVector, MeshTri
+
+        grid, t = self.grid, self.timings
+        self._built = True
+        a = grid.radius
+        t0 = time.perf_counter()
+        path = self._mesh_path
         p, tri, region = read_mesh(path, scale=a, regions=True)
         if region.max() != len(self.layers):
             raise ValueError(f"mesh {path} has {region.max()} layers, the body "
@@ -278,21 +312,29 @@ class FEOperator(SurfaceOperator):
                         options={"SymmetricMode": True})
         self._Kfd = K[free][:, fixed]
         t["factorisation"] = time.perf_counter() - t0
+        self._rows = self._surface_rows()
 
+    def _condense(self):
+        """The body's surface compliance: one batched solve for every annulus' unit
+        pressure."""
         t0 = time.perf_counter()
-        totals = grid.areas  # total force of a unit pressure on each annulus
-        rhs = B[free] - self._Kfd @ (uD[fixed][:, None] * totals[None, :])
+        totals = self.grid.areas  # total force of a unit pressure on each annulus
+        rhs = self.B[self.free] - self._Kfd @ (self.uD[self.fixed][:, None] * totals[None, :])
         U = self._lu.solve(np.asarray(rhs))
-        self.compliance_body = U[self._surface_rows(), :]
+        body = U[self._rows, :]
+        self.timings["condensation"] = time.perf_counter() - t0
+        return body
+
+    def _set_compliance(self, body):
+        """C = C_body (+ the sphere's Green compliance on the same nodes)."""
+        self.compliance_body = body
         if self.sphere is not None:
-            self.compliance_sphere = GreenOperator(grid,
+            self.compliance_sphere = GreenOperator(self.grid,
                                                    self.sphere.plane_strain_modulus).compliance
             self.compliance = self.compliance_body + self.compliance_sphere
         else:
             self.compliance_sphere = np.zeros_like(self.compliance_body)
             self.compliance = self.compliance_body
-        t["condensation"] = time.perf_counter() - t0
-        self.timings = t
 
     # ------------------------------------------------------------------ the body
     def _set_body(self, e_star, nu, substrate, layers, sphere):
