@@ -215,6 +215,30 @@ def damage_cell(scene, out, name, flags=("--no-figures", "--no-estimate")):
     return {"damage": name, "exit": code, "stderr": err.strip(), "status": status}
 
 
+def outside(scene, out, rows, delay, sig):
+    """A real ``femadh run`` process signalled from outside once curve.csv has ``rows``
+    rows (and ``delay`` s more): (exit code, seconds from the signal to its exit)."""
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-m", "femadh", "run", str(scene), "--out",
+                          str(out), "--quiet"], cwd=ROOT, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, env=dict(os.environ,
+                                                             OPENBLAS_NUM_THREADS="1"))
+    curve = Path(out) / "curve.csv"
+    t0 = time.time()
+    while not (curve.exists() and curve.read_text().count("\n") > rows):
+        if p.poll() is not None or time.time() - t0 > 120:
+            p.kill()
+            return p.wait(), math.nan
+        time.sleep(0.01)
+    time.sleep(delay)
+    t = time.perf_counter()
+    p.send_signal(sig)
+    code = p.wait()
+    return code, time.perf_counter() - t
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "validation" / "results" / "fault_matrix.md"))
@@ -289,6 +313,16 @@ def main(argv=None):
                       f" ± {hl['max_adhesion_N_error'] * 1e6:.2g} µN at d = "
                       f"{hl['d_at_max_adhesion_m'] * 1e9:.5g} nm; every resumed run above "
                       "ends with the same numbers."]
+        (tmp / "n800").mkdir()
+        big = short_scene(tmp / "n800", nodes=800)
+        said = []
+        for label, rows, delay, sig in (("sweep", 20, 0.0, signal.SIGINT),
+                                        ("estimate members", 72, 0.5, signal.SIGTERM)):
+            code, dt = outside(big, tmp / f"out-{rows}", rows, delay, sig)
+            said.append(f"{label}: exit {code} {dt * 1e3:.0f} ms")
+        lines += ["", "From outside, a real `femadh run` process (the scene on 800 nodes, "
+                  "~40 ms a state) signalled while it runs, to its exit (interpreter "
+                  "shutdown included): " + "; ".join(said) + "."]
         lines += ["", "A run stopped inside its sweep saves its last committed state whole "
                   "(checkpoint.npz: the factorisation the next step predicts from included), "
                   "so the resumed sweep is bit for bit the uninterrupted one. Without it (a "
