@@ -10,6 +10,23 @@ Python API::
     femadh.run(softer, "out/sigma-0.5")                # csv, json, figures into that folder
 """
 from ._version import __version__  # noqa: F401  (the package version, femadh.__version__)
+from .errors import (ConvergenceError, DependencyError, FemadhError, Interrupted,  # noqa: F401
+                     OutputError, SceneError, TimeLimitReached)
+
+__all__ = ["load_scene", "scene_from_dict", "run", "Scene", "ContactResult",
+           "MeniscusRunResult", "FemadhError", "SceneError", "OutputError", "ConvergenceError",
+           "DependencyError", "Interrupted", "TimeLimitReached", "__version__"]
+
+
+def __getattr__(name):
+    # Scene and the result types load the numerical core (~0.8 s): only when asked for
+    if name == "Scene":
+        from .scene import Scene
+        return Scene
+    if name in ("ContactResult", "MeniscusRunResult"):
+        from .runner import result
+        return getattr(result, name)
+    raise AttributeError(f"module 'femadh' has no attribute {name!r}")
 
 
 def load_scene(path):
@@ -24,18 +41,61 @@ def scene_from_dict(data, file=None):
     return _from_dict(data, file, bare_numbers=True)
 
 
-def run(scene, out_dir=None, **kwargs):
-    """Solve a scene (writes into ``out_dir`` only if given); see
-    :func:`femadh.runner.contact.run`.
+def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
+        estimate=True, time_limit=None, resume_from=None, operator=None, folder_id=None):
+    """Solve a scene; write its outputs into ``out_dir`` only if one is given.
 
-    A Ctrl-C stops the run at its next safe point (every completed state kept on disk,
-    ``summary.json`` says "interrupted", ``--resume`` continues it) and then raises
-    KeyboardInterrupt here, so that one Ctrl-C also stops a script's loop of runs (SIGTERM:
-    SystemExit with code 143)."""
+    Parameters
+    ----------
+    scene : Scene or str or Path
+        A scene (:func:`load_scene`, :func:`scene_from_dict`, ``Scene.replace``) or the path
+        of its TOML file.
+    out_dir : str or Path, optional
+        Folder for curve.csv, fields.csv, diagnostics.csv, jumps.csv, summary.json and the
+        figures. None (default): nothing is written. ``""`` is refused (OutputError).
+    figures : bool
+        Draw the figures into ``out_dir`` (default True).
+    progress : bool, optional
+        Progress on stderr (default: only when stderr is a terminal).
+    overwrite : bool
+        Replace the outputs of a previous run in ``out_dir``.
+    resume : bool
+        Continue an interrupted, failed or time-limited run of the same scene in ``out_dir``
+        (every committed row is checked first; the result equals an uninterrupted run's).
+    estimate : bool or "peak"
+        Estimate the headline numbers' errors (coarser grids, the tail, the peak between
+        the separations); "peak": only locate the peak; False: neither.
+    time_limit : float or str, optional
+        Stop cleanly after this long (seconds or e.g. "10 min"); default the scene's
+        ``[solver] time_limit``. The result then has status "time limit".
+    resume_from : int, optional
+        Resume keeping only the first ``resume_from`` committed states.
+    operator, folder_id
+        For studies and adaptive runs (see :func:`femadh.runner.contact.run`).
+
+    Returns
+    -------
+    ContactResult or MeniscusRunResult
+        ``status`` is "converged", "failed" (``error`` says where) or "time limit";
+        ``curve(branch)``, ``headline``, ``estimates``, ``jumps``, ``timings``.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        After a Ctrl-C: the run stopped at its next safe point (every completed state kept
+        on disk, ``summary.json`` says "interrupted", ``resume=True`` continues it), so that
+        one Ctrl-C also stops a script's loop of runs.
+    SystemExit
+        With code 143 after SIGTERM (the same safe stop).
+    SceneError, OutputError, DependencyError
+        Before anything is computed.
+    """
     import signal
 
     from .runner.contact import run as _run
-    res = _run(scene, out_dir, **kwargs)
+    res = _run(scene, out_dir, figures=figures, progress=progress, overwrite=overwrite,
+               resume=resume, estimate=estimate, time_limit=time_limit,
+               resume_from=resume_from, operator=operator, folder_id=folder_id)
     if res.status == "interrupted":
         if getattr(res, "exit_code", 130) == 128 + signal.SIGTERM:
             raise SystemExit(res.exit_code)

@@ -5,8 +5,10 @@ Every user mistake or fault ends in one ``femadh: error:`` line per problem, nev
 traceback. Exit codes: 0 done; 2 the scene or the command line is wrong; 3 a solve failed
 (the states computed before it are kept); 4 an output cannot be written or the output
 folder holds another run (use --resume or --overwrite); 5 an optional
-dependency is missing; 130 / 143 interrupted by SIGINT / SIGTERM (completed states kept,
-``--resume`` continues); 1 an internal error (a bug: set FEMADH_DEBUG=1 for its traceback).
+dependency is missing; 6 the run reached its time limit (``[solver] time_limit``,
+``--time-limit``: completed states kept, ``--resume`` continues); 130 / 143 interrupted by
+SIGINT / SIGTERM (completed states kept, ``--resume`` continues); 1 an internal error (a bug:
+set FEMADH_DEBUG=1 for its traceback).
 """
 import argparse
 import os
@@ -29,7 +31,7 @@ def _parser():
                     "examples and `femadh keys` for every key.",
         epilog="exit codes: 0 done, 2 bad scene/arguments, 3 solve failed (states kept), "
                "4 output not writable or folder holds a previous run, 5 missing dependency, "
-               "130/143 interrupted.")
+               "6 time limit reached (states kept), 130/143 interrupted.")
     p.add_argument("--version", action="version", version=f"femadh {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     r = sub.add_parser("run", help="solve a scene and write its results and figures",
@@ -42,7 +44,16 @@ def _parser():
     g.add_argument("--overwrite", action="store_true",
                    help="replace the results of a previous run in the output folder")
     g.add_argument("--resume", action="store_true",
-                   help="continue an interrupted or failed run in the output folder")
+                   help="continue an interrupted, failed or time-limited run in the output "
+                        "folder (every committed row is checked first)")
+    g.add_argument("--resume-from", type=int, metavar="K",
+                   help="continue keeping only the first K committed states (a folder whose "
+                        "later rows do not match their record)")
+    r.add_argument("--time-limit", metavar="DURATION",
+                   help="stop cleanly after this long, e.g. '10 min' (exit 6, states kept; "
+                        "default: the scene's [solver] time_limit)")
+    r.add_argument("--force", action="store_true",
+                   help="run a scene whose estimated time or memory is beyond reason")
     r.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     r.add_argument("--no-estimate", action="store_true",
                    help="skip the error estimates of the headline numbers (they solve the "
@@ -50,8 +61,11 @@ def _parser():
     r.add_argument("--quiet", action="store_true", help="no progress bar or summary lines")
     c = sub.add_parser("check", help="validate a scene without solving it",
                        description="Validate every key, the optional dependencies the scene "
-                                   "needs and its memory estimate.")
+                                   "needs, and estimate its memory and run time (rates "
+                                   "measured on a 2-core CI machine).")
     c.add_argument("scene", help="scene file (TOML)")
+    c.add_argument("--force", action="store_true",
+                   help="pass a scene whose estimated time is beyond reason")
     sub.add_parser("keys", help="print every scene key (markdown reference page)")
     m = sub.add_parser("mesh", help="build (or fetch from cache) the FE mesh of a scene",
                        description="Mesh the half-space of a scene with gmsh (cached by a hash "
@@ -199,6 +213,11 @@ def _dispatch(args):
 
     scene = load_scene(args.scene)
     check_resources(scene)
+    if args.command in ("check", "run"):
+        from .scene.resources import check_cost
+
+        # a scene whose cost is beyond reason is refused before it starts
+        check_cost(scene, force=args.force)
     if args.command == "check":
         return _check(scene, args.scene)
     if args.command == "mesh":
@@ -221,30 +240,58 @@ def _require_contact(scene, what):
 
 def _check(scene, path):
     if scene.kind == "meniscus":
+        from .scene.resources import _hms, meniscus_time
+
         n = len(scene.liquids) * len(scene.radii) * len(scene.methods) * len(scene.p_ratios)
         print(f"{path}: ok (meniscus: {len(scene.liquids)} liquids, {len(scene.radii)} radii, "
-              f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves)")
+              f"{len(scene.p_ratios)} p/psat, methods {', '.join(scene.methods)}: {n} solves, "
+              f"about {_hms(meniscus_time(scene)[0])} at rates measured on a 2-core machine)")
         return 0
-    from .scene.resources import memory_estimate
+    from .scene.resources import _hms, memory_estimate, time_estimate
 
     mem, _ = memory_estimate(scene)
+    t, what = time_estimate(scene)
     print(f"{path}: ok ({len(scene.d_values)} separations, {', '.join(scene.directions)}, "
-          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB)")
+          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB, "
+          f"{'' if t < 1 else '~'}{_hms(t)} with "
+          f"its error estimate: {what}, at rates measured on a 2-core machine; folds and "
+          "jumps can take up to ~10x more)")
     return 0
 
 
 def _run(scene, args):
+    import shlex
+
     from .runner.contact import run
 
     out = args.out or scene.output_dir
+    if args.resume_from is not None and args.resume_from < 0:
+        raise SceneError("command line", "--resume-from", args.resume_from, "an integer >= 0")
+    limit = None
+    if args.time_limit is not None:
+        from .units import to_si
+
+        limit = to_si(args.time_limit, "time", file="command line", key="--time-limit")
+        if not limit > 0:
+            raise SceneError("command line", "--time-limit", args.time_limit,
+                             "a positive duration such as '10 min'")
     res = run(scene, out, figures=not args.no_figures,
               progress=False if args.quiet else None, overwrite=args.overwrite,
-              resume=args.resume, estimate="peak" if args.no_estimate else True)
+              resume=args.resume, estimate="peak" if args.no_estimate else True,
+              time_limit=limit, resume_from=args.resume_from)
+    for w in getattr(res, "warnings", ()):
+        if w.startswith("resume: "):
+            print(f"femadh: note: {w}", file=sys.stderr)
     if not args.quiet:
         _report(res)
-    if res.status == "interrupted":
+    if res.status in ("interrupted", "time limit"):
+        # the command that continues it, as typed (pasted, it resumes this very folder)
+        again = ["femadh", "run", args.scene, "--out", str(out), "--resume"] + [
+            f for f, on in (("--no-figures", args.no_figures),
+                            ("--no-estimate", args.no_estimate), ("--quiet", args.quiet),
+                            ("--force", args.force)) if on]
         _error(f"{res.error}: the states computed before it are kept in {res.out_dir}; "
-               f"`femadh run {args.scene} --resume` continues the run")
+               f"`{shlex.join(again)}` continues the run")
         return getattr(res, "exit_code", 130)
     if res.status != "converged":
         _error(f"{res.error}; what was computed before it is kept in {res.out_dir}")

@@ -85,6 +85,35 @@ class Interrupted(FemadhError):
         name = signal.Signals(signum).name
         super().__init__(f"interrupted by {name}")
 
+    #: the status a run stopped by this ends with (summary.json)
+    status = "interrupted"
+
+
+#: exit code of a run that reached its time limit (``[solver] time_limit``, ``--time-limit``)
+EXIT_TIME_LIMIT = 6
+
+
+class TimeLimitReached(Interrupted):
+    """A run stopped by its time limit at a safe point (completed states kept; status "time
+    limit", exit code 6; ``--resume`` continues it)."""
+
+    status = "time limit"
+
+    def __init__(self, limit_s):
+        self.signum = None
+        self.limit_s = limit_s
+        self.exit_code = EXIT_TIME_LIMIT
+        FemadhError.__init__(self, f"time limit {_duration(limit_s)} reached")
+
+
+def _duration(s):
+    """'90 s', '10 min', '2 h' for a number of seconds."""
+    if s >= 3600 and s % 360 == 0:
+        return f"{s / 3600:g} h"
+    if s >= 60 and s % 6 == 0:
+        return f"{s / 60:g} min"
+    return f"{s:g} s"
+
 
 class MeshResolutionWarning(UserWarning):
     """The discretisation is too coarse for the surface forces' stiffness: single nodes can

@@ -27,6 +27,7 @@ DIMENSIONS = {
     "temperature": ("[temperature]", "K", "a temperature such as '298.15 K'"),
     "molar_volume": ("[length] ** 3 / [substance]", "m^3/mol", "a molar volume such as '58.7 cm^3/mol'"),
     "stiffness": ("[mass] / [time] ** 2", "N/m", "a stiffness such as '0.5 N/m'"),
+    "time": ("[time]", "s", "a duration such as '10 min' or '90 s'"),
     "dimensionless": ("", "", "a plain number"),
 }
 

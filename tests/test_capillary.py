@@ -58,7 +58,7 @@ def test_scene_with_capillary_writes_F_cap_and_includes_it_in_F_ex(tmp_path):
     res = femadh.run(sc, str(tmp_path), figures=False, progress=False)
     assert res.status == "converged"
     header = (tmp_path / "curve.csv").read_text().splitlines()[0].split(",")
-    assert header[-1] == "F_cap_N"
+    assert header[-2:] == ["F_cap_N", "crc32"]     # the law's force, then the row checksum
     check_curve_against_fields(tmp_path)
     # paper 1 sec 6: the meniscus force 4 pi R gamma = 0.55 mN dwarfs the LJ adhesion
     c = res.curve("approach")

@@ -71,7 +71,7 @@ def test_cli_run_writes_outputs_and_keeps_header(tmp_path):
     out = tmp_path / "out"
     assert main(["run", str(p), "--out", str(out), "--quiet"]) == 0
     header = (out / "curve.csv").read_text().splitlines()[0]
-    assert header == ",".join(CURVE_HEADER)
+    assert header == ",".join(CURVE_HEADER + ["crc32"])     # the row checksum last
     c = read_curve(out / "curve.csv")
     assert set(c["branch"]) == {"approach", "retract"} and c["converged"].all()
     # the force balance of eq 13 holds row by row, with forces integrated from fields.csv

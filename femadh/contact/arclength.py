@@ -34,6 +34,7 @@ from scipy import linalg
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
+from ..runner.interrupt import check as safe_point
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
 from .stability import is_positive_definite
 
@@ -226,6 +227,7 @@ class _Tracer:
         x = x_pred.copy()
         res = res_first = res_prev = math.inf
         for it in range(1, MAX_ITER + 1):
+            safe_point()        # a signal stops the trace between corrector iterations
             w, d = x[:n] * scale, x[n] * scale
             h = problem.contour(d) - w
             if np.any(h <= 0):

@@ -3,6 +3,7 @@ slides downhill into the basin it rolls into), polished by Newton."""
 import numpy as np
 from scipy import linalg as sla
 
+from ..runner.interrupt import check as safe_point
 from .complementarity import solve_complementarity
 
 
@@ -23,6 +24,7 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400):
     g = problem.energy_gradient(w, d)
     g0 = float(np.max(np.abs(g))) + 1e-300
     for _ in range(max_iter):
+        safe_point()            # a signal stops the run between descent steps
         at_bound = (w >= upper - 1e-18) & (g < 0)   # pushing further into h < floor
         free = ~at_bound
         if float(np.max(np.abs(g[free]), initial=0.0)) <= 1e-10 * g0:

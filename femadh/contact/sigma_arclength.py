@@ -38,6 +38,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
+from ..runner.interrupt import check as safe_point
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
 from .linalg import disk_size
 from .stability import is_stable
@@ -162,6 +163,7 @@ class _Piece:
         res_first = math.inf
         res = math.inf
         for it in range(1, MAX_ITER + 1):
+            safe_point()        # a signal stops the trace between corrector iterations
             h = problem.contour(d) - w
             if np.any(h[f] <= 0):
                 return w, d, it, math.inf, False

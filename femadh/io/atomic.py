@@ -104,6 +104,8 @@ class RowLog:
         self.path = Path(path)
         self.header = list(header)
         try:
+            if keep is not None and not self.path.exists():
+                keep = None             # a lost file (its rows are recomputed): a new one
             if keep is None:
                 self.fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
                 self.size = 0

@@ -80,19 +80,34 @@ class RunFolder:
 
     def _lock(self):
         lock = self.path / LOCK
-        try:
-            self.lock_fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as exc:
-            raise OutputError(f"output folder {self.path} is not writable: "
-                              f"{exc.strerror or exc}") from None
-        try:
-            fcntl.flock(self.lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            other = os.read(self.lock_fd, 64).decode(errors="replace").strip() or "?"
+        # a lock taken on a file that another run removed as it ended (it had been opened
+        # just before) guards nothing: taken again on the folder's current file (budget 5)
+        for _ in range(5):
+            try:
+                self.lock_fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as exc:
+                raise OutputError(f"output folder {self.path} is not writable: "
+                                  f"{exc.strerror or exc}") from None
+            try:
+                fcntl.flock(self.lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                other = os.read(self.lock_fd, 64).decode(errors="replace").strip() or "?"
+                os.close(self.lock_fd)
+                self.lock_fd = None
+                raise OutputError(f"output folder {self.path} is in use by another femadh "
+                                  f"run (pid {other}); wait for it or give another --out") \
+                    from None
+            try:
+                same = os.stat(lock).st_ino == os.fstat(self.lock_fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
             os.close(self.lock_fd)
             self.lock_fd = None
-            raise OutputError(f"output folder {self.path} is in use by another femadh run "
-                              f"(pid {other}); wait for it or give another --out") from None
+        else:
+            raise OutputError(f"output folder {self.path}: its lock file keeps being replaced "
+                              "by another run; wait for it or give another --out")
         os.ftruncate(self.lock_fd, 0)
         os.write(self.lock_fd, str(os.getpid()).encode())
 
@@ -112,10 +127,14 @@ class RunFolder:
                 raise OutputError(f"{what} of another scene: its summary cannot be amended")
             return prev
         if self.mode == "resume":
+            if str(prev.get("status", "")).startswith("unknown"):
+                # summary.json lost or unreadable: the run checks curve.csv's rows against
+                # this scene (their checksums are seeded with its id) before it keeps any
+                return prev
             if prev.get("scene_id") != self.scene_id:
                 raise OutputError(f"{what} of another scene (or of this scene changed): it "
                                   "cannot be resumed; use --overwrite to replace it")
-            if prev.get("status") == "converged":
+            if prev.get("status") == "converged" and not prev.get("trial"):
                 raise OutputError(f"{what}: it has finished, there is nothing to resume")
             return prev
         raise OutputError(f"{what}; use --resume to continue it or --overwrite to replace it "
@@ -142,6 +161,11 @@ class RunFolder:
                                 default=_json_default) + "\n")
 
     def release(self):
+        """Give the folder up: the lock file is removed while it is still held, then closed
+        (closing first would let a second run lock the file in between and then lose it
+        to the unlink: two runs could both believe they hold the folder). A run that opened
+        the file just before the unlink holds a lock on a removed file: ``_lock`` checks
+        that the file it locked is still the folder's."""
         if getattr(self, "lock_fd", None) is not None:
             try:
                 os.unlink(self.path / LOCK)

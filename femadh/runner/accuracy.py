@@ -6,6 +6,7 @@ would snap alone - until the estimate meets the target, within a budget; the res
 was chosen and every step (``result.accuracy``), or fails saying the target was not met."""
 import math
 
+from ..scene import scene_id
 from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
 
 
@@ -37,9 +38,11 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
     res = None
     for i in range(MAX_REFINEMENTS + 1):
         trial = variant(scene, nodes=nodes, delta=delta)
+        # claimed under the user's scene: --resume and --overwrite recognise the folder
+        # whichever trial it holds
         with phase(f"{'refinement ' + str(i) if i else 'grid'} (N = {nodes})"):
             res = run(trial, out_dir, figures=figures, progress=progress, estimate=True,
-                      **mode)
+                      folder_id=scene_id(scene), **mode)
         mode = {"overwrite": True, "resume": False}       # later trials replace earlier ones
         grid, tail = _relative(res) if res.status == "converged" else (math.inf, 0.0)
         steps.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,
@@ -77,10 +80,9 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
                      f"{MAX_REFINEMENTS} refinements)")
     if out_dir is not None:
         from ..io.run_folder import RunFolder
-        from ..scene import scene_id
         from .result import contact_summary as summary
 
         # the last trial's outputs stay; only its summary gains the accuracy record
-        with RunFolder(out_dir, scene_id(trial), scene.name, "amend") as folder:
+        with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
             folder.write_summary(summary(res))
     return res

@@ -201,14 +201,13 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
         # the last trial's outputs stay; its summary gains the accuracy record, its figures
         with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
-            if figures and res.branches and any(len(next(iter(b.values())))
-                                                for b in res.branches.values()):
-                from ..io.plots import contact_figures
+            if figures and res.status in ("converged", "failed") and res.branches and any(
+                    len(next(iter(b.values()))) for b in res.branches.values()):
+                from .contact import draw_figures
 
-                t1 = time.perf_counter()
+                # a signal stops the figures at once: the run ends "interrupted"
                 with phase("figures"):
-                    contact_figures(res, folder.path)
-                res.timings["figures_s"] = time.perf_counter() - t1
+                    draw_figures(res, folder)
             folder.write_summary(summary(res))
     return res
 

@@ -7,6 +7,7 @@ atomically at the end, every committed state is in every csv, SIGINT/SIGTERM sto
 current state with status ``interrupted``, and ``resume=True`` continues an interrupted or
 failed sweep from its last committed state.
 """
+from dataclasses import dataclass
 import math
 import sys
 import time
@@ -17,7 +18,7 @@ import numpy as np
 from .._threads import blas_threads
 from ..contact import Jump, State, trace
 from ..contact.forces import state_forces
-from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning
+from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning, OutputError
 from ..scene import build_problem, load_scene, scene_id  # noqa: F401 (scene_id: the API)
 from . import interrupt
 from .estimates import GuardError
@@ -32,7 +33,7 @@ PROFILES = 12
 
 
 def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
-        operator=None, estimate=True, folder_id=None):
+        operator=None, estimate=True, folder_id=None, time_limit=None, resume_from=None):
     """Solve a scene.
 
     Parameters
@@ -41,14 +42,16 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         A scene or the path of its TOML file.
     out_dir : str or Path, optional
         Folder for the csv/json/VTK outputs and figures. None (the default): nothing is
-        written (the command line passes the scene's ``[output] dir``).
+        written (the command line passes the scene's ``[output] dir``). An empty string is
+        refused (it would mean the current folder).
     figures : bool
         Draw the scene's figures into ``out_dir``.
     progress : bool, optional
         Progress bar on stderr; default: only when stderr is a terminal.
     overwrite, resume : bool
         What to do with a folder that holds a previous run: replace it, or continue it
-        (an interrupted or failed run of the same scene). Neither: refuse it.
+        (an interrupted, failed or time-limited run of the same scene; every committed row is
+        checked first, see :mod:`femadh.io.resume_check`). Neither: refuse it.
     operator : SurfaceOperator, optional
         Reuse an operator built for this scene's grid (studies keep one per worker).
     estimate : bool or "peak"
@@ -58,13 +61,19 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     folder_id : str, optional
         The scene id the output folder is claimed under (an adaptive run's trials claim it
         under the user's scene, so that --resume and --overwrite recognise it).
+    time_limit : float or str, optional
+        Stop cleanly after this long (seconds, or a duration such as "10 min"); default the
+        scene's ``[solver] time_limit``. Status "time limit"; ``resume`` continues.
+    resume_from : int, optional
+        Resume keeping only the first ``resume_from`` committed states (a folder whose later
+        rows do not match their record).
 
     Returns
     -------
     ContactResult or MeniscusRunResult
-        Also when a step fails (status "failed", ``error`` says where) or the run is
-        interrupted (status "interrupted"): every state computed before is in the result
-        and on disk.
+        Also when a step fails (status "failed", ``error`` says where), the run is
+        interrupted (status "interrupted") or reaches its time limit (status "time limit"):
+        every state computed before is in the result and on disk.
 
     Raises
     ------
@@ -73,14 +82,26 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     """
     if not hasattr(scene, "kind"):
         scene = load_scene(scene)
-    if scene.kind == "meniscus":
-        from .meniscus import run_meniscus
+    if out_dir is not None and not str(out_dir).strip():
+        from ..errors import OutputError
 
-        return run_meniscus(scene, out_dir, figures=figures, progress=progress,
-                            overwrite=overwrite)
+        raise OutputError("output folder '' is empty: give a folder name (None writes "
+                          "nothing; '.' is the current folder)")
+    if resume_from is not None:
+        resume = True
+    limit = _time_limit(scene, time_limit)
     if progress is None:
         progress = sys.stderr.isatty()
-    with blas_threads(), display(scene.name, progress):
+    from contextlib import nullcontext
+
+    # one display over the whole run (a meniscus run has its own bar)
+    shown = nullcontext() if scene.kind == "meniscus" else display(scene.name, progress)
+    with blas_threads(), interrupt.interruptible(limit), shown:
+        if scene.kind == "meniscus":
+            from .meniscus import run_meniscus
+
+            return run_meniscus(scene, out_dir, figures=figures, progress=progress,
+                                overwrite=overwrite)
         if getattr(scene, "adaptive", False):
             from .adaptive import run_adaptive
 
@@ -97,14 +118,44 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
 
         mode = "resume" if resume else "overwrite" if overwrite else "new"
         with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
-            res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate)
-            if figures and any(len(next(iter(b.values()))) for b in res.branches.values()):
-                from ..io.plots import contact_figures
-
+            res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
+                       resume_from=resume_from)
+            if figures and res.status in ("converged", "failed") and any(
+                    len(next(iter(b.values()))) for b in res.branches.values()):
                 with phase("figures"):
-                    res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
+                    draw_figures(res, folder)
                 folder.write_summary(summary(res))
             return res
+
+
+def _time_limit(scene, given):
+    """The run's time limit in seconds (None: none): the argument, else the scene's."""
+    if given is None:
+        return getattr(scene, "time_limit", None)
+    if isinstance(given, str):
+        from ..units import to_si
+
+        given = to_si(given, "time", file="time_limit", key="time_limit")
+    if not (isinstance(given, (int, float)) and given > 0 and math.isfinite(given)):
+        from ..errors import SceneError
+
+        raise SceneError("time_limit", "time_limit", given, "a positive duration such as "
+                         "'10 min' or a number of seconds")
+    return float(given)
+
+
+def draw_figures(res, folder):
+    """The run's figures into its folder; a signal stops them at once (each file is written
+    whole or not at all) and the run ends "interrupted" (--resume draws them)."""
+    from ..errors import Interrupted
+    from ..io.plots import contact_figures
+
+    try:
+        with interrupt.immediate():
+            res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
+    except Interrupted as exc:
+        res.status, res.error = exc.status, f"{exc} while drawing the figures"
+        res.exit_code = exc.exit_code
 
 
 def solve_sweeps(scene, problem=None):
@@ -137,35 +188,66 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress, operator=None, estimate=True):
+def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     from ..io.progress import note
 
     say = note if progress else None
-    resuming = folder is not None and folder.previous
-    resume = _resume_point(folder) if resuming and scene.continuation != "arclength" else None
+    run_id = scene_id(scene)
+    # an adaptive run's trial claims the folder under the user's scene: its summary says
+    # so (a trial's "converged" is not the run's end: --resume may continue the run)
+    trial = folder is not None and folder.scene_id != run_id
+    prev = folder.previous if folder is not None else None
+    if prev and trial and prev.get("run_id") not in (None, run_id):
+        # the folder holds another trial of this adaptive run (a later one, stopped): this
+        # trial starts afresh in it
+        folder.clean()
+        prev = None
+    resuming = bool(prev)
     if resuming and scene.continuation == "arclength":
         # an arclength trace cannot restart mid-curve from the files: its paths are read off
         # the whole curve, whose orientation and fold history are not on disk; it is traced
         # again from its start (the files are rewritten, consistent at every point)
         def rows(name):
             f = folder.path / name
-            return max(0, len(f.read_text().splitlines()) - 1) if f.exists() else 0
+            return max(0, len(f.read_text(errors="replace").splitlines()) - 1) \
+                if f.exists() else 0
 
         res.warnings.append("resume: the arclength curve was traced again from its start "
                             f"({rows('equilibrium_curve.csv')} curve points and "
                             f"{rows('curve.csv')} branch states of the previous run replaced)")
-        resume = None
-    writer = None
+        resuming = False
+    elif resuming and getattr(scene, "instrument", None) is not None:
+        # an instrument's readout refines between the sweep's own states and its jumps'
+        # fold and landing states, which the files do not hold: the sweep is run again
+        res.warnings.append("resume: the sweep was computed again from its start (an "
+                            "instrument's readout needs every state of it in memory)")
+        resuming = False
+    resume = None
+    writer = sink = None
+    checked = False         # a resumed folder's record has been checked (and is kept)
+
+    def write_summary(status=None):
+        if folder is not None:
+            folder.write_summary({**summary(res, status=status),
+                                  **({"trial": True} if trial else {})})
     with interrupt.interruptible():
         try:
-            if folder is not None:
-                folder.write_summary(summary(res, status="running"))
+            if not resuming:
+                write_summary("running")
             t1 = time.perf_counter()
-            with phase("operator"):
+            # the build writes nothing but whole cache files: a signal stops it at once
+            with phase("operator"), interrupt.immediate():
                 problem = build_problem(scene, operator=operator, progress=say)
             res.timings["operator_s"] = time.perf_counter() - t1
+            if resuming:
+                # every committed row checked before anything is appended (refused in one
+                # line, or the side files cut back to what is complete in all of them)
+                resume = _resume_point(folder, scene, problem, run_id, prev, resume_from, res)
+                checked = True
+            if resuming:
+                write_summary("running")
             res.nodes = problem.grid.nodes.copy()
             g = problem.grid
             res.grid = {"kind": "uniform" if g.fine_radius is None else "banded", "nodes": g.n,
@@ -178,38 +260,49 @@ def _run(scene, folder, *, progress, operator=None, estimate=True):
             if folder is not None:
                 from ..io.writers import ContactWriter
 
-                writer = ContactWriter(folder, problem, vtk=scene.vtk, resume=resume)
+                writer = ContactWriter(folder, problem, vtk=scene.vtk, resume=resume,
+                                       run_id=run_id)
             sink = Sink(problem, res, writer, progress)
             if resume:
-                sink.load(folder.path)
+                sink.load(folder.path, resume)
             t1 = time.perf_counter()
             if scene.continuation == "arclength":
                 _trace_arclength(scene, problem, sink)
             else:
                 _trace_steps(scene, problem, sink, resume)
             res.timings["solve_s"] = time.perf_counter() - t1
-            if res.status == "converged":
+            if folder is not None and (folder.path / CHECKPOINT).exists():
+                (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
+            if res.status == "running":
+                res.status = "converged"
                 _finish(scene, res, problem, sink, estimate)
                 if folder is not None and res.instrument is not None:
                     from ..io.writers import write_instrument
 
                     write_instrument(folder.path, res)
+                # a signal that arrived after the last safe point is still a stop: the run
+                # never ends "converged" once the user has asked it to stop
+                interrupt.check()
         except (ConvergenceError, GuardError) as exc:
             res.status, res.error = "failed", str(exc)
         except Interrupted as exc:
-            res.status, res.error = "interrupted", str(exc)
+            res.status, res.error = exc.status, str(exc)
             res.exit_code = exc.exit_code
+            if sink is not None and res.timings.get("solve_s") is None:
+                _save_checkpoint(folder, sink)       # stopped inside the sweep
         except BaseException as exc:
             # an output fault, a law error, a bug: the summary must not say "converged"
             res.status = "failed"
             res.error = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+            if resuming and not checked and isinstance(exc, OutputError):
+                # refused while checking the folder: it is left as it was
+                folder = None
             raise
         finally:
             if writer is not None:
                 writer.close()
             res.timings["total_s"] = time.perf_counter() - t0
-            if folder is not None:
-                folder.write_summary(summary(res))
+            write_summary()
     return res
 
 
@@ -235,6 +328,20 @@ def _finish(scene, res, problem, sink, estimate):
     res.timings["estimate_s"] = time.perf_counter() - t1
 
 
+@dataclass
+class Committed:
+    """What the peak search (and a resume) needs of a committed state: its separation,
+    displacements, contact set, contact radius and F_ex - each exactly as written to the
+    files (fields.csv, curve.csv), so that a resumed run searches from the same numbers as
+    an uninterrupted one."""
+
+    d: float
+    w: np.ndarray
+    active: np.ndarray
+    r_c: float
+    f_ex: float
+
+
 class Sink:
     """Where each state goes as soon as it exists: the result's arrays, the csv files, the
     progress bar; then the interrupt check (a safe point: the state is complete on disk)."""
@@ -255,48 +362,62 @@ class Sink:
         self.scene = result.scene
         # the state of largest F_ex and its neighbours (the peak search needs them)
         self.peak, self._prev, self._need_next = None, None, False
+        # the last committed state of each branch (a resumed branch restarts from it), and
+        # the last one whole (state number, branch, State: the checkpoint of a stopped run)
+        self.last = {}
+        self.last_state = None
         # an instrument's readout solves fresh states between the branch's own
         self.states, self.jump_states = {}, []
         self._keep = getattr(self.scene, "instrument", None) is not None
 
-    def plan(self, branch, n):
-        """A branch of n states begins: which of them keep their surface profile."""
-        self.profile_picks[branch] = set(np.linspace(0, n - 1, min(n, PROFILES)).round()
-                                         .astype(int))
+    def plan(self, branch, n, total=None):
+        """A branch of ``total`` states begins (``n`` of them still to compute): which of
+        them keep their surface profile."""
+        total = n if total is None else total
+        self.profile_picks[branch] = _picks(total)
         begin(branch, n)        # the run's display, if one is shown
 
     def state(self, branch, st):
         from .estimates import check_state
 
         check_state(self.problem, st, self.scene)
-        self._track_peak(branch, st)
+        f = state_forces(self.problem, st)[2]
+        snap = Committed(st.d, st.w, st.p_contact != 0, st.r_c, f)
+        self._track_peak(branch, snap)
         if self._keep:
             self.states.setdefault(branch, []).append(st)
         rows = self.rows.setdefault(branch, [])
         if branch in self.profile_picks and len(rows) in self.profile_picks[branch]:
-            prof = self.result.profiles.setdefault(
-                branch, {"d_m": [], "w_m": [], "P_LJ_Pa": [], "P_el_Pa": []})
-            prof["d_m"].append(st.d)
-            prof["w_m"].append(st.w.copy())
-            prof["P_LJ_Pa"].append(st.p_effects.get("lj", 0 * st.w).copy())
-            prof["P_el_Pa"].append(st.p_contact.copy())
+            self._profile(branch, st.d, st.w, st.p_effects.get("lj", 0 * st.w), st.p_contact)
         rows.append([float(v) if not isinstance(v, bool) else v for v in self._row(st)])
         if self.writer:
-            self.writer.write_state(branch, st)
+            k = self.writer.write_state(branch, st)
+            self.last_state = (k, branch, st)
         advance()
         self._publish(branch)
         interrupt.check()
 
-    def _track_peak(self, branch, st):
-        f = state_forces(self.problem, st)[2]
+    def _profile(self, branch, d, w, p_lj, p_el):
+        prof = self.result.profiles.setdefault(
+            branch, {"d_m": [], "w_m": [], "P_LJ_Pa": [], "P_el_Pa": []})
+        prof["d_m"].append(d)
+        prof["w_m"].append(w.copy())
+        prof["P_LJ_Pa"].append(p_lj.copy())
+        prof["P_el_Pa"].append(p_el.copy())
+
+    def _track_peak(self, branch, snap):
+        """Keep the committed state of largest F_ex (the first of equals) and its neighbours
+        on its branch."""
+        f = snap.f_ex
         prev = self._prev if self._prev is not None and self._prev[0] == branch else None
         if self._need_next and self.peak is not None and self.peak[0] == branch:
-            self.peak[4] = st
+            self.peak[4] = snap
         self._need_next = False
         if self.peak is None or f > self.peak[1]:
-            self.peak = [branch, f, prev[1] if prev else None, st, None]
+            self.peak = [branch, f, prev[1] if prev else None, snap, None]
             self._need_next = True
-        self._prev = (branch, st)
+        self._prev = (branch, snap)
+        self.last[branch] = snap
 
     def jump(self, jump):
         p = self.problem
@@ -332,23 +453,60 @@ class Sink:
             for k in list(prof):
                 prof[k] = np.array(prof[k])
 
-    def load(self, folder):
-        """Resume: the committed states and jumps of the previous run, into the result."""
-        from ..io.writers import read_curve
-
-        c = read_curve(folder / "curve.csv")
-        for i, b in enumerate(c["branch"]):
-            row = [c[k][i] for k in self.columns]
-            self.rows.setdefault(str(b), []).append(
-                [bool(v) if isinstance(v, np.bool_) else float(v) for v in row])
-        for b in self.rows:
-            self._publish(b)
+    def load(self, folder, resume):
+        """Resume: the committed states and jumps of the previous run, into the result, as
+        the uninterrupted run held them - the rows, the profiles it kept, the peak and its
+        neighbours and the last state of each branch (from fields.csv: the same bits)."""
         import csv
 
+        from ..io.resume_check import field_states
+
+        rows = resume["rows"]
+        with open(folder / "curve.csv") as f:
+            head = f.readline().strip().split(",")
+        col = [head.index(c) for c in self.columns]
+        per_branch = {}
+        # the peak bookkeeping replayed over the committed rows (state numbers stand in for
+        # the states until the few it needs are read)
+        for k, r in enumerate(rows):
+            b = r[1]
+            vals = [r[j] for j in col]
+            self.rows.setdefault(b, []).append(
+                [v == "True" if c in ("converged", "stable") else float(v)
+                 for c, v in zip(self.columns, vals)])
+            per_branch.setdefault(b, []).append(k)
+            self._track_peak(b, Committed(float(r[2]), None, None,
+                                          float(vals[self.columns.index("r_c_m")]), float(
+                                              vals[self.columns.index("F_ex_N")])))
+            self.last[b].w = k           # (the state number, replaced below)
+        for b in self.rows:
+            self._publish(b)
+        # the profiles the uninterrupted run kept: the picks of each branch's full length
+        picks = {b: [ks[j] for j in sorted(_picks(len(self.scene.d_values))) if j < len(ks)]
+                 for b, ks in per_branch.items()}
+        snaps = [s for s in ([self.peak[2], self.peak[3], self.peak[4]] if self.peak else [])
+                 + list(self.last.values()) if s is not None]
+        wanted = {s.w for s in snaps} | {k for ks in picks.values() for k in ks}
+        fields = field_states(folder, wanted)
+        self.last_k = {b: s.w for b, s in self.last.items()}
+        for s in {id(s): s for s in snaps}.values():
+            d, w, _, p_el = fields[s.w]
+            s.w, s.active = w, p_el != 0
+        for b, ks in picks.items():
+            for k in ks:
+                d, w, p_lj, p_el = fields[k]
+                self._profile(b, d, w, p_lj, p_el)
         with open(folder / "jumps.csv", newline="") as f:
-            for r in csv.DictReader(f):
+            for j, r in enumerate(csv.DictReader(f)):
+                if j >= resume["jumps"]:
+                    break
                 self.result.jumps.append({k: (v if k == "branch" else float(v))
                                           for k, v in r.items()})
+
+
+def _picks(n):
+    """Indices of the states of a branch of n whose surface profiles the result keeps."""
+    return set(np.linspace(0, n - 1, min(n, PROFILES)).round().astype(int))
 
 
 def _stiffness_warning(scene, problem):
@@ -387,12 +545,13 @@ def _trace_steps(scene, problem, sink, resume):
         if done >= len(d_vals):
             start, prev = None, branch
             continue
+        total = len(d_vals)
         if done:                      # resume inside this branch
             start = _restart_state(problem, scene, sink, branch)
             d_vals, skip_first = d_vals[done - 1:], True
         elif start is None and prev is not None:    # resume at the start of this branch
             start = _restart_state(problem, scene, sink, prev)
-        sink.plan(branch, len(d_vals) - skip_first)
+        sink.plan(branch, len(d_vals) - skip_first, total)
         first = [skip_first]
 
         def on_state(st, branch=branch):
@@ -411,9 +570,14 @@ def _restart_state(problem, scene, sink, branch):
     Newton from the saved w converges in an iteration or two to the same state (to the
     tolerance)."""
     from ..contact import solve_state
-    from ..io.writers import read_fields_state
 
-    d, w = read_fields_state(sink.result.out_dir, branch)
+    last = sink.last[branch]
+    d, w = last.d, last.w
+    if sink.writer is not None:
+        # stopped by a signal or its time limit: the state was saved whole (bit for bit)
+        st = _load_checkpoint(sink.writer.dir, getattr(sink, "last_k", {}).get(branch), d)
+        if st is not None:
+            return st
     kw = {}
     if problem.contact_model == "hertz-closure":
         kw["r_c0"] = float(sink.result.branches[branch]["r_c_m"][-1]) or None
@@ -426,14 +590,31 @@ def _restart_state(problem, scene, sink, branch):
     return st
 
 
-def _resume_point(folder):
-    """How much of a previous run's output to keep: its committed states (curve.csv rows),
-    their field rows, their jumps."""
-    from ..io.writers import committed_counts
+def _resume_point(folder, scene, problem, run_id, prev, resume_from, res):
+    """What a resumed run keeps of the folder (:mod:`femadh.io.resume_check`): its committed
+    states whose rows match their record and are complete in every file, their field rows,
+    the jumps before them; None to start from the first state. Notes of a repair go to the
+    result's warnings; a damaged record raises DamagedFolder (one line)."""
+    from ..io.resume_check import DamagedFolder, check_curve, check_side_files, kept_jumps
 
-    if not (folder.path / "curve.csv").exists():
-        return None             # stopped before its first state (e.g. in the operator build)
-    return committed_counts(folder.path)
+    k, rows, notes = check_curve(folder.path, scene, problem, run_id, resume_from)
+    if str(prev.get("status", "")).startswith("unknown"):
+        # summary.json lost or unreadable: the checksum of the first row, seeded with the
+        # scene id, is the proof that the folder holds this scene's run
+        if k == 0:
+            raise DamagedFolder(f"{folder.path}: summary.json is missing or unreadable and "
+                                "curve.csv has no committed row to show it is this scene's "
+                                "run; use --overwrite")
+        notes.append("resume: summary.json was missing or unreadable; rewritten (curve.csv's "
+                     "rows check with this scene)")
+    if k:
+        k, more = check_side_files(folder.path, rows, problem.grid.n)
+        notes += more
+    res.warnings += notes
+    if k == 0:
+        return None
+    return {"states": k, "fields_rows": k * problem.grid.n,
+            "jumps": kept_jumps(folder.path, rows[:k]), "rows": rows[:k]}
 
 
 def _curve_state(problem, d, w, stable):
@@ -500,3 +681,75 @@ def _once(path):
             continue
         out.append(e)
     return out
+
+
+#: the last committed state of a sweep stopped by a signal or its time limit, whole (its
+#: factorisation included): a resumed sweep continues from it bit for bit
+CHECKPOINT = "checkpoint.npz"
+
+
+def _save_checkpoint(folder, sink):
+    """Write the last committed state whole (npz, no pickle), if the sweep has one this
+    format holds (complementarity / smooth laws; the closure's states are re-solved)."""
+    from ..contact.linalg import TrailingLU
+    from ..io.atomic import save_atomic
+
+    if sink is None or sink.writer is None or sink.last_state is None:
+        return
+    k, branch, st = sink.last_state
+    if st.diagnostics or sink.problem.contact_model == "hertz-closure":
+        return
+    data = {"k": np.array(k), "branch": np.array(branch), "d": np.array(st.d), "w": st.w,
+            "h": st.h, "p_contact": st.p_contact, "active": st.active,
+            "r_c": np.array(st.r_c), "n_iter": np.array(st.n_iter),
+            "residual": np.array(st.residual), "flags": np.array([st.converged, st.stable]),
+            "effects": np.array(list(st.p_effects))}
+    data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
+    lu = st.lu
+    if lu is None:
+        data["lu_kind"] = np.array("none")
+    elif isinstance(lu, TrailingLU):
+        data.update(lu_kind=np.array("trailing"), lu=lu.lu, piv=lu.piv,
+                    dims=np.array([lu.n, lu.m0, lu.k_valid]))
+        if lu.scale is not None:
+            data["scale"] = lu.scale
+    elif isinstance(lu, tuple) and len(lu) == 2 and isinstance(lu[0], tuple):
+        data.update(lu_kind=np.array("dense"), lu=lu[0][0], piv=lu[0][1], lu_I=lu[1])
+    else:
+        return
+    def write(path):
+        with open(path, "wb") as f:
+            np.savez(f, **data)
+    save_atomic(folder.path / CHECKPOINT, write)
+
+
+def _load_checkpoint(folder, k, d):
+    """The whole state number k at separation d from the checkpoint, or None (absent, of
+    another state, unreadable: the caller re-solves the state from fields.csv)."""
+    from ..contact.linalg import TrailingLU
+
+    path = folder / CHECKPOINT
+    if not path.exists():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if int(z["k"]) != k or float(z["d"]) != d:
+                return None
+            kind = str(z["lu_kind"])
+            if kind == "trailing":
+                lu = TrailingLU.__new__(TrailingLU)
+                lu.n, lu.m0, lu.k_valid = (int(x) for x in z["dims"])
+                lu.lu, lu.piv = z["lu"], z["piv"]
+                lu.scale = z["scale"] if "scale" in z.files else None
+                lu._block = (None, None)
+            elif kind == "dense":
+                lu = ((z["lu"], z["piv"]), z["lu_I"])
+            else:
+                lu = None
+            conv, stable = (bool(x) for x in z["flags"])
+            return State(float(z["d"]), z["w"], z["h"],
+                         {str(n): z[f"pe_{n}"] for n in z["effects"]}, z["p_contact"],
+                         z["active"], float(z["r_c"]), int(z["n_iter"]),
+                         float(z["residual"]), conv, stable, lu)
+    except (OSError, ValueError, KeyError):
+        return None

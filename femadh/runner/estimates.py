@@ -135,11 +135,12 @@ def peak_adhesion(problem, prev, best, nxt, scene):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
-    branch (within a quarter of every gap of the interpolation). Returns (F, d, half-width of
-    the final d bracket)."""
+    branch (within a quarter of every gap of the interpolation). The states may be
+    :class:`~femadh.runner.contact.Committed` records (d, w, active, r_c, f_ex) as the files
+    hold them. Returns (F, d, half-width of the final d bracket)."""
     from ..contact.forces import state_forces
 
-    f_best = state_forces(problem, best)[2]
+    f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
     found = {}
 
@@ -265,6 +266,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         else:
             with _phase("estimate: " + ("Green function" if green else "coarser mesh")):
                 g = run(other, progress=False, estimate="peak")
+        _stop_if_stopped(g)
         if g is not None and g.status == "converged":
             for k, v in g.headline.items():
                 if isinstance(v, float) and isinstance(hl.get(k), float):
@@ -282,6 +284,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     for i, (label, member) in enumerate(members):
         with _phase(f"estimate: {label}"):
             r = run(member, progress=False, estimate="peak")
+        _stop_if_stopped(r)
         if r.status != "converged":
             res.warnings.append(member_note(label, r.error, _fine_label(scene, problem),
                                             [lb for lb, _ in members[:i]]))
@@ -324,6 +327,22 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         comp["total"] = float(sum(abs(v) for v in comp.values()))
         hl[f"{k}_error"] = comp["total"]
     return parts
+
+
+def _stop_if_stopped(member):
+    """A member stopped by a signal or the time limit stops the run: its estimate would be
+    degraded, and the run must end "interrupted" (exit 130/143), never "converged" with a
+    warning."""
+    if member is None or member.status not in ("interrupted", "time limit"):
+        return
+    from ..errors import Interrupted, TimeLimitReached
+
+    code = getattr(member, "exit_code", 130)
+    if member.status == "time limit":
+        from .interrupt import time_limit
+
+        raise TimeLimitReached(time_limit() or 0.0)
+    raise Interrupted(code - 128)
 
 
 def _phase(label):

@@ -49,8 +49,13 @@ def run_meniscus(scene, out_dir=None, *, figures=True, progress=None, overwrite=
                 from ..io.plots import meniscus_forces
 
                 t0 = time.perf_counter()
-                meniscus_forces(res, folder.path / "meniscus_force.png")
-                res.timings["figures_s"] = time.perf_counter() - t0
+                try:
+                    with interrupt.interruptible(), interrupt.immediate():
+                        meniscus_forces(res, folder.path / "meniscus_force.png")
+                    res.timings["figures_s"] = time.perf_counter() - t0
+                except Interrupted as exc:
+                    res.status, res.error = exc.status, f"{exc} while drawing the figure"
+                    res.exit_code = exc.exit_code
                 folder.write_summary(summary(res))
             return res
 
@@ -92,9 +97,14 @@ def _run(scene, folder, progress):
                 res.timings[f"{lq.name}/{R:g}/{meth}_s"] = time.perf_counter() - t1
                 if folder is not None and scene.vtk and meth == "fe":
                     _write_vtk(folder.path, lq.name, R, scene.p_ratios, points)
+            res.status = "converged"
         except Interrupted as exc:
-            res.status, res.error = "interrupted", str(exc)
+            res.status, res.error = exc.status, str(exc)
             res.exit_code = exc.exit_code
+        except BaseException as exc:
+            res.status = "failed"
+            res.error = f"{type(exc).__name__}: {exc}"
+            raise
         finally:
             if bar is not None:
                 bar.close()

@@ -4,7 +4,8 @@
   force column, the jumps, the headline numbers with their error estimates, timings.
 - :class:`MeniscusRunResult` - a meniscus scene: one force curve per liquid, radius, method.
 
-Both have ``to_csv`` and ``status`` ("converged", "failed", "interrupted") and ``error``.
+Both have ``to_csv`` and ``status`` ("running" until the run decides, then "converged",
+"failed", "interrupted" or "time limit") and ``error``.
 """
 import csv
 from dataclasses import dataclass, field
@@ -27,7 +28,8 @@ class ContactResult:
     name : str
     scene : Scene
     status : str
-        "converged", "failed" (``error`` says where) or "interrupted".
+        "running" until the run decides; then "converged", "failed" (``error`` says where),
+        "interrupted" or "time limit".
     error : str or None
     branches : dict
         "approach" / "retract" -> dict of arrays keyed by the curve.csv columns (d_m, h0_m,
@@ -65,7 +67,7 @@ class ContactResult:
 
     name: str
     scene: object
-    status: str = "converged"
+    status: str = "running"
     error: str | None = None
     branches: dict = field(default_factory=dict)
     jumps: list = field(default_factory=list)
@@ -125,7 +127,7 @@ class MeniscusRunResult:
 
     name: str
     scene: object
-    status: str = "converged"
+    status: str = "running"
     error: str | None = None
     curves: dict = field(default_factory=dict)
     errors: list = field(default_factory=list)
@@ -167,8 +169,13 @@ def contact_summary(res, status=None):
                        "d_at_max_F_ex_m": float(cols["d_m"][k]),
                        "all_converged": bool(np.all(cols["converged"])),
                        "all_stable": bool(np.all(cols["stable"]))}
+    from ..scene import scene_id
+
     return {"femadh_version": __version__, "scene_file": scene.path,
             "status": status or res.status, "error": res.error,
+            # the scene actually run (an adaptive trial's; its rows' checksums are seeded
+            # with it)
+            "run_id": scene_id(scene),
             "sign_convention": SIGN_NOTE, "scene": scene.resolved, "branches": branches,
             "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
             "instrument": instrument_summary(res),

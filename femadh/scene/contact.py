@@ -129,6 +129,10 @@ SOLVER = Table("solver", "Discretisation and solver.", (
         "1e-3 for the adaptive grid; with explicit [solver] nodes and no accuracy, the "
         "nodes are used as given and the estimate is reported.", default=None, lo=0.0,
         hi=0.1, hi_closed=True),
+    Key("time_limit", "time", "Wall time after which the run stops cleanly (every completed "
+        "state kept, status 'time limit', exit code 6; --resume continues it), e.g. "
+        "\"10 min\". Also `femadh run --time-limit`. Not part of the scene's identity.",
+        default=None, lo=0.0),
     Key("grid", "custom", "An explicit banded grid, see [solver.grid].", default=None,
         parse=lambda r, raw, path: None if raw is None else r.read(GRID, raw, path),
         expect="a table (see [solver.grid])"),
@@ -261,6 +265,7 @@ class Scene:
     nodes_explicit: bool = True
     topography: dict | None = None
     instrument: object = None        # femadh.instrument.Spring, or None (a rigid drive)
+    time_limit: float | None = None  # s; how long a run may take (not in ``resolved``)
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "contact"
@@ -406,6 +411,7 @@ def parse_contact(reader, data, file):
                  accuracy=so["accuracy"], grid=so["grid"],
                  nodes_explicit="nodes" in (data.get("solver") or {}),
                  instrument=instrument, topography=topography or None,
+                 time_limit=so["time_limit"],
                  raw=copy.deepcopy(data))
 
 

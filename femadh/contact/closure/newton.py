@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
+from ...runner.interrupt import check as safe_point
 from .system import _finite_or_raise
 
 #: backtracking halvings of one Newton step before the iteration gives up
@@ -59,6 +60,7 @@ def _newton_contact(cs, d, w, r_c, *, border, tol, max_iter):
     ev = cs.evaluate(d, w, r_c, it=1)
     last = None
     for it in range(1, max_iter + 1):
+        safe_point()            # a signal stops the run between Newton iterations
         if ev.residual <= tol:
             return _Result(True, d, w, r_c, ev, it, last=last)
         # Newton (fresh factorisation) until the residual is within CHORD_FINISH of the
@@ -129,6 +131,7 @@ def _newton_free(cs, d, w, *, tol, max_iter):
     h, P, F = cs.evaluate_free(d, w, it=1)
     last = None
     for it in range(1, max_iter + 1):
+        safe_point()            # a signal stops the run between Newton iterations
         if float(np.max(np.abs(F))) <= tol:
             return _Result(True, d, w, 0.0, (h, P, F), it, last=last)
         dP = cs.dlaw(h)
