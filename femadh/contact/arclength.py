@@ -34,7 +34,7 @@ from scipy import linalg
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
-from ..runner.interrupt import check as safe_point
+from ..interrupt import check as safe_point
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
 from .stability import is_positive_definite
 

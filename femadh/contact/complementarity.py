@@ -18,7 +18,7 @@ import math
 import numpy as np
 from scipy import linalg
 
-from ..runner.interrupt import check as safe_point
+from ..interrupt import check as safe_point
 from .linalg import TrailingLU, disk_size
 from .stability import is_stable
 from .state import State
@@ -94,7 +94,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     res, res_prev, it = math.inf, math.inf, 0
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
-        # this state is on disk yet (femadh.runner.interrupt)
+        # this state is on disk yet (femadh.interrupt)
         safe_point()
         if sigma is not None:
             w[A] = b[A] - sigma

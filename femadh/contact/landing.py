@@ -3,7 +3,7 @@ slides downhill into the basin it rolls into), polished by Newton."""
 import numpy as np
 from scipy import linalg as sla
 
-from ..runner.interrupt import check as safe_point
+from ..interrupt import check as safe_point
 from .complementarity import solve_complementarity
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
-from ..runner.interrupt import check as safe_point
+from ..interrupt import check as safe_point
 from .curve import CurvePoint, EquilibriumCurve, Fold, bracketed_root
 from .linalg import disk_size
 from .stability import is_stable

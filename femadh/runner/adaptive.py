@@ -203,7 +203,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
             if figures and res.status in ("converged", "failed") and res.branches and any(
                     len(next(iter(b.values()))) for b in res.branches.values()):
-                from .contact import draw_figures
+                from .figures import draw_figures
 
                 # a signal stops the figures at once: the run ends "interrupted"
                 with phase("figures"):

@@ -20,8 +20,9 @@ from ..contact import Jump, State, trace
 from ..contact.forces import state_forces
 from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning, OutputError
 from ..scene import build_problem, load_scene, scene_id  # noqa: F401 (scene_id: the API)
-from . import interrupt
+from .. import interrupt
 from .estimates import GuardError
+from .figures import draw_figures
 from .result import ContactResult
 from .result import contact_summary as summary
 from ..io.progress import advance, begin, display, phase
@@ -142,20 +143,6 @@ def _time_limit(scene, given):
         raise SceneError("time_limit", "time_limit", given, "a positive duration such as "
                          "'10 min' or a number of seconds")
     return float(given)
-
-
-def draw_figures(res, folder):
-    """The run's figures into its folder; a signal stops them at once (each file is written
-    whole or not at all) and the run ends "interrupted" (--resume draws them)."""
-    from ..errors import Interrupted
-    from ..io.plots import contact_figures
-
-    try:
-        with interrupt.immediate():
-            res.timings["figures_s"] = _timed(lambda: contact_figures(res, folder.path))
-    except Interrupted as exc:
-        res.status, res.error = exc.status, f"{exc} while drawing the figures"
-        res.exit_code = exc.exit_code
 
 
 def solve_sweeps(scene, problem=None):

@@ -339,7 +339,7 @@ def _stop_if_stopped(member):
 
     code = getattr(member, "exit_code", 130)
     if member.status == "time limit":
-        from .interrupt import time_limit
+        from ..interrupt import time_limit
 
         raise TimeLimitReached(time_limit() or 0.0)
     raise Interrupted(code - 128)

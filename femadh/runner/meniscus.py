@@ -13,7 +13,7 @@ from .._threads import blas_threads
 from .._version import __version__
 from ..errors import Interrupted
 from ..meniscus.solve import sweep_points
-from . import interrupt
+from .. import interrupt
 from .result import MeniscusRunResult
 
 HEADER = ["method", "p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
-from ...runner.interrupt import check as safe_point
+from ...interrupt import check as safe_point
 from .system import _finite_or_raise
 
 #: backtracking halvings of one Newton step before the iteration gives up

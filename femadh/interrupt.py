@@ -25,7 +25,7 @@ import signal
 import threading
 import time
 
-from ..errors import Interrupted, TimeLimitReached
+from .errors import Interrupted, TimeLimitReached
 
 _pending = []
 #: nesting depth of interruptible() blocks (only the outermost installs and restores)
