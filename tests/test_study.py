@@ -23,6 +23,19 @@ FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 
 
+def _running(out):
+    """The ids of the points whose record exists but says they have not finished."""
+    ids = set()
+    for f in Path(out).glob("points/*/record.json"):
+        try:
+            rec = json.loads(f.read_text())
+        except ValueError:
+            continue
+        if not rec.get("finished"):
+            ids.add(f.parent.name)
+    return ids
+
+
 def _finished(out):
     """The ids of the points whose record says they finished."""
     ids = set()
@@ -98,8 +111,10 @@ def test_killed_study_loses_no_completed_point(tmp_path):
     p = subprocess.Popen(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE)
     t0 = time.time()
-    while not _finished(out) and time.time() - t0 < 60:
-        time.sleep(0.05)
+    # kill while a point is under way (its record says "running") after one has finished:
+    # a kill between two points would leave nothing to redo
+    while not (_finished(out) and _running(out)) and time.time() - t0 < 60:
+        time.sleep(0.01)
     p.send_signal(signal.SIGKILL)
     p.communicate()
     done = {f.parent.name for f in out.glob("points/*/record.json")
