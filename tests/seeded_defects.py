@@ -584,6 +584,15 @@ DEFECTS = [
     D("reference_gw_density", "GW judge: summit height density exp(-(z - z_m)^2 / sigma^2)",
       "femadh/reference/gw.py", (("/ (2 * sigma_a**2)) / (math.sqrt(2 * math.pi)",
                                   "/ (sigma_a**2)) / (math.sqrt(2 * math.pi)"),)),
+    D("reference_hertz_outside", "Hertz judge: displacement outside the contact with "
+      "- a sqrt(r^2 - a^2)", "femadh/reference/hertz.py",
+      (("+ a * np.sqrt(ro**2 - a * a))", "- a * np.sqrt(ro**2 - a * a))"),)),
+    D("reference_jkr_pull_off", "JKR pull-off 2 pi R dg (the DMT value) for 3/2 pi R dg",
+      "femadh/reference/adhesion.py", (("return 1.5 * math.pi * radius * work_of_adhesion",
+                                        "return 2.0 * math.pi * radius * work_of_adhesion"),)),
+    D("reference_rigid_lj_peak", "eq 14's peak A R / (6 z0^2) for A R / (8 z0^2)",
+      "femadh/reference/rigid_lj.py", (("return hamaker * radius / (8.0 * z0**2)",
+                                        "return hamaker * radius / (6.0 * z0**2)"),)),
 ]
 
 
