@@ -24,7 +24,7 @@ FIG3 = ROOT / "validation" / "scenes" / "paper1_fig3.toml"
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 
 
-def long_scene(tmp_path, step="0.02 nm", nodes=200, extra=""):
+def long_scene(tmp_path, step="0.02 nm", nodes=100, extra=""):
     """The Fig 3 scene with many small steps (350 per branch): long enough to interrupt."""
     text = fig3_uniform_text().replace('step = "0.2 nm"', f'step = "{step}"').replace(
         "nodes = 200", f"nodes = {nodes}") + extra
@@ -107,7 +107,7 @@ def test_fe_run_interrupted_keeps_its_vtk_consistent_and_resumes(tmp_path):
 
     text = (ROOT / "validation" / "scenes" / "paper1_fig3_fe.toml").read_text()
     text = text.replace("nodes = 200", "nodes = 60").replace('step = "0.2 nm"',
-                                                              'step = "0.05 nm"')
+                                                              'step = "0.1 nm"')
     text += "vtk = true\n"                 # [output]: every state's VTK as it converges
     scene = tmp_path / "fe.toml"
     scene.write_text(text)
