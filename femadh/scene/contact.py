@@ -15,6 +15,7 @@ from ..materials import IsotropicMaterial, composite_modulus
 from ..schema import Key, Table
 from .instrument import BEAM, INSTRUMENT, read_instrument
 from .reader import BAD, any_bad
+from .replacing import Replaceable
 from .topography import resolve as resolve_topography
 
 METHODS = ("green", "fe")
@@ -229,7 +230,7 @@ def _material(reader, raw, path):
 
 
 @dataclass
-class Scene:
+class Scene(Replaceable):
     """A validated contact scene, all quantities in SI units.
 
     Build one from a file (:func:`femadh.load_scene`), from a dict (:meth:`from_dict`), or
@@ -294,19 +295,6 @@ class Scene:
         if not isinstance(sc, cls):
             raise TypeError("the dict describes a meniscus scene, not a contact scene")
         return sc
-
-    def replace(self, changes=None, /, *, si=False, **kw):
-        """A new scene with keys changed, validated like a file: ``changes`` maps dotted keys
-        to values (``{"sphere.radius": "1 um", "effects.asperity_gap.sigma": "0.5 nm"}``);
-        keywords use ``__`` for the dots (``sphere__radius="1 um"``).
-
-        A dimensional value needs its unit, as in a file (``0.6`` for a length is refused
-        with the file's one-line error); ``si=True`` takes bare numbers as SI (code that
-        holds SI floats, e.g. a fit's parameter vector). Raises SceneError for any bad key
-        or value (a key that is not a dotted string included)."""
-        from . import replace_scene
-
-        return replace_scene(self, changes, kw, si)
 
     @property
     def resolved(self):

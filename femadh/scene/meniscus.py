@@ -21,6 +21,7 @@ from ..meniscus.methods import METHODS
 from ..schema import Key, Table
 from .liquids import read_liquid
 from .reader import BAD, any_bad, quantity
+from .replacing import Replaceable
 
 #: the most p/psat points a scene may ask for (each is a meniscus solve per liquid, radius and
 #: method; 1e5 already takes minutes)
@@ -118,7 +119,7 @@ TABLES = (MENISCUS, RANGE, OUTPUT)
 
 
 @dataclass
-class MeniscusScene:
+class MeniscusScene(Replaceable):
     name: str
     path: str | None
     radii: list
@@ -135,19 +136,6 @@ class MeniscusScene:
     raw: dict = field(repr=False, default_factory=dict)
 
     kind = "meniscus"
-
-    def replace(self, changes=None, /, *, si=False, **kw):
-        """A new scene with keys changed, validated like a file: ``changes`` maps dotted keys
-        to values (``{"sphere.radius": "1 um", "effects.asperity_gap.sigma": "0.5 nm"}``);
-        keywords use ``__`` for the dots (``sphere__radius="1 um"``).
-
-        A dimensional value needs its unit, as in a file (``0.6`` for a length is refused
-        with the file's one-line error); ``si=True`` takes bare numbers as SI (code that
-        holds SI floats, e.g. a fit's parameter vector). Raises SceneError for any bad key
-        or value (a key that is not a dotted string included)."""
-        from . import replace_scene
-
-        return replace_scene(self, changes, kw, si)
 
     @property
     def resolved(self):
