@@ -54,7 +54,13 @@ class State:
     @property
     def p_total(self):
         """Net attractive surface pressure (Pa): sum of effects minus contact pressure."""
-        p = -self.p_contact.copy()
-        for v in self.p_effects.values():
-            p += v
-        return p
+        return net_pressure(self.p_effects, self.p_contact)
+
+
+def net_pressure(p_effects, p_contact):
+    """Net attractive surface pressure (Pa) at the nodes: the sum of the laws' pressures
+    ``p_effects`` (name -> array) minus the contact pressure ``p_contact``."""
+    p = -np.array(p_contact, dtype=float)
+    for v in p_effects.values():
+        p += v
+    return p

@@ -21,6 +21,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..contact.state import net_pressure
 from ..elastic.fe.fields import fe_point_fields
 from .atomic import save_atomic, write_atomic
 
@@ -72,10 +73,7 @@ class _SavedState:
 
     @property
     def p_total(self):
-        p = -self.p_contact.copy()
-        for v in self.p_effects.values():
-            p += v
-        return p
+        return net_pressure(self.p_effects, self.p_contact)
 
 
 def saved_states(run_dir, problem, states):
