@@ -25,7 +25,12 @@ def small_text(nodes=120, stop="-1 nm"):
 @pytest.fixture(scope="module")
 def traced():
     """(problem, curve, approach sweep, retract sweep) of the small sigma = 0.5 nm scene."""
-    sc = scene_from_dict(tomllib.loads(small_text()))
+    return stepped_and_traced(scene_from_dict(tomllib.loads(small_text())))
+
+
+def stepped_and_traced(sc):
+    """(problem, curve, approach sweep, retract sweep) of a scene: its stepped branches and
+    its sigma-gap curve traced by arclength over the same separations."""
     problem = build_problem(sc)
     d, tol = sc.d_values, sc.tolerance
     ap = trace(problem, d, branch="approach", tol=tol)
@@ -218,13 +223,7 @@ def test_a_small_jump_in_inside_one_grid_step_is_found():
     path = Path(__file__).resolve().parents[1] / "validation/scenes/paper1_fig8_rho179.toml"
     raw = copy.deepcopy(load_scene(path).raw)
     raw["effects"]["asperity_adhesion"]["model"] = "smoothed"
-    sc = scene_from_dict(raw, str(path))
-    problem = build_problem(sc)
-    d, tol = sc.d_values, sc.tolerance
-    ap = trace(problem, d, branch="approach", tol=tol)
-    rt = trace(problem, d[::-1], branch="retract", tol=tol, start=ap.states[-1])
-    curve = trace_sigma_curve(problem, d[0], d[-1], tol=tol, scale=abs(d[1] - d[0]), ds=1.0,
-                              ds_max=1.0)
+    problem, curve, ap, rt = stepped_and_traced(scene_from_dict(raw, str(path)))
     assert len(ap.jumps) == 1
     j = ap.jumps[0]
     assert j.d_fold - j.resolution <= curve.folds[0].d <= j.d_fold
