@@ -96,3 +96,12 @@ def fig3_uniform_text():
     text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"
             / "paper1_fig3.toml").read_text()
     return text.replace("[solver]\n", "[solver]\nnodes = 200\n", 1)
+
+
+def tiny_fe_text():
+    """The Fig 3 FE scene on 40 nodes, swept from 2 to -1 nm in 1-nm steps: an FE run of a
+    few states for the render and VTK tests (fields, not accuracy)."""
+    text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"
+            / "paper1_fig3_fe.toml").read_text()
+    text = text.replace("nodes = 200", "nodes = 40").replace('stop = "-5 nm"', 'stop = "-1 nm"')
+    return text.replace('step = "0.2 nm"', 'step = "1 nm"')

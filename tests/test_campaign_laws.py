@@ -20,11 +20,11 @@ def test_lj_work_of_adhesion_is_minus_the_energy_at_z0():
         lj = LennardJones(A, z0)
         # identity (eq 19): measured relative difference <= 2e-16; tolerance 1e-13
         assert lj.work_of_adhesion == pytest.approx(-float(lj.energy(np.array([z0]))[0]),
-                                                    rel=1e-13)
+                                                    rel=1e-13, abs=0)
         R = 2e-3
         # Derjaguin: 2 pi R dg = the rigid sphere's largest force A R / (8 z0^2) (eq 14)
         assert 2 * math.pi * R * lj.work_of_adhesion == pytest.approx(
-            max_rigid_lj_force(A, z0, R), rel=1e-13)
+            max_rigid_lj_force(A, z0, R), rel=1e-13, abs=0)
 
 
 @pytest.mark.parametrize("x", [0.3, 0.6, 0.85])
@@ -47,4 +47,4 @@ def test_capillary_scene_law_carries_the_isotherm_film(x):
     F = -2 * math.pi * R * float(law.energy(np.array([0.0]))[0])
     expected = 4 * math.pi * R * water.surface_tension * (1 + t / abs(r_k))
     # the smoothed edge is exact up to softplus(50) - 50 ~ 2e-22: measured 1e-16; tol 1e-12
-    assert F == pytest.approx(expected, rel=1e-12)
+    assert F == pytest.approx(expected, rel=1e-12, abs=0)

@@ -10,6 +10,8 @@ import pytest
 import femadh
 from femadh.cli import main
 
+from conftest import tiny_fe_text
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -36,10 +38,7 @@ def test_render_an_fe_run_to_png(tmp_path):
     and a picture (many distinct colours), not an empty canvas."""
     import matplotlib.image as mpimg
 
-    text = (ROOT / "validation" / "scenes" / "paper1_fig3_fe.toml").read_text()
-    text = text.replace("nodes = 200", "nodes = 40").replace('stop = "-5 nm"', 'stop = "-1 nm"')
-    text = text.replace('step = "0.2 nm"', 'step = "1 nm"')
-    (tmp_path / "fe.toml").write_text(text)
+    (tmp_path / "fe.toml").write_text(tiny_fe_text())
     out = tmp_path / "run"
     assert main(["run", str(tmp_path / "fe.toml"), "--out", str(out), "--quiet",
                  "--no-figures"]) == 0
