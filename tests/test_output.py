@@ -72,6 +72,33 @@ def test_width_falls_back_when_the_terminal_reports_zero(monkeypatch):
     assert progress.width(_Tty()) == 80
 
 
+def test_a_terminal_of_zero_size_still_shows_the_display(monkeypatch):
+    """A pseudo-terminal nobody sized reports 0 columns and 0 rows; the display must still
+    show the run's phases there (tqdm hides a bar below a screen's last row: with 0 rows it
+    printed nothing at all before the rows fell back to 24)."""
+    import os
+
+    master, slave = os.openpty()
+    assert os.get_terminal_size(slave) == (0, 0)
+    monkeypatch.delenv("COLUMNS", raising=False)
+    monkeypatch.delenv("LINES", raising=False)
+    with open(slave, "w", closefd=True) as tty:
+        monkeypatch.setattr("sys.stderr", tty)
+        with progress.display("demo", True):
+            with progress.phase("approach"):
+                progress.begin("approach", 3)
+                progress.advance()
+    out = b""
+    os.set_blocking(master, False)
+    try:
+        while chunk := os.read(master, 65536):
+            out += chunk
+    except (BlockingIOError, OSError):
+        pass
+    os.close(master)
+    assert "demo › approach" in out.decode(errors="replace")
+
+
 def test_phase_and_advance_are_no_ops_without_a_display():
     with progress.phase("anything"):
         progress.begin("approach", 3)

@@ -23,6 +23,9 @@ _active = None
 
 #: width used when the terminal reports none
 FALLBACK_COLUMNS = 80
+#: height used when the terminal reports none (tqdm hides a bar below the screen's last row,
+#: so a terminal of 0 rows - a pty nobody sized - would show nothing)
+FALLBACK_ROWS = 24
 
 
 def terminal():
@@ -46,6 +49,22 @@ def width(stream=None):
     return cols if cols > 0 else FALLBACK_COLUMNS
 
 
+def height(stream=None):
+    """Rows of the terminal behind ``stream`` (default stderr); LINES or 24 when it reports 0
+    or none."""
+    stream = stream or sys.stderr
+    try:
+        rows = os.get_terminal_size(stream.fileno()).lines
+    except (AttributeError, OSError, ValueError):
+        rows = 0
+    if rows <= 0:
+        try:
+            rows = int(os.environ.get("LINES", "0"))
+        except ValueError:
+            rows = 0
+    return rows if rows > 0 else FALLBACK_ROWS
+
+
 class Display:
     """One tqdm line for a whole run; see the module docstring."""
 
@@ -58,7 +77,8 @@ class Display:
         self.leaf = None          # the current step's label inside the innermost phase
         self.t0 = time.perf_counter()
         self.bar = tqdm(total=None, desc=name, file=self.stream, leave=False,
-                        ncols=width(self.stream), dynamic_ncols=False, unit="state",
+                        ncols=width(self.stream), nrows=height(self.stream),
+                        dynamic_ncols=False, unit="state",
                         bar_format="{desc}")
 
     def label(self, room=None):
