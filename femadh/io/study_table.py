@@ -117,7 +117,11 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
         xmap, xl = axis(keys[0])
         x = np.array([xmap[repr(p.changes[keys[0]])] for p, _ in vals])
         order = np.argsort(x)
-        ax.plot(x[order], y[order] * fs, "o-")
+        # each value with its estimated error (nan where a run had no estimate)
+        err = np.array([records[p.id].get(quantity + "_error", math.nan) for p, _ in vals],
+                       float)
+        ax.errorbar(x[order], y[order] * fs, yerr=np.abs(err[order]) * fs, fmt="o-",
+                    capsize=3)
         ax.set(xlabel=xl, ylabel=qlabel)
         _verdicts(ax, [(xv, yv * fs, records[p.id].get("instrument_stuck"))
                        for (p, _), xv, yv in zip(vals, x, y)])
@@ -134,7 +138,9 @@ def study_figure(points, records, out, quantity="max_adhesion_N"):
         ax.set(xlabel=xl, ylabel=yl)
         _verdicts(ax, [(xmap[repr(p.changes[keys[0]])], ymap[repr(p.changes[keys[1]])],
                         records[p.id].get("instrument_stuck")) for p, _ in vals])
-    ax.set_title("study: " + quantity.removesuffix("_N").replace("_", " "))
+    name = getattr(getattr(points[0], "scene", None), "name", "study")
+    ax.set_title(f"{name}: " + quantity.removesuffix("_N").replace("_", " ")
+                 + (" ± estimated error" if len(keys) == 1 else ""))
     fig.tight_layout()
     save_atomic(path, lambda p: fig.savefig(p, dpi=110))
     plt.close(fig)
