@@ -242,6 +242,10 @@ def test_parts_are_frozen():
 
 def test_flat_attributes_read_the_parts_and_old_writes_replace_a_part():
     sc = coated()
+    assert [type(getattr(sc, p)) for p in ("body", "laws", "discretisation", "sweep",
+                                           "output")] == [Body, Laws, Discretisation, Sweep,
+                                                          Output]
+    assert sc.operator_inputs == (sc.body, sc.discretisation)
     assert (sc.nodes, sc.method, sc.analysis_radius) == (
         sc.discretisation.nodes, sc.discretisation.method, sc.discretisation.analysis_radius)
     assert sc.sphere is sc.body.sphere and sc.e_star == sc.body.e_star
