@@ -252,6 +252,13 @@ DEFECTS = [
     D("study_key_discretisation_only", "the operator key of the discretisation alone",
       "femadh/scene/build.py",
       (("return content_hash(body, discretisation)", "return content_hash(discretisation)"),)),
+    D("operator_reads_the_laws", "the operator's build reads the sigma-gap's contact model "
+      "(one more node for the closure), outside its key", "femadh/scene/build.py",
+      (("    return operator_from_parts(scene.body, scene.discretisation, progress, grid=grid,",
+        "    d = scene.discretisation\n"
+        "    if scene.gap is not None and scene.gap.contact_model != 'complementarity':\n"
+        "        d = __import__('dataclasses').replace(d, nodes=d.nodes + 1)\n"
+        "    return operator_from_parts(scene.body, d, progress, grid=grid,"),)),
     D("study_key_drops_a_field", "the content hash leaves out each part's last field",
       "femadh/scene/parts/frozen.py",
       (("for f in dataclasses.fields(obj)}}", "for f in dataclasses.fields(obj)[:-1]}}"),)),

@@ -207,6 +207,20 @@ def test_the_operator_is_a_function_of_its_key():
     assert stiff.e_star / sc.e_star > 1.2        # a stiffer disk: E* 24 % up (the slider)
 
 
+def test_no_field_of_the_laws_sweep_or_output_reaches_the_operator():
+    """What the key leaves out, the operator must not read: with any one field of the laws,
+    the sweep or the output changed (unvalidated, so a read of it shows), the built operator
+    is bit for bit the scene's."""
+    sc = green().replace({"solver.nodes": 24})
+    c0 = build_operator(sc).compliance
+    n = 0
+    for part in ("laws", "sweep", "output"):
+        for name, other in part_variants(sc, part):
+            assert np.array_equal(build_operator(other).compliance, c0), f"{part}.{name}"
+            n += 1
+    assert n >= 8
+
+
 def test_study_points_share_an_operator_exactly_when_their_pairs_agree():
     """A sweep of a law's value keeps one operator; a sweep of the nodes does not."""
     OPERATOR_CACHE.clear()

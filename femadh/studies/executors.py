@@ -108,11 +108,11 @@ def write_record(folder, rec):
 def run_point(point, root, estimate=True):
     """Run one point into ``root/points/<id>/`` and return its record (a small dict).
 
-    Runs in a worker: the surface operator of each distinct grid/mesh is built once per
-    process and reused. Never raises for a failed solve or a fault of the point: the record
-    says what happened and whether it is final (``finished``). A signal that stops the
-    point's run is recorded ("interrupted") and then ends a pool worker with that signal,
-    so that the driver's shutdown does not wait for it."""
+    Runs in a worker: the surface operator of each distinct body and discretisation is built
+    once per process and reused (:func:`worker_operator`). Never raises for a failed solve or
+    a fault of the point: the record says what happened and whether it is final
+    (``finished``). A signal that stops the point's run is recorded ("interrupted") and then
+    ends a pool worker with that signal, so that the driver's shutdown does not wait for it."""
     from .._threads import blas_threads
     from ..runner.contact import run
     import warnings
