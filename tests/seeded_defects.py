@@ -200,8 +200,8 @@ DEFECTS = [
     # -- layered substrates
     D("layered_sphere_compliance", "layered scene: the slider's own compliance dropped",
       "femadh/scene/build.py",
-      (("layers=scene.layers,\n                                   sphere=scene.slider)",
-        "layers=scene.layers,\n                                   sphere=None)"),)),
+      (("layers=body.layers,\n                                   sphere=body.slider)",
+        "layers=body.layers,\n                                   sphere=None)"),)),
     D("hankel_sphere_twice", "Hankel layered operator: the sphere's compliance counted twice",
       "femadh/judges.py",
       (("+ GreenOperator(grid, sphere.plane_strain_modulus).compliance)",
@@ -229,9 +229,6 @@ DEFECTS = [
       "femadh/runner/accuracy.py",
       (('RunFolder(out_dir, scene_id(scene), scene.name, "amend")',
         'RunFolder(out_dir, scene_id(scene), scene.name, "overwrite")'),)),
-    D("study_key_ignores_layers", "a study worker reuses one FE body across layer values",
-      "femadh/studies/executors.py",
-      (("fe += (tuple(sc.layers), sc.disk, sc.slider)", "pass"),)),
     # -- stepping: a fold inside one step told by the step's energy
     D("fold_energy_sign", "stepping: the step's energy change counted with the wrong sign",
       "femadh/contact/stepping.py",
@@ -247,10 +244,40 @@ DEFECTS = [
       "the corrector found", "femadh/contact/stepping.py",
       (("                    beyond = new\n", "                    pass\n"),)),
     # -- studies: the operator cache, the done/redo bookkeeping, exit codes, units, workers
-    D("study_key_ignores_modulus", "a study's operator key forgets the composite modulus",
-      "femadh/studies/executors.py",
-      (("return repr((sc.method, sc.nodes, grid, sc.analysis_radius, sc.e_star, fe))",
-        "return repr((sc.method, sc.nodes, grid, sc.analysis_radius, fe))"),)),
+    # the operator's key is the content hash of (body, discretisation): femadh/scene/parts
+    D("study_key_wrong_part", "a study's operator key of the laws instead of the body (the "
+      "modulus, the layers forgotten)", "femadh/studies/executors.py",
+      (("return operator_key(*sc.operator_inputs)",
+        "return operator_key(sc.laws, sc.discretisation)"),)),
+    D("study_key_discretisation_only", "the operator key of the discretisation alone",
+      "femadh/scene/build.py",
+      (("return content_hash(body, discretisation)", "return content_hash(discretisation)"),)),
+    D("operator_reads_the_laws", "the operator's build reads the sigma-gap's contact model "
+      "(one more node for the closure), outside its key", "femadh/scene/build.py",
+      (("    return operator_from_parts(scene.body, scene.discretisation, progress, grid=grid,",
+        "    d = scene.discretisation\n"
+        "    if scene.gap is not None and scene.gap.contact_model != 'complementarity':\n"
+        "        d = __import__('dataclasses').replace(d, nodes=d.nodes + 1)\n"
+        "    return operator_from_parts(scene.body, d, progress, grid=grid,"),)),
+    D("study_key_drops_a_field", "the content hash leaves out each part's last field",
+      "femadh/scene/parts/frozen.py",
+      (("for f in dataclasses.fields(obj)}}", "for f in dataclasses.fields(obj)[:-1]}}"),)),
+    D("study_key_float_rounded", "the content hash writes floats to 6 digits",
+      "femadh/scene/parts/frozen.py",
+      (("            return repr(x)          # JSON has no NaN/inf; as a string they stay "
+        "distinct\n        return x\n",
+        "            return repr(x)          # JSON has no NaN/inf; as a string they stay "
+        "distinct\n        return float(f'{x:.6g}')\n"),)),
+    D("scene_tables_writable", "a part's tables (effects, mesh, grid) take new entries",
+      "femadh/scene/parts/frozen.py",
+      (("    __setitem__ = __delitem__ = _refuse", "    __delitem__ = _refuse"),)),
+    D("scene_flat_write_mutates_part", "assigning a flat attribute changes the shared part",
+      "femadh/scene/contact.py",
+      (("setattr(obj, self.part, dataclasses.replace(part, **{self.name: value}))",
+        "object.__setattr__(part, self.name, value)"),)),
+    D("scene_id_layout", "the scene's resolved view renames a key (every scene id moves)",
+      "femadh/scene/contact.py",
+      (('"tolerance_m": self.tolerance', '"tolerance": self.tolerance'),)),
     D("study_point_id_of_base", "a study's points carry the base scene's id",
       "femadh/studies/sweep.py",
       (("points.append(Point(i, changes, sc, scene_id(sc)))",

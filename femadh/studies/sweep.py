@@ -21,7 +21,8 @@ point's result is ``points/<id>/`` (its curve and summary, as a single run write
 a physical reason; see :mod:`femadh.studies.executors`). Running the same study again reuses
 the finished points, runs the interrupted or crashed ones again ("redone") and the others
 ("new"). The study's table ``study.csv`` (:mod:`femadh.io.study_table`) is rewritten as points
-finish, its figure at the end. Workers keep the surface operator of each distinct grid/mesh.
+finish, its figure at the end. Workers keep the surface operator of each distinct body and
+discretisation (:func:`femadh.studies.executors.worker_operator`).
 """
 from dataclasses import dataclass, field
 import itertools
