@@ -195,6 +195,30 @@ def test_a_solver_failure_inside_a_contact_run_keeps_every_committed_state(tmp_p
     assert ref.status == "converged"
 
 
+def test_a_fault_in_a_resumed_run_after_its_folder_was_checked_is_failed(tmp_path,
+                                                                         monkeypatch,
+                                                                         summaries):
+    """While a resumed folder is checked an OutputError leaves it as it was; once it is
+    checked (and the run appends to it) the same fault ends the run "failed" on disk."""
+    from femadh.io.writers import ContactWriter
+
+    scene, out = short_scene(tmp_path), tmp_path / "out"
+    assert femadh.run(scene, out, progress=False, time_limit=1e-9).status == "time limit"
+    real = ContactWriter.write_state
+
+    def failing(self, branch, state):
+        if self.count == 3:
+            raise OutputError("cannot write curve.csv: seeded fault")
+        return real(self, branch, state)
+    monkeypatch.setattr(ContactWriter, "write_state", failing)
+    summaries.clear()
+    with pytest.raises(OutputError, match="seeded fault"):
+        femadh.run(scene, out, progress=False, figures=False, estimate=False, resume=True)
+    assert summaries == ["running", "failed"]
+    assert json.loads((out / "summary.json").read_text())["status"] == "failed"
+    assert len(_rows(out / "curve.csv")) == 3
+
+
 def test_a_fault_inside_a_meniscus_run_keeps_every_committed_point(tmp_path, monkeypatch,
                                                                   summaries):
     from femadh.io.atomic import RowLog

@@ -5,7 +5,9 @@ Nothing is lost: the output folder is claimed before anything is computed (one r
 folder, checked writable), ``summary.json`` says ``running`` from the start and is rewritten
 atomically at the end, every committed state is in every csv, SIGINT/SIGTERM stop after the
 current state with status ``interrupted``, and ``resume=True`` continues an interrupted or
-failed sweep from its last committed state.
+failed sweep from its last committed state (the run's status and summary:
+:mod:`.lifecycle`, the same for every scene kind; :func:`femadh.runner.run.run` dispatches
+every kind).
 """
 from dataclasses import dataclass
 import math

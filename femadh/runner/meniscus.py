@@ -1,7 +1,8 @@
 """Run a ``[meniscus]`` scene (paper 2): a p/psat sweep for every liquid, tip radius and method;
 ``meniscus.csv``, ``profiles.csv`` (meridians), ``summary.json``, the force figure and VTK
 surfaces of revolution. Same guarantees as a contact run: the folder is claimed first, rows
-are written in whole chunks, SIGINT/SIGTERM stop after the current point (the run's life: :mod:`.lifecycle`)."""
+are written in whole chunks, SIGINT/SIGTERM stop after the current point (the run's life:
+:mod:`.lifecycle`)."""
 import math
 from pathlib import Path
 import sys
