@@ -411,7 +411,8 @@ def _stiffness_warning(scene, problem):
                             f"Use [solver.grid] spacing <= "
                             f"{float(problem.grid.nodes[1]) * STIFFNESS_WARNING / ratio:.3g} m "
                             "(or leave the grid to femadh)."))
-    warnings.warn(msg, MeshResolutionWarning, stacklevel=4)
+    # (the caller of run(): _run <- run_contact <- runner.run.run <- the caller)
+    warnings.warn(msg, MeshResolutionWarning, stacklevel=5)
     return [msg]
 
 
