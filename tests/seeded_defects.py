@@ -644,6 +644,43 @@ DEFECTS = [
     D("reference_rigid_lj_peak", "eq 14's peak A R / (6 z0^2) for A R / (8 z0^2)",
       "femadh/reference/rigid_lj.py", (("return hamaker * radius / (8.0 * z0**2)",
                                         "return hamaker * radius / (6.0 * z0**2)"),)),
+    # -- the run lifecycle (femadh/runner/lifecycle.py) and the result base
+    D("life_failure_status", "lifecycle: a solver failure ends the run \"converged\"",
+      "femadh/runner/lifecycle.py",
+      (("            result.fail(str(exc))",
+        "            result.status, result.error = \"converged\", str(exc)"),)),
+    D("life_stop_status", "result: every stop is \"interrupted\" (the time limit too)",
+      "femadh/runner/result.py", (("self.status, self.error, self.exit_code = exc.status,",
+                                   "self.status, self.error, self.exit_code = \"interrupted\","),)),
+    D("life_stop_exit_code", "result: a stop's exit code always 130",
+      "femadh/runner/result.py", (("f\"{exc}{where}\", exc.exit_code", "f\"{exc}{where}\", 130"),)),
+    D("life_final_check", "lifecycle: no check after the work (a late signal ends "
+      "\"converged\")", "femadh/runner/lifecycle.py",
+      (("            yield life\n            # a signal that arrived after the last safe point "
+        "is still a stop\n            interrupt.check()\n", "            yield life\n"),)),
+    D("life_no_running", "lifecycle: summary.json never says \"running\"", "femadh/runner/lifecycle.py",
+      (("                life.write_summary(\"running\")", "                pass"),)),
+    D("life_interrupted_summary", "lifecycle: a stopped run's last summary still says "
+      "\"running\"", "femadh/runner/lifecycle.py",
+      (("            life.write_summary()\n",
+        "            life.write_summary(\"running\" if result.exit_code else None)\n"),)),
+    D("life_no_checkpoint", "lifecycle: the stop hook (the sweep's checkpoint) not called",
+      "femadh/runner/lifecycle.py", (("                life.on_stop()", "                pass"),)),
+    D("life_untouched", "lifecycle: a folder refused while checked gets a summary written",
+      "femadh/runner/lifecycle.py", (("                life._write = None", "                pass"),)),
+    D("life_cleanup_on_success_only", "lifecycle: cleanups (writer, logs) only for a "
+      "converged run", "femadh/runner/lifecycle.py", (("                fn()", "                result.status == "
+                                   "\"converged\" and fn()"),)),
+    D("life_sigterm_reraise", "femadh.run: SIGTERM reaches a script as KeyboardInterrupt",
+      "femadh/runner/lifecycle.py", (("if result.exit_code == 128 + signal.SIGTERM:",
+                                   "if result.exit_code == 128 + signal.SIGINT:"),)),
+    D("life_resume_untouched_kept", "contact: a fault after the resumed folder was checked "
+      "leaves its summary \"running\"", "femadh/runner/contact.py",
+      (("            life.untouched_on = ()\n", ""),)),
+    D("meniscus_headline_error", "meniscus headline: the error of the point before the "
+      "largest force", "femadh/runner/result.py",
+      (("float(np.asarray(c[\"force_error_N\"], float)[k])",
+        "float(np.asarray(c[\"force_error_N\"], float)[k - 1])"),)),
 ]
 
 
