@@ -70,7 +70,6 @@ def study_operator_key(sc):
 
 
 #: the name of earlier versions (femadh.fitting reads it)
-_operator_key = study_operator_key
 
 
 def worker_operator(sc):
@@ -117,7 +116,7 @@ def run_point(point, root, estimate=True):
     from ..runner.contact import run
     import warnings
 
-    _tune_malloc()
+    tune_malloc()
     t0 = time.perf_counter()
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
@@ -204,7 +203,7 @@ def _pool_init():
 _MALLOC_TUNED = False
 
 
-def _tune_malloc():
+def tune_malloc():
     """Undo dask's MALLOC_TRIM_THRESHOLD_ for femadh's allocation pattern (once per process).
 
     A dask nanny starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which also switches

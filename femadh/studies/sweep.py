@@ -33,8 +33,8 @@ import time
 from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
 from ..io.study_table import study_figure, write_table
-from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable, _operator_key,  # noqa: F401
-                        _tune_malloc, _worker_init, driver_signals, execute, finished,
+from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable,  # noqa: F401
+                        tune_malloc, _worker_init, driver_signals, execute, finished,
                         run_point, write_record)
 from ..scene.values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
 
