@@ -49,9 +49,12 @@ import numpy as np
 
 from ..contact import ContactProblem
 from ..contact.arclength import trace_curve
+from ..contact.curve import read_curve
 from ..discretisation.moving import MovingBand, contact_edge
 from ..elastic import GreenOperator
 from ..errors import ConvergenceError, MeshResolutionWarning
+from ..estimate import (TRAPPING_LIMIT, Budget, discretisation, outside_bounds,
+                        refine_until_met, trapping_message, worst_relative)
 from ..indenter import Sphere
 from ..laws import LennardJones
 from ..reference.adhesion import jkr_contact_radius
@@ -62,9 +65,6 @@ from .smooth_sphere import (FINE_MARGIN, PRELOAD, STIFFNESS_TARGET, deepest_sepa
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
-#: a posteriori: above this local ratio -P'(h_k)/K_kk (on any traced state) a node can snap on
-#: its own (lattice trapping): the point is not a converged result
-TRAPPING_LIMIT = 1.0
 #: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
 #: it is added to the force exactly); at least sqrt(2 R 20 z0) (the rigid gap there is 20 z0)
 ANALYSIS_RADIUS = 8.0
@@ -97,6 +97,8 @@ MAX_REFINEMENTS = 4
 #: node budget of a refinement (a dense grid of N nodes costs ~N^2 per Krylov iteration at
 #: every continuation step: 1600 nodes ~ 10x the cost of 500)
 MAX_NODES = 1600
+#: the budget of an accuracy request (:func:`femadh.estimate.refine.refine_until_met`)
+BUDGET = Budget(MAX_REFINEMENTS, MAX_NODES)
 #: the headline quantities and the accuracy they are judged by
 QUANTITIES = ("pull_off", "pull_off_displacement", "jump_in", "jump_out", "hysteresis")
 #: proven bounds of the load-controlled pull-off / (pi R dg) for a paraboloid (see
@@ -311,56 +313,34 @@ def trace_point(setup, tol, progress):
 
 
 def _read(setup, curve):
-    """Headline quantities and diagnostics of a traced curve (dict)."""
-    law, z0, radius = setup.law, setup.z0, setup.radius
-    scale = math.pi * radius * setup.dg
+    """Headline quantities (units of the map) and diagnostics of a traced curve (dict): the
+    readout of :func:`femadh.contact.curve.read_curve` with the smooth sphere's force (grid
+    plus exact tail), the grids' resolution diagnostics."""
+    law, z0 = setup.law, setup.z0
+    scale = math.pi * setup.radius * setup.dg
     pb = curve.problem_of
-
-    def force(seg):
-        return lambda d, w: lj_force(pb(seg), law, d, w)
-
-    paths = {k: curve.branch(k, segments=True) for k in ("approach", "retract")}
-    F = {k: np.array([force(g)(d, w) for _, d, w, g in v]) for k, v in paths.items()}
-    D = {k: np.array([d for _, d, _, _ in v]) for k, v in paths.items()}
-    # hysteresis: the work of the closed cycle is the energy released at the jumps (the
-    # interaction beyond a is continuous in d and drops out); the loop integral checks it
-    released = 0.0
-    for v in paths.values():
-        for (k1, d1, w1, g1), (k2, _, w2, g2) in zip(v, v[1:]):
-            if k1 == "fold" and k2 == "land":
-                released += pb(g1).energy(w1, d1) - pb(g2).energy(w2, d1)
-    trap = getattr(np, "trapezoid", None) or np.trapz
-    loop = trap(F["retract"], D["retract"]) + trap(F["approach"], D["approach"])
-    # load control: the largest tension anywhere on the curve, refined between the
-    # neighbours of the best traced point
+    ro = read_curve(curve, lambda problem, d, w: lj_force(problem, law, d, w))
     pts = curve.points
-    cf = np.array([force(p.seg)(p.d, p.w) for p in pts])
-    i = int(np.argmax(cf))
-    pull = cf[i]
-    if 0 < i < len(pts) - 1:
-        pull = max(pull, curve.maximize(i, force(pts[i].seg))[0])
-    # displacement control: the tension at the fold where the retract path leaves contact
-    r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
-    a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
-    pull_disp = force(r_folds[-1][2])(*r_folds[-1][:2]) / scale if r_folds else None
     trapping = max(pb(p.seg).node_softening_ratio(pb(p.seg).contour(p.d) - p.w) for p in pts)
     edges = [contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts]
-    edge = max(edges)
     band_offset = max((setup.band_offset(pb(p.seg), e) for p, e in zip(pts, edges)),
                       default=0.0)
+    (da, fa), (dr, fr) = ro.paths["approach"], ro.paths["retract"]
     return {
-        "pull_off": float(pull / scale), "pull_off_displacement": pull_disp,
-        "jump_in": a_folds[0] / z0 if a_folds else None,
-        "jump_out": r_folds[-1][0] / z0 if r_folds else None,
-        "hysteresis": float(released / (scale * z0)),
-        "hysteresis_trapezoid": float(loop / (scale * z0)),
-        "trapping": float(trapping), "edge_ratio": edge / setup.a,
+        "pull_off": float(ro.pull_off / scale),
+        "pull_off_displacement": (None if ro.pull_off_displacement is None
+                                  else ro.pull_off_displacement / scale),
+        "jump_in": None if ro.jump_in is None else ro.jump_in / z0,
+        "jump_out": None if ro.jump_out is None else ro.jump_out / z0,
+        "hysteresis": float(ro.hysteresis / (scale * z0)),
+        "hysteresis_trapezoid": float(ro.loop_work / (scale * z0)),
+        "trapping": float(trapping), "edge_ratio": max(edges) / setup.a,
         "band_offset": band_offset,
         "nodes": max(t.problem.grid.n for t in curve.tracers),
-        "curves": {"curve_d": curve.d / z0, "curve_F": cf / scale,
+        "curves": {"curve_d": curve.d / z0, "curve_F": ro.force / scale,
                    "curve_stable": np.array([p.stable for p in pts]),
-                   "approach_d": D["approach"] / z0, "approach_F": F["approach"] / scale,
-                   "retract_d": D["retract"] / z0, "retract_F": F["retract"] / scale,
+                   "approach_d": da / z0, "approach_F": fa / scale,
+                   "retract_d": dr / z0, "retract_F": fr / scale,
                    "n_factor": curve.n_factor, "n_krylov": curve.n_krylov},
     }
 
@@ -368,11 +348,11 @@ def _read(setup, curve):
 def _unresolved(setup, q):
     """Why the traced states are not resolved (str naming quantity, value and the setting to
     change), or None."""
-    if q["trapping"] > TRAPPING_LIMIT:
-        return (f"mu = {setup.mu:g}: a traced state reached the node softening ratio "
-                f"-P'(h)/K_kk = {q['trapping']:.2f} > {TRAPPING_LIMIT} (nodes can snap alone: "
-                f"lattice trapping); refine the grid (spacing = {setup.res.spacing:g} ell, "
-                f"stiffness_target = {setup.res.stiffness_target}) or give accuracy=")
+    trapped = trapping_message(q["trapping"], TRAPPING_LIMIT)
+    if trapped:
+        return (f"mu = {setup.mu:g}: on a traced state {trapped}; refine the grid (spacing = "
+                f"{setup.res.spacing:g} ell, stiffness_target = "
+                f"{setup.res.stiffness_target}) or give accuracy=")
     if q["band_offset"] > BAND_LIMIT:
         return (f"mu = {setup.mu:g}: the contact edge left the fine band (|edge - centre| = "
                 f"{q['band_offset']:.2f} half-widths > {BAND_LIMIT}): the grid did not follow "
@@ -384,32 +364,28 @@ def _unresolved(setup, q):
     return None
 
 
-def _estimate(fine, coarse, ratio=2.0):
-    """Richardson estimates of the fine result's absolute errors from a coarser member whose
-    spacing is ``ratio`` times the fine one."""
+def estimate_errors(fine, coarse, ratio=2.0):
+    """Estimates of the fine result's absolute errors from a coarser member whose spacing is
+    ``ratio`` times the fine one: Richardson at the family's measured ORDER
+    (:func:`femadh.estimate.richardson.discretisation` on two members); a quantity the coarse
+    grid missed (no fold there) has its own size as the estimate."""
+    rich = discretisation({k: fine[k] for k in QUANTITIES},
+                          {k: coarse[k] for k in QUANTITIES}, None, ratio, order=ORDER)
     out = {}
     for k in QUANTITIES:
-        a, b = fine[k], coarse[k]
-        if a is None:
+        if fine[k] is None:
             out[k] = None
-        elif b is None:   # the coarse grid missed the feature: its size is the estimate
-            out[k] = abs(a)
+        elif coarse[k] is None:   # the coarse grid missed the feature: its size is the estimate
+            out[k] = abs(fine[k])
         else:
-            out[k] = abs(a - b) / (ratio**ORDER - 1.0)
+            out[k] = abs(rich[k])
     return out
 
 
 def _worst(q, errors):
     """(name, relative error) of the quantity furthest from its accuracy."""
-    worst = (None, 0.0)
-    for k in QUANTITIES:
-        e, v = errors.get(k), q[k]
-        if e is None or v is None:
-            continue
-        rel = e / (max(abs(v), HYSTERESIS_FLOOR) if k == "hysteresis" else abs(v))
-        if rel > worst[1]:
-            worst = (k, rel)
-    return worst
+    return worst_relative({k: q[k] for k in QUANTITIES}, errors,
+                          {"hysteresis": HYSTERESIS_FLOOR})
 
 
 def _check_bounds(mu, q, errors):
@@ -421,11 +397,11 @@ def _check_bounds(mu, q, errors):
     The fixed-grip tension at the jump-out is a point of the curve: it cannot exceed the
     largest tension on it (proven), and lies above the JKR fixed-grip 5/6 (empirical)."""
     p, e = q["pull_off"], errors.get("pull_off") or 0.0
-    if not (JKR - e <= p <= DERJAGUIN + e):
+    if outside_bounds(p, e, JKR, DERJAGUIN, rel=0.0):
         raise ResolutionError(f"mu = {mu:g}: pull-off {p:.6f} pi R dg outside [{JKR}, "
                               f"{DERJAGUIN}] (estimated error {e:.2g}): not a resolved result")
     pd = q["pull_off_displacement"]
-    if pd is not None and pd > p * (1 + 1e-9) + e:
+    if pd is not None and outside_bounds(pd, e, upper=p):
         raise ResolutionError(f"mu = {mu:g}: fixed-grip pull-off {pd:.6f} exceeds the largest "
                               f"tension on the curve {p:.6f}")
 
@@ -519,30 +495,45 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         if "spacing" not in over and not res.legacy:
             res = replace(res, spacing=initial_spacing(accuracy, _lattice_cap(mu, radius,
                                                                                law)))
-    coarse, ratio = _coarse_member(mu, radius, law, res, tol)
-    for attempt in range(MAX_REFINEMENTS + 1):
+    member = {}
+    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
+
+    def attempt(res):
         fine = solve_point(mu, radius, law, res, tol, progress)
-        why = _unresolved(fine["setup"], fine)
-        errors = _estimate(fine, coarse, ratio)
-        name, rel = _worst(fine, errors)
-        if accuracy is None or (why is None and rel <= accuracy):
-            break
-        if attempt == MAX_REFINEMENTS:
-            why = why or (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
-                          f"requested {accuracy:g} after {MAX_REFINEMENTS} refinements "
-                          f"(spacing {res.spacing:g} ell)")
-            raise ResolutionError(why, n_iter=attempt)
-        if why is None and 2 * fine["nodes"] > MAX_NODES:
-            raise ResolutionError(
-                f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > requested "
-                f"{accuracy:g} at spacing {res.spacing:g} ell ({fine['nodes']} nodes); the "
-                f"next refinement would exceed MAX_NODES = {MAX_NODES}", n_iter=attempt)
+        errors = estimate_errors(fine, member["coarse"], member["ratio"])
+        fine["errors"], fine["worst"] = errors, _worst(fine, errors)
+        return fine, fine["worst"][1], _unresolved(fine["setup"], fine)
+
+    def refine(res, fine, rel, why):
         if fine["edge_ratio"] > EDGE_LIMIT:
-            res = replace(res, analysis_radius=1.5 * res.analysis_radius)
-        else:
-            coarse, ratio, res = fine, 2.0, res.finer()
+            return replace(res, analysis_radius=1.5 * res.analysis_radius)
+        # the fine member becomes the coarser member of the next estimate (ratio 2)
+        member["coarse"], member["ratio"] = fine, 2.0
+        return res.finer()
+
+    def nodes(res, fine, nxt):
+        return 2 * fine["nodes"] if nxt.spacing < res.spacing else fine["nodes"]
+
+    if accuracy is None:
+        fine, _, why = attempt(res)
+    else:
+        out = refine_until_met(res, attempt, refine, accuracy, BUDGET, nodes)
+        res, fine, why = out.setting, out.result, out.why
+        name, rel = fine["worst"]
+        if not out.met:
+            if why is None and out.stop == "nodes":
+                why = (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
+                       f"requested {accuracy:g} at spacing {res.spacing:g} ell "
+                       f"({fine['nodes']} nodes); the next refinement would exceed the "
+                       f"budget's max_nodes = {BUDGET.max_nodes}")
+            elif why is None:
+                why = (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
+                       f"requested {accuracy:g} after {len(out.steps) - 1} refinements "
+                       f"(spacing {res.spacing:g} ell)")
+            raise ResolutionError(why, n_iter=len(out.steps) - 1)
     if why is not None:
         raise ResolutionError(why)
+    errors = fine["errors"]
     _check_bounds(mu, fine, errors)
     if fine["trapping"] > 0.5 * TRAPPING_LIMIT:
         warnings.warn(f"mu = {mu:g}: node softening ratio {fine['trapping']:.2f} is within 2x "
