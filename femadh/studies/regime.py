@@ -202,6 +202,7 @@ class RegimePoint:
     accuracy: float | None = None  # the requested relative accuracy (None: explicit settings)
     failed: str | None = None      # why the point is not a converged result (None: it is)
     band_offset: float = math.nan  # largest |contact edge - band centre| / band half-width
+    judged: tuple = QUANTITIES     # the quantities the accuracy was asked of
 
     def error(self, name):
         """Estimated absolute error of quantity ``name`` (None if it does not exist)."""
@@ -390,9 +391,9 @@ def estimate_errors(fine, coarse, ratio=2.0):
     return out
 
 
-def _worst(q, errors):
-    """(name, relative error) of the quantity furthest from its accuracy."""
-    return worst_relative({k: q[k] for k in QUANTITIES}, errors,
+def _worst(q, errors, judged=QUANTITIES):
+    """(name, relative error) of the judged quantity furthest from its accuracy."""
+    return worst_relative({k: q[k] for k in judged}, {k: errors[k] for k in judged},
                           {"hysteresis": HYSTERESIS_FLOOR})
 
 
@@ -455,7 +456,7 @@ def _coarse_member(mu, radius, law, res, tol):
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
               accuracy=None, resolution=None, spacing=None, stiffness_target=None,
-              min_nodes=None, ds_max=None, progress=None):
+              min_nodes=None, ds_max=None, progress=None, judged=QUANTITIES):
     """One regime-map point: trace the curve at Tabor parameter mu and read it.
 
     Parameters
@@ -473,6 +474,12 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         Requested relative accuracy of the headline quantities (pull-offs, jump separations,
         hysteresis relative to max(value, HYSTERESIS_FLOOR)). The spacing starts from the
         measured error model and is halved until the a-posteriori estimate meets it.
+    judged : tuple of str
+        The quantities the accuracy is asked of (default: all of QUANTITIES; every one is
+        reported with its estimate). Without "pull_off_displacement" the lattice cap of the
+        flat jump-out fold (:func:`lattice_cap`) does not bound the spacing: the largest
+        tension is a smooth maximum that coarser grids resolve (peer problem, mu = 3: 1.4e-4
+        at 0.133 ell, where the fold's tension is 1.7e-3 off).
     resolution : Resolution, optional
         Explicit discretisation (default: :class:`Resolution` defaults); ``spacing`` (units of
         ell), ``stiffness_target``/``min_nodes`` (legacy fixed grid) and ``ds_max`` (z0)
@@ -500,16 +507,21 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     if accuracy is not None:
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
+        unknown = set(judged) - set(QUANTITIES)
+        if unknown or not judged:
+            raise ValueError(f"judged must name some of {', '.join(QUANTITIES)}, got "
+                             f"{', '.join(sorted(unknown)) or 'none'}")
         if "spacing" not in over and not res.legacy:
-            res = replace(res, spacing=initial_spacing(accuracy, _lattice_cap(mu, radius,
-                                                                               law)))
+            cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged
+                   else None)
+            res = replace(res, spacing=initial_spacing(accuracy, cap))
     member = {}
     member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
 
     def attempt(res):
         fine = solve_point(mu, radius, law, res, tol, progress)
         errors = estimate_errors(fine, member["coarse"], member["ratio"])
-        fine["errors"], fine["worst"] = errors, _worst(fine, errors)
+        fine["errors"], fine["worst"] = errors, _worst(fine, errors, judged)
         return fine, fine["worst"][1], _unresolved(fine["setup"], fine)
 
     def refine(res, fine, rel, why):
@@ -556,19 +568,19 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["hysteresis"], fine["hysteresis_trapezoid"], fine["n_folds"], fine["trapping"],
         fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
         fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
-        fine["n_grids"], accuracy, band_offset=fine["band_offset"])
+        fine["n_grids"], accuracy, band_offset=fine["band_offset"], judged=tuple(judged))
 
 
 def initial_spacing(accuracy, cap=None):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
     map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error, at
-    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`_lattice_cap`)."""
+    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`lattice_cap`)."""
     cap = MAX_SPACING / COARSE_RATIO if cap is None else cap
     return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
 
 
-def _lattice_cap(mu, radius, law):
+def lattice_cap(mu, radius, law):
     """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
     below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
     jump-out fold) and below MAX_SPACING ell. On the DMT side (ell = sqrt(R z0 / 8) <
