@@ -115,6 +115,11 @@ def test_observed_order_of_a_manufactured_sequence_and_its_refusals():
         assert observed_order(a, b, c, r) == pytest.approx(p, rel=1e-9)
     assert observed_order(1.0, 1.001, 0.99, 2.0) is None      # oscillating
     assert observed_order(1.0, 1.01, 1.015, 2.0) is None      # diverging
+    # oscillating members whose finest difference (1e-3) nearly cancels: the envelope takes
+    # the coarser one, 1.1e-2 / r^p, with the finest difference's sign (identity on numbers)
+    r, p = 2.0, est.ENVELOPE_ORDER
+    e = discretisation({"q": 1.0}, {"q": 1.001}, {"q": 0.99}, ratio=r)["q"]
+    assert e == pytest.approx(-0.011 / r**p / (r**p - 1), rel=1e-12, abs=0)
 
 
 # --------------------------------------------------------------------------- family ratios
