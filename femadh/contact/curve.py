@@ -315,7 +315,7 @@ class EquilibriumCurve:
 
 
 @dataclass
-class CurveReadout:
+class CycleReadout:
     """What an experiment reads off a traced curve (SI units; forces attractive positive).
 
     Attributes
@@ -350,7 +350,7 @@ class CurveReadout:
 
 
 def read_curve(curve, force):
-    """Pull-offs, jumps and hysteresis of a traced curve (:class:`CurveReadout`).
+    """Pull-offs, jumps and hysteresis of a traced curve (:class:`CycleReadout`).
 
     Parameters
     ----------
@@ -385,7 +385,7 @@ def read_curve(curve, force):
     r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
     a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
     pull_disp = force(pb(r_folds[-1][2]), *r_folds[-1][:2]) if r_folds else None
-    return CurveReadout(float(pull), pull_disp, a_folds[0] if a_folds else None,
+    return CycleReadout(float(pull), pull_disp, a_folds[0] if a_folds else None,
                         r_folds[-1][0] if r_folds else None, float(released), float(loop),
                         cf, {k: (D[k], F[k]) for k in D})
 
