@@ -11,7 +11,6 @@ from femadh.contact import AsperityGap
 from femadh.laws import LennardJones
 from femadh.elastic import GreenOperator, RadialGrid, disk_displacement
 from femadh.elastic.fe import FEOperator, FESettings
-from femadh.elastic.fe.cache import cached_operator
 from femadh.indenter import Sphere
 from femadh.contact.forces import state_forces
 from femadh.reference import hertz_displacement
@@ -27,7 +26,7 @@ def test_uniform_disk_absolute_displacement_converges():
     exact = disk_displacement(g.nodes, g.radius, E_STAR)
     sizes, errs = [], []
     for growth, frac in ((0.5, 1.0), (0.25, 0.5), (0.125, 0.25)):
-        fe = FEOperator(g, E_STAR, 0.3, FESettings(1e3, growth, frac))
+        fe = FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(1e3, growth, frac))
         w = fe.displacement(np.ones(g.n))
         sizes.append(frac)
         errs.append(np.max(np.abs(w - exact)) / exact.max())
@@ -43,7 +42,7 @@ def test_hertz_absolute_displacement_tracks_green_and_converges():
     for n in (20, 40, 80):
         g = RadialGrid.uniform(1e-6, n)
         p = hertz_annulus_averages(g.edges, a_c, R, E_STAR)
-        w_fe = FEOperator(g, E_STAR, 0.3, FESettings(1e3)).displacement(p)
+        w_fe = FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(1e3)).displacement(p)
         w_g = GreenOperator(g, E_STAR).displacement(p)
         exact = hertz_displacement(g.nodes, a_c, p0, E_STAR)
         hs.append(g.nodes[1])
@@ -62,8 +61,8 @@ def test_far_field_truncation_removed_by_boussinesq_data():
     err = {}
     for far in ("fixed", "boussinesq"):
         for L in (10.0, 100.0, 1000.0):
-            w = FEOperator(g, E_STAR, 0.3, FESettings(L, 0.25, 0.5, far)).displacement(
-                np.ones(g.n))
+            w = FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(L, 0.25, 0.5, far)
+                                       ).displacement(np.ones(g.n))
             err[far, L] = np.max(np.abs(w - exact)) / exact.max()
     # a fixed boundary shifts w by ~ F/(pi E* L): error ~ a/L, slope -1 (measured -0.955)
     slope = observed_order([10, 100, 1000], [err["fixed", L] for L in (10, 100, 1000)])
@@ -80,7 +79,7 @@ def fe_fig3():
     R = 2e-3
     g = RadialGrid.uniform(math.sqrt(2 * R * 10e-9), 60)
     eff = {"lj": LennardJones(HAMAKER, Z0)}
-    fe = FEOperator(g, E_STAR, 0.3)
+    fe = FEOperator.homogeneous(g, E_STAR, 0.3)
     return (ContactProblem(fe, Sphere(R), eff, AsperityGap(1e-9)),
             ContactProblem(GreenOperator(g, E_STAR), Sphere(R), eff, AsperityGap(1e-9)))
 
@@ -125,8 +124,8 @@ def test_fe_matches_green_and_converges_under_refinement():
 
     ref = curve(GreenOperator(g, E_STAR))
     peak = np.abs(ref).max()
-    errs = [np.abs(curve(FEOperator(g, E_STAR, 0.3, FESettings(1e4, gr, fr))) - ref).max() / peak
-            for gr, fr in ((0.5, 1.0), (0.25, 0.5))]
+    errs = [np.abs(curve(FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(1e4, gr, fr)))
+                   - ref).max() / peak for gr, fr in ((0.5, 1.0), (0.25, 0.5))]
     assert errs[1] <= 2e-4                 # default mesh: measured 1.0e-4 of the peak force
     assert errs[0] / errs[1] > 7           # measured 10.6x per halving of the element size
 
@@ -186,10 +185,10 @@ def test_cached_operator_equals_a_fresh_one_and_builds_its_body_on_demand(tmp_pa
     fresh operator's full field."""
     cache = _cache_env(tmp_path, monkeypatch)
     g = RadialGrid.uniform(6.32e-6, 40)
-    fresh = FEOperator(g, E_STAR, 0.3)
-    miss = cached_operator(g, E_STAR, 0.3)
+    fresh = FEOperator.homogeneous(g, E_STAR, 0.3)
+    miss = FEOperator.homogeneous(g, E_STAR, 0.3, cache=True)
     assert not miss.cache_hit and len(list(cache.glob("fe-*.npz"))) == 1
-    hit = cached_operator(g, E_STAR, 0.3)
+    hit = FEOperator.homogeneous(g, E_STAR, 0.3, cache=True)
     assert hit.cache_hit and "assembly" not in hit.timings     # nothing assembled
     assert np.array_equal(hit.compliance, miss.compliance)
     # a separate condensation: same sparse LU, same bits here (allow round-off anyway)
@@ -210,9 +209,11 @@ def test_operator_cache_is_invalidated_by_a_changed_body(tmp_path, monkeypatch):
 
     cache = _cache_env(tmp_path, monkeypatch)
     g = RadialGrid.uniform(6.32e-6, 30)
-    base = cached_operator(g, E_STAR, 0.3)
-    for other in (cached_operator(g, 1.01 * E_STAR, 0.3), cached_operator(g, E_STAR, 0.25),
-                  cached_operator(g, E_STAR, 0.3, FESettings(1e4, growth=0.3))):
+    base = FEOperator.homogeneous(g, E_STAR, 0.3, cache=True)
+    for other in (FEOperator.homogeneous(g, 1.01 * E_STAR, 0.3, cache=True),
+                  FEOperator.homogeneous(g, E_STAR, 0.25, cache=True),
+                  FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(1e4, growth=0.3),
+                                         cache=True)):
         assert not other.cache_hit
         assert not np.array_equal(other.compliance, base.compliance)
     assert len(list(cache.glob("fe-*.npz"))) == 4
@@ -224,12 +225,12 @@ def test_operator_cache_is_invalidated_by_a_changed_body(tmp_path, monkeypatch):
     with open(meshes / src.name, "a") as f:
         f.write("\n")                                         # other bytes, same mesh
     monkeypatch.setenv("FEMADH_MESH_PATH", str(meshes))
-    moved = cached_operator(g, E_STAR, 0.3)
+    moved = FEOperator.homogeneous(g, E_STAR, 0.3, cache=True)
     assert moved._mesh_path != src and operator_key(moved) != operator_key(base)
     assert not moved.cache_hit
     # a sphere material on a layered-call body: the sphere's Green part is added on load
     sub = IsotropicMaterial(163e9, 0.3)
-    rigid = cached_operator(g, substrate=sub)
-    soft = cached_operator(g, substrate=sub, sphere=IsotropicMaterial(83e9, 0.21))
+    rigid = FEOperator.layered(g, sub, cache=True)
+    soft = FEOperator.layered(g, sub, sphere=IsotropicMaterial(83e9, 0.21), cache=True)
     assert soft.cache_hit and np.array_equal(soft.compliance_body, rigid.compliance_body)
     assert not np.array_equal(soft.compliance, rigid.compliance)

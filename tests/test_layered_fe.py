@@ -63,8 +63,7 @@ def reference(stack, substrate=(E, NU)):
 
 
 def fe(stack, substrate=SUBSTRATE, sphere=None, **settings):
-    return FEOperator(GRID, substrate=substrate, layers=layers_of(stack), sphere=sphere,
-                      settings=FESettings(**settings))
+    return FEOperator.layered(GRID, substrate, layers_of(stack), sphere, FESettings(**settings))
 
 
 # ---- mesh ------------------------------------------------------------------------------
@@ -313,22 +312,18 @@ def test_sphere_compliance_is_its_green_function_added_to_the_body():
     assert not np.any(rigid.compliance_sphere)
     # a homogeneous substrate + elastic sphere is the composite modulus of paper 1 eq 2:
     # measured 8.3e-5 (disk), 6.1e-5 (Hertz)
-    pair = FEOperator(GRID, substrate=SUBSTRATE, sphere=sphere)
+    pair = FEOperator.layered(GRID, SUBSTRATE, sphere=sphere)
     comp = GreenOperator(GRID, composite_modulus(SUBSTRATE, sphere)).compliance
     assert rel(pair.compliance @ DISK, comp @ DISK) < 3e-4
     assert rel(pair.compliance @ HERTZ, comp @ HERTZ) < 3e-4
-    # the old call is the substrate-only body of the new one, bit for bit
-    old = FEOperator(GRID, e_star(E, NU), NU)
-    assert np.array_equal(old.compliance, FEOperator(GRID, substrate=SUBSTRATE).compliance)
+    # the homogeneous body of E* is the bare substrate's layered body, bit for bit
+    hom = FEOperator.homogeneous(GRID, e_star(E, NU), NU)
+    assert np.array_equal(hom.compliance, FEOperator.layered(GRID, SUBSTRATE).compliance)
 
 
-def test_ambiguous_calls_are_refused():
-    with pytest.raises(ValueError, match="either e_star or substrate"):
-        FEOperator(GRID, 1e11, substrate=SUBSTRATE)
-    with pytest.raises(ValueError, match="need substrate"):
-        FEOperator(GRID, 1e11, layers=[Layer(1e-7, E, NU)])
-    with pytest.raises(ValueError, match="give e_star"):
-        FEOperator(GRID)
+def test_the_old_two_form_call_is_refused_with_the_constructors_named():
+    with pytest.raises(TypeError, match=r"FEOperator.homogeneous\(grid, e_star"):
+        FEOperator(GRID, 1e11, 0.3)
 
 
 # ---- fields and VTK --------------------------------------------------------------------
@@ -343,8 +338,8 @@ def test_layered_vtk_has_regions_p2_cells_and_sharp_interfaces(tmp_path):
 
     R = 2e-3
     grid = RadialGrid.uniform(math.sqrt(2 * R * 10e-9), 20)
-    op = FEOperator(grid, substrate=SUBSTRATE, layers=[Layer(0.1 * grid.radius, 2 * E, 0.25)],
-                    sphere=IsotropicMaterial(83e9, 0.21))
+    op = FEOperator.layered(grid, SUBSTRATE, [Layer(0.1 * grid.radius, 2 * E, 0.25)],
+                            IsotropicMaterial(83e9, 0.21))
     problem = ContactProblem(op, Sphere(R), {"lj": LennardJones(1e-19, 0.165e-9)},
                              AsperityGap(1e-9))
     state = trace(problem, np.array([1.0, -2.0]) * 1e-9, branch="approach", tol=1e-19).states[-1]

@@ -26,17 +26,16 @@ def build_operator(scene, progress=None, *, grid=None, settings=None):
 
     grid = grid or scene_grid(scene)
     if scene.method == "fe":
-        from ..elastic.fe.cache import cached_operator
+        from ..elastic.fe import FEOperator
 
         settings = settings or scene.fe_settings
         # the condensed body from the on-disk operator cache when it was built before (by
         # content: mesh, grid, materials, settings); its factorised body only on demand
         if scene.layers:
-            return cached_operator(grid, settings=settings, progress=progress,
-                                   substrate=scene.disk, layers=scene.layers,
-                                   sphere=scene.slider)
-        return cached_operator(grid, scene.e_star, scene.fe_poisson_ratio, settings,
-                               progress=progress)
+            return FEOperator.layered(grid, scene.disk, scene.layers, scene.slider, settings,
+                                      progress=progress, cache=True)
+        return FEOperator.homogeneous(grid, scene.e_star, scene.fe_poisson_ratio, settings,
+                                      progress=progress, cache=True)
     return GreenOperator(grid, scene.e_star)
 
 
