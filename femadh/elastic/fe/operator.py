@@ -38,10 +38,14 @@ from ..operator import SurfaceOperator
 from .body import FEBody
 from .farfield import boussinesq
 from .mesh import cached_mesh, load_mesh
-from .settings import (NU_DISPLACEMENT_MAX, NU_LIMIT, SOFT_RATIO, FESettings,  # noqa: F401
+from .settings import (NU_DISPLACEMENT_MAX, NU_LIMIT, SOFT_RATIO, FESettings,
                        layered_surface_size, layers_needing_radial_resolution, mesh_spec)
 from .weakform import (annulus_load_matrix, axisymmetric_elasticity, lame,
                        projected_volumetric, surface_facet_basis)
+
+# the settings' names stay importable from here (their home is .settings)
+__all__ = ["FEOperator", "FESettings", "mesh_spec", "NU_DISPLACEMENT_MAX", "NU_LIMIT",
+           "SOFT_RATIO", "layered_surface_size", "layers_needing_radial_resolution"]
 
 
 class FEOperator(SurfaceOperator):
