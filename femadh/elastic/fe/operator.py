@@ -144,7 +144,7 @@ class FEOperator(SurfaceOperator):
         self.timings = {}
 
     #: attributes of the assembled, factorised body: an operator read from the cache
-    #: (:meth:`cached`) builds them on first use (full fields, VTK, render)
+    #: (``cache=True``, :mod:`.cache`) builds them on first use (full fields, VTK, render)
     _BODY = frozenset(("mesh", "region", "basis", "free", "fixed", "uD", "K_full", "B", "_lu",
                        "_Kfd", "surface_vertices", "_pressure", "_pbasis", "_rows",
                        "far_dofs", "axis_dofs"))
