@@ -196,12 +196,12 @@ class FEOperator(SurfaceOperator):
         quadrature exact for the element's trace times r)."""
         m, g = self.mesh, self.grid
         surface = m.boundaries["surface"]
-        mid = m.p[0, m.facets[:, surface]].mean(axis=0)
-        loaded = surface[mid < g.radius]
+        loaded = surface[m.p[0, m.facets[:, surface]].mean(axis=0) < g.radius]
         fb = surface_facet_basis(m, self.basis.elem, loaded)
         if fb.N != self.basis.N:
             raise RuntimeError("the surface FacetBasis numbers the DOFs unlike the body's")
-        annulus = np.searchsorted(g.edges, mid[mid < g.radius]) - 1
+        # the annulus of each facet in the basis' own order (its midpoint's)
+        annulus = np.searchsorted(g.edges, m.p[0, m.facets[:, fb.find]].mean(axis=0)) - 1
         return annulus_load_matrix(fb, annulus, g.n)
 
     def _constrain(self):
