@@ -8,7 +8,8 @@ PARTS = ("crosscheck", "slider", "film", "render", "benchmark")
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description="Coated and layered substrates: the studies")
+    ap = argparse.ArgumentParser(prog="python -m validation.layered",
+                                 description="Coated and layered substrates: the studies")
     ap.add_argument("--part", action="append", choices=sorted(PARTS))
     args = ap.parse_args(argv)
     for name in args.part or PARTS:
