@@ -214,8 +214,8 @@ DEFECTS = [
     # -- layered substrates
     D("layered_sphere_compliance", "layered scene: the slider's own compliance dropped",
       "femadh/scene/build.py",
-      (("layers=scene.layers,\n                                   sphere=scene.slider)",
-        "layers=scene.layers,\n                                   sphere=None)"),)),
+      (("layers=body.layers,\n                                   sphere=body.slider)",
+        "layers=body.layers,\n                                   sphere=None)"),)),
     D("hankel_sphere_twice", "Hankel layered operator: the sphere's compliance counted twice",
       "femadh/judges.py",
       (("+ GreenOperator(grid, sphere.plane_strain_modulus).compliance)",
@@ -243,9 +243,6 @@ DEFECTS = [
       "femadh/runner/accuracy.py",
       (('RunFolder(out_dir, scene_id(scene), scene.name, "amend")',
         'RunFolder(out_dir, scene_id(scene), scene.name, "overwrite")'),)),
-    D("study_key_ignores_layers", "a study worker reuses one FE body across layer values",
-      "femadh/studies/executors.py",
-      (("fe += (tuple(sc.layers), sc.disk, sc.slider)", "pass"),)),
     # -- stepping: a fold inside one step told by the step's energy
     D("fold_energy_sign", "stepping: the step's energy change counted with the wrong sign",
       "femadh/contact/stepping.py",
@@ -261,10 +258,40 @@ DEFECTS = [
       "the corrector found", "femadh/contact/stepping.py",
       (("                    beyond = new\n", "                    pass\n"),)),
     # -- studies: the operator cache, the done/redo bookkeeping, exit codes, units, workers
-    D("study_key_ignores_modulus", "a study's operator key forgets the composite modulus",
-      "femadh/studies/executors.py",
-      (("return repr((sc.method, sc.nodes, grid, sc.analysis_radius, sc.e_star, fe))",
-        "return repr((sc.method, sc.nodes, grid, sc.analysis_radius, fe))"),)),
+    # the operator's key is the content hash of (body, discretisation): femadh/scene/parts
+    D("study_key_wrong_part", "a study's operator key of the laws instead of the body (the "
+      "modulus, the layers forgotten)", "femadh/studies/executors.py",
+      (("return operator_key(*sc.operator_inputs)",
+        "return operator_key(sc.laws, sc.discretisation)"),)),
+    D("study_key_discretisation_only", "the operator key of the discretisation alone",
+      "femadh/scene/build.py",
+      (("return content_hash(body, discretisation)", "return content_hash(discretisation)"),)),
+    D("operator_reads_the_laws", "the operator's build reads the sigma-gap's contact model "
+      "(one more node for the closure), outside its key", "femadh/scene/build.py",
+      (("    return operator_from_parts(scene.body, scene.discretisation, progress, grid=grid,",
+        "    d = scene.discretisation\n"
+        "    if scene.gap is not None and scene.gap.contact_model != 'complementarity':\n"
+        "        d = __import__('dataclasses').replace(d, nodes=d.nodes + 1)\n"
+        "    return operator_from_parts(scene.body, d, progress, grid=grid,"),)),
+    D("study_key_drops_a_field", "the content hash leaves out each part's last field",
+      "femadh/scene/parts/frozen.py",
+      (("for f in dataclasses.fields(obj)}}", "for f in dataclasses.fields(obj)[:-1]}}"),)),
+    D("study_key_float_rounded", "the content hash writes floats to 6 digits",
+      "femadh/scene/parts/frozen.py",
+      (("            return repr(x)          # JSON has no NaN/inf; as a string they stay "
+        "distinct\n        return x\n",
+        "            return repr(x)          # JSON has no NaN/inf; as a string they stay "
+        "distinct\n        return float(f'{x:.6g}')\n"),)),
+    D("scene_tables_writable", "a part's tables (effects, mesh, grid) take new entries",
+      "femadh/scene/parts/frozen.py",
+      (("    __setitem__ = __delitem__ = _refuse", "    __delitem__ = _refuse"),)),
+    D("scene_flat_write_mutates_part", "assigning a flat attribute changes the shared part",
+      "femadh/scene/contact.py",
+      (("setattr(obj, self.part, dataclasses.replace(part, **{self.name: value}))",
+        "object.__setattr__(part, self.name, value)"),)),
+    D("scene_id_layout", "the scene's resolved view renames a key (every scene id moves)",
+      "femadh/scene/contact.py",
+      (('"tolerance_m": self.tolerance', '"tolerance": self.tolerance'),)),
     D("study_point_id_of_base", "a study's points carry the base scene's id",
       "femadh/studies/sweep.py",
       (("points.append(Point(i, changes, sc, scene_id(sc)))",
@@ -631,6 +658,43 @@ DEFECTS = [
     D("reference_rigid_lj_peak", "eq 14's peak A R / (6 z0^2) for A R / (8 z0^2)",
       "femadh/reference/rigid_lj.py", (("return hamaker * radius / (8.0 * z0**2)",
                                         "return hamaker * radius / (6.0 * z0**2)"),)),
+    # -- the run lifecycle (femadh/runner/lifecycle.py) and the result base
+    D("life_failure_status", "lifecycle: a solver failure ends the run \"converged\"",
+      "femadh/runner/lifecycle.py",
+      (("            result.fail(str(exc))",
+        "            result.status, result.error = \"converged\", str(exc)"),)),
+    D("life_stop_status", "result: every stop is \"interrupted\" (the time limit too)",
+      "femadh/runner/result.py", (("self.status, self.error, self.exit_code = exc.status,",
+                                   "self.status, self.error, self.exit_code = \"interrupted\","),)),
+    D("life_stop_exit_code", "result: a stop's exit code always 130",
+      "femadh/runner/result.py", (("f\"{exc}{where}\", exc.exit_code", "f\"{exc}{where}\", 130"),)),
+    D("life_final_check", "lifecycle: no check after the work (a late signal ends "
+      "\"converged\")", "femadh/runner/lifecycle.py",
+      (("            yield life\n            # a signal that arrived after the last safe point "
+        "is still a stop\n            interrupt.check()\n", "            yield life\n"),)),
+    D("life_no_running", "lifecycle: summary.json never says \"running\"", "femadh/runner/lifecycle.py",
+      (("                life.write_summary(\"running\")", "                pass"),)),
+    D("life_interrupted_summary", "lifecycle: a stopped run's last summary still says "
+      "\"running\"", "femadh/runner/lifecycle.py",
+      (("            life.write_summary()\n",
+        "            life.write_summary(\"running\" if result.exit_code else None)\n"),)),
+    D("life_no_checkpoint", "lifecycle: the stop hook (the sweep's checkpoint) not called",
+      "femadh/runner/lifecycle.py", (("                life.on_stop()", "                pass"),)),
+    D("life_untouched", "lifecycle: a folder refused while checked gets a summary written",
+      "femadh/runner/lifecycle.py", (("                life._write = None", "                pass"),)),
+    D("life_cleanup_on_success_only", "lifecycle: cleanups (writer, logs) only for a "
+      "converged run", "femadh/runner/lifecycle.py", (("                fn()", "                result.status == "
+                                   "\"converged\" and fn()"),)),
+    D("life_sigterm_reraise", "femadh.run: SIGTERM reaches a script as KeyboardInterrupt",
+      "femadh/runner/lifecycle.py", (("if result.exit_code == 128 + signal.SIGTERM:",
+                                   "if result.exit_code == 128 + signal.SIGINT:"),)),
+    D("life_resume_untouched_kept", "contact: a fault after the resumed folder was checked "
+      "leaves its summary \"running\"", "femadh/runner/contact.py",
+      (("            life.untouched_on = ()\n", ""),)),
+    D("meniscus_headline_error", "meniscus headline: the error of the point before the "
+      "largest force", "femadh/runner/result.py",
+      (("float(np.asarray(c[\"force_error_N\"], float)[k])",
+        "float(np.asarray(c[\"force_error_N\"], float)[k - 1])"),)),
 ]
 
 
