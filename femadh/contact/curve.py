@@ -313,6 +313,59 @@ class EquilibriumCurve:
                     here = (d_f, w, i)
         return total
 
+    def readout(self, force):
+        """Pull-off and jumps of a curve traced on one grid (:class:`CurveReadout`).
+
+        Parameters
+        ----------
+        force : callable(d, w) -> float
+            Force (N, tension positive) of a state.
+
+        Load control: the largest tension anywhere on the curve, refined between the
+        neighbours of the best traced point (:meth:`maximize`). Displacement control: that
+        value when its point is stable, else the largest tension along the
+        displacement-controlled retract path (:meth:`branch`: points, folds, landings).
+        Jumps: the separations of the approach path's first fold and the retract path's last.
+        """
+        pts = self.points
+        forces = np.array([force(p.d, p.w) for p in pts])
+        i = int(np.argmax(forces))
+        pull = forces[i]
+        if 0 < i < len(pts) - 1:
+            pull = max(pull, self.maximize(i, force)[0])
+        paths = {k: self.branch(k) for k in ("approach", "retract")}
+        f_ret = np.array([force(d, w) for _, d, w in paths["retract"]])
+        pull_disp = pull if pts[i].stable else float(np.max(f_ret))
+        fin = [d for kind, d, _ in paths["approach"] if kind == "fold"]
+        fout = [d for kind, d, _ in paths["retract"] if kind == "fold"]
+        return CurveReadout(forces, float(pull), pull_disp, fin[0] if fin else None,
+                            fout[-1] if fout else None, paths)
+
+
+@dataclass
+class CurveReadout:
+    """What :meth:`EquilibriumCurve.readout` reads off a curve (forces N, separations m).
+
+    Attributes
+    ----------
+    forces : ndarray
+        The force at every curve point.
+    pull_off, pull_off_displacement : float
+        The largest tension under load control and along the displacement-controlled
+        retract path.
+    jump_in, jump_out : float or None
+        d of the approach path's first fold and of the retract path's last (None: no fold).
+    paths : dict
+        ``"approach"``, ``"retract"``: the paths as :meth:`EquilibriumCurve.branch` gives.
+    """
+
+    forces: np.ndarray
+    pull_off: float
+    pull_off_displacement: float
+    jump_in: float | None
+    jump_out: float | None
+    paths: dict
+
 
 @dataclass
 class CycleReadout:

@@ -54,17 +54,16 @@ def operator_from_parts(body, disc, progress=None, *, grid=None, settings=None):
 
     grid = grid or discretisation_grid(disc)
     if disc.method == "fe":
-        from ..elastic.fe.cache import cached_operator
+        from ..elastic.fe import FEOperator
 
         settings = settings or disc.fe_settings
         # the condensed body from the on-disk operator cache when it was built before (by
         # content: mesh, grid, materials, settings); its factorised body only on demand
         if body.layers:
-            return cached_operator(grid, settings=settings, progress=progress,
-                                   substrate=body.disk, layers=body.layers,
-                                   sphere=body.slider)
-        return cached_operator(grid, body.e_star, disc.fe_poisson_ratio, settings,
-                               progress=progress)
+            return FEOperator.layered(grid, body.disk, body.layers, body.slider, settings,
+                                      progress=progress, cache=True)
+        return FEOperator.homogeneous(grid, body.e_star, disc.fe_poisson_ratio, settings,
+                                      progress=progress, cache=True)
     return GreenOperator(grid, body.e_star)
 
 
