@@ -376,7 +376,7 @@ def test_layered_vtk_has_regions_p2_cells_and_sharp_interfaces(tmp_path):
 # ---- the film study's readout (validation.layered.common) ----------------------------------
 
 def test_film_readout_reaches_the_dmt_limit_and_finds_the_jkr_side_jumps():
-    """The film study's curve readout (``film_point``: ``EquilibriumCurve.readout`` and the
+    """The film study's curve readout (``film_point``: ``femadh.contact.curve.read_curve`` and the
     contact edge) on its two half-space limits, Green operators on the study's grid: glass
     (Tabor mu = 5e-3) is DMT, pull-off 2 pi R dg with no fold; the film (mu = 3) is near-JKR,
     with a jump-in before a jump-out (hysteresis) and the pull-off on a stable state."""

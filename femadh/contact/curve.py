@@ -313,59 +313,6 @@ class EquilibriumCurve:
                     here = (d_f, w, i)
         return total
 
-    def readout(self, force):
-        """Pull-off and jumps of a curve traced on one grid (:class:`CurveReadout`).
-
-        Parameters
-        ----------
-        force : callable(d, w) -> float
-            Force (N, tension positive) of a state.
-
-        Load control: the largest tension anywhere on the curve, refined between the
-        neighbours of the best traced point (:meth:`maximize`). Displacement control: that
-        value when its point is stable, else the largest tension along the
-        displacement-controlled retract path (:meth:`branch`: points, folds, landings).
-        Jumps: the separations of the approach path's first fold and the retract path's last.
-        """
-        pts = self.points
-        forces = np.array([force(p.d, p.w) for p in pts])
-        i = int(np.argmax(forces))
-        pull = forces[i]
-        if 0 < i < len(pts) - 1:
-            pull = max(pull, self.maximize(i, force)[0])
-        paths = {k: self.branch(k) for k in ("approach", "retract")}
-        f_ret = np.array([force(d, w) for _, d, w in paths["retract"]])
-        pull_disp = pull if pts[i].stable else float(np.max(f_ret))
-        fin = [d for kind, d, _ in paths["approach"] if kind == "fold"]
-        fout = [d for kind, d, _ in paths["retract"] if kind == "fold"]
-        return CurveReadout(forces, float(pull), pull_disp, fin[0] if fin else None,
-                            fout[-1] if fout else None, paths)
-
-
-@dataclass
-class CurveReadout:
-    """What :meth:`EquilibriumCurve.readout` reads off a curve (forces N, separations m).
-
-    Attributes
-    ----------
-    forces : ndarray
-        The force at every curve point.
-    pull_off, pull_off_displacement : float
-        The largest tension under load control and along the displacement-controlled
-        retract path.
-    jump_in, jump_out : float or None
-        d of the approach path's first fold and of the retract path's last (None: no fold).
-    paths : dict
-        ``"approach"``, ``"retract"``: the paths as :meth:`EquilibriumCurve.branch` gives.
-    """
-
-    forces: np.ndarray
-    pull_off: float
-    pull_off_displacement: float
-    jump_in: float | None
-    jump_out: float | None
-    paths: dict
-
 
 @dataclass
 class CycleReadout:
@@ -379,6 +326,10 @@ class CycleReadout:
     pull_off_displacement : float or None
         Displacement-controlled pull-off (N): the tension at the fold where the retract path
         leaves the contact (the last retract fold); None without folds.
+    pull_off_path : float
+        The largest tension (N) a displacement-controlled retract meets: ``pull_off`` where
+        its point is stable (the path passes through it), else the largest along the retract
+        path (its points, folds and landings).
     jump_in, jump_out : float or None
         Separations (m) of the approach path's first fold and the retract path's last.
     hysteresis : float
@@ -394,6 +345,7 @@ class CycleReadout:
 
     pull_off: float
     pull_off_displacement: float | None
+    pull_off_path: float
     jump_in: float | None
     jump_out: float | None
     hysteresis: float
@@ -438,7 +390,8 @@ def read_curve(curve, force):
     r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
     a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
     pull_disp = force(pb(r_folds[-1][2]), *r_folds[-1][:2]) if r_folds else None
-    return CycleReadout(float(pull), pull_disp, a_folds[0] if a_folds else None,
+    pull_path = float(pull) if pts[i].stable else float(np.max(F["retract"]))
+    return CycleReadout(float(pull), pull_disp, pull_path, a_folds[0] if a_folds else None,
                         r_folds[-1][0] if r_folds else None, float(released), float(loop),
                         cf, {k: (D[k], F[k]) for k in D})
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from femadh.contact import ContactProblem
 from femadh.contact.arclength import trace_curve
+from femadh.contact.curve import read_curve
 from femadh.discretisation.moving import contact_edge
 from femadh.elastic import RadialGrid
 from femadh.indenter import Sphere
@@ -79,8 +80,8 @@ def film_point(op, lj, z0, d_min):
     t0 = time.perf_counter()
     curve = trace_curve(problem, 12 * z0, d_min, tol=1e-16, scale=z0, ds=0.2, ds_max=0.5)
     wall = time.perf_counter() - t0
-    read = curve.readout(lambda d, w: lj_force(problem, lj, d, w))
-    cf = read.forces
+    read = read_curve(curve, lambda pb, d, w: lj_force(pb, lj, d, w))
+    cf = read.force
     # zero-load contact radius on the stable loading branch
     a0 = math.nan
     pts = curve.points
@@ -89,7 +90,7 @@ def film_point(op, lj, z0, d_min):
             s = cf[k] / (cf[k] - cf[k + 1])
             a0 = ((1 - s) * contact_edge(problem, pts[k].w, pts[k].d, z0)
                   + s * contact_edge(problem, pts[k + 1].w, pts[k + 1].d, z0))
-    return {"pull": read.pull_off / scale, "pull_disp": read.pull_off_displacement / scale,
+    return {"pull": read.pull_off / scale, "pull_disp": read.pull_off_path / scale,
             "jump_in": math.nan if read.jump_in is None else read.jump_in / z0,
             "jump_out": math.nan if read.jump_out is None else read.jump_out / z0, "a0": a0,
             "curve_d": curve.d / z0, "curve_F": cf / scale, "wall": wall,
