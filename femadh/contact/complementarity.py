@@ -31,6 +31,14 @@ CHORD_RATE = 0.05
 LARGE_N, CHORD_RATE_LARGE = 600, 0.15
 #: largest fraction of the current gap one Newton step may close (keeps h > 0 for LJ)
 MAX_GAP_CLOSURE = 0.8
+#: stagnation exit: a solve whose residual has not fallen below STALL_FACTOR of its last
+#: progress mark for STALL_ITER iterations (while its contact disk does not move steadily
+#: one way) gives up: there is no equilibrium near the prediction (a step across a fold).
+#: Measured on the Fig 4 scene (285 nodes): converging solves mark progress every 1-3
+#: iterations (slowest: the x0.7 linear descent while the edge moves node by node, and the
+#: disk then moves one way); the 15 solves across a fold that ran to max_iter = 40 hovered
+#: within a factor 2 of 1e-13 or cycled their contact edge back and forth from iteration 3 on
+STALL_ITER, STALL_FACTOR = 8, 0.5
 
 
 def _damping(h, dh_closing):
@@ -60,7 +68,8 @@ def _residual(problem, w, p_net):
 DISK_MARGIN_FRACTION = 0.05
 
 
-def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None):
+def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
+                          stall_iter=STALL_ITER, stats=None):
     """Equilibrium at separation d (m) from displacements w0 (m): semismooth Newton on the
     sigma-gap complementarity problem (without a gap, Newton on eq 6).
 
@@ -72,6 +81,12 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     mask the factorisation is reused (chord steps), and refreshed only when the residual stops
     falling by CHORD_RATE per step. The LJ stiffness P'(h) is a small, slowly varying diagonal
     next to K, so chord steps converge almost as fast as Newton steps at a fraction of the cost.
+
+    ``stall_iter``: iterations without progress after which the solve gives up (see
+    STALL_ITER; None: run to ``max_iter``, for a decision that must not be cut short). A
+    stagnated state says so in ``diagnostics["stagnated"]`` (iterations, residual, best
+    residual); converged states carry no diagnostics. ``stats`` (dict, optional) accumulates
+    the work done: "iterations", "factorisations" and "stagnated" (solves that gave up).
     """
     K, b = problem.K, problem.contour(d)
     sigma = problem.sigma
@@ -92,6 +107,9 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         lu, lu_I = factor if factor is not None else (None, None)
     fresh = False
     res, res_prev, it = math.inf, math.inf, 0
+    n_factor, res_it = 0, math.inf
+    mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
+    stagnated = None
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
         # this state is on disk yet (femadh.interrupt)
@@ -112,6 +130,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
                 m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
                 cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
+                n_factor += 1
                 if cand.covers(m):
                     lu, lu_I, fresh = cand, None, True
                     res_prev = math.inf
@@ -128,6 +147,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
                 M = K[idx[:, None], idx]
                 M[np.diag_indices_from(M)] += problem.dpressure(h[I])
                 lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+                n_factor += 1
                 res_prev = math.inf
             else:
                 res_prev = res
@@ -147,7 +167,9 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         res = _residual(problem, w, P - pc)
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
             factor = lu if isinstance(lu, TrailingLU) else (lu, lu_I)
+            _count(stats, it, n_factor, False)
             return _finish(problem, d, w, h, pc, A, it, res, factor, fresh)
+        res_it = res
         key = new_A.tobytes()
         if key in seen and not np.array_equal(new_A, A):
             # The active set cycles (non-convex LJ near the contact edge): accept only the
@@ -160,13 +182,39 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # rather than refactorised: the contact edge moves node by node along a sweep)
             res, res_prev = math.inf, math.inf
         A = new_A
+        # progress: the residual halves against its mark, or the contact disk keeps moving
+        # one way (an edge advancing node by node at a flat residual)
+        m_new = int(A.sum())
+        step_dir = (m_new > m_last) - (m_new < m_last)
+        steady = step_dir != 0 and step_dir == m_trend
+        m_trend, m_last = (step_dir or m_trend), m_new
+        if res_it < STALL_FACTOR * mark or steady:
+            mark, it_mark = min(res_it, mark), it
+        elif stall_iter is not None and it - it_mark >= stall_iter:
+            stagnated = {"iterations": it, "residual_m": res_it, "best_residual_m": mark,
+                         "since_iteration": it_mark}
+            break
     h = b - w
     pc = np.zeros(n)
     if sigma is not None and np.all(h[~A] > 0):
         pc[A] = problem.pressure(h)[A] - (K @ w)[A]
-    return State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300), A),
-                 _contact_pressure(problem, pc, A), A,
-                 _area_radius(problem, A), it, res, False, False, None)
+    _count(stats, it, n_factor, stagnated is not None)
+    st = State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300), A),
+               _contact_pressure(problem, pc, A), A,
+               _area_radius(problem, A), it, res_it, False, False, None)
+    if stagnated is not None:
+        st.diagnostics["stagnated"] = stagnated
+    return st
+
+
+def _count(stats, iterations, factorisations, stagnated):
+    """Add one solve's work to ``stats`` (a dict, or None: not counted)."""
+    if stats is None:
+        return
+    stats["solves"] = stats.get("solves", 0) + 1
+    stats["iterations"] = stats.get("iterations", 0) + iterations
+    stats["factorisations"] = stats.get("factorisations", 0) + factorisations
+    stats["stagnated"] = stats.get("stagnated", 0) + int(stagnated)
 
 
 def _restrict_change(A, new_A):
