@@ -19,7 +19,7 @@ import numpy as np
 from scipy import linalg
 
 from ..interrupt import check as safe_point
-from .linalg import TrailingLU, disk_size
+from .linalg import TrailingCholesky, TrailingLU, disk_size, gmres
 from .stability import is_stable
 from .state import State
 
@@ -66,10 +66,17 @@ def _residual(problem, w, p_net):
 
 #: extra nodes factorised inside the contact edge so a shrinking contact stays covered
 DISK_MARGIN_FRACTION = 0.05
+#: Newton steps on a disk-shaped active set by preconditioned GMRES (False: the LU path only)
+KRYLOV = True
+#: relative residual of the linear Newton system GMRES reaches: an inexact Newton step whose
+#: error is 1e-6 of the step (quadratic convergence holds down to the tolerance: from a
+#: predictor residual of ~1e-12 m the next step's 1e-18 m is below the scenes' 1e-19 m... the
+#: step after it)
+GMRES_RTOL = 1e-6
 
 
 def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
-                          stall_iter=STALL_ITER, stats=None):
+                          stall_iter=None, stats=None):
     """Equilibrium at separation d (m) from displacements w0 (m): semismooth Newton on the
     sigma-gap complementarity problem (without a gap, Newton on eq 6).
 
@@ -82,8 +89,9 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     falling by CHORD_RATE per step. The LJ stiffness P'(h) is a small, slowly varying diagonal
     next to K, so chord steps converge almost as fast as Newton steps at a fraction of the cost.
 
-    ``stall_iter``: iterations without progress after which the solve gives up (see
-    STALL_ITER; None: run to ``max_iter``, for a decision that must not be cut short). A
+    ``stall_iter``: iterations without progress after which the solve gives up (the
+    continuation's trial steps pass STALL_ITER; None, the default: run to ``max_iter``, for a
+    decision that must not be cut short - a fold, a landing, a state of the estimate). A
     stagnated state says so in ``diagnostics["stagnated"]`` (iterations, residual, best
     residual); converged states carry no diagnostics. ``stats`` (dict, optional) accumulates
     the work done: "iterations", "factorisations" and "stagnated" (solves that gave up).
@@ -101,8 +109,11 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     else:
         A = b - w < sigma
     seen = set()
+    pre = factor if isinstance(factor, TrailingCholesky) else None
     if isinstance(factor, TrailingLU):
         lu, lu_I = factor, None
+    elif pre is not None:
+        lu, lu_I = None, None
     else:
         lu, lu_I = factor if factor is not None else (None, None)
     fresh = False
@@ -123,35 +134,18 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         P = problem.pressure(h)
         F_I = (K @ w)[I] - P[I]
         m = disk_size(A)
-        # near the tolerance the residual approaches round-off and no step cuts it by
-        # CHORD_RATE; there a chord step only has to keep making progress
-        stalled = res > (chord_rate if res > 100 * tol else 0.7) * res_prev
-        if m is not None:
-            if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
-                m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-                cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
-                n_factor += 1
-                if cand.covers(m):
-                    lu, lu_I, fresh = cand, None, True
-                    res_prev = math.inf
-                else:  # pivoting swapped rows inside the block: use the general path
-                    m = None
-            else:
-                res_prev = res
-        if m is not None:
-            dw = -lu.solve(m, F_I)
-        else:
-            if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
-                    or stalled:
-                idx = np.flatnonzero(I)
-                M = K[idx[:, None], idx]
-                M[np.diag_indices_from(M)] += problem.dpressure(h[I])
-                lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
-                n_factor += 1
-                res_prev = math.inf
-            else:
-                res_prev = res
-            dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+        dw = None
+        if m is not None and KRYLOV:
+            # a disk: a Newton step solved by GMRES on the exact Jacobian, preconditioned by
+            # a Cholesky of the energy Hessian that covers every disk from its margin on
+            dw, pre, nf = _krylov_step(problem, h, A, m, F_I, pre)
+            n_factor += nf
+            if dw is not None:
+                fresh = "krylov"
+        if dw is None:
+            dw, lu, lu_I, fresh, res_prev, nf = _lu_step(problem, h, A, I, m, F_I, lu, lu_I,
+                                                         fresh, res, res_prev, tol, chord_rate)
+            n_factor += nf
         alpha = _damping(h[I], dw)
         w[I] += alpha * dw
         h = b - w
@@ -166,7 +160,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             new_A = A
         res = _residual(problem, w, P - pc)
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
-            factor = lu if isinstance(lu, TrailingLU) else (lu, lu_I)
+            factor = (pre if fresh == "krylov" else lu if isinstance(lu, TrailingLU)
+                      else (lu, lu_I))
             _count(stats, it, n_factor, False)
             return _finish(problem, d, w, h, pc, A, it, res, factor, fresh)
         res_it = res
@@ -205,6 +200,82 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     if stagnated is not None:
         st.diagnostics["stagnated"] = stagnated
     return st
+
+
+def _krylov_step(problem, h, A, m, F_I, pre):
+    """A Newton step dw on the free nodes m..n-1 of a disk contact: GMRES on the area-scaled
+    Jacobian diag(area)(K + diag(P'(h)))_II, preconditioned by ``pre`` (a
+    :class:`TrailingCholesky` of the energy Hessian), refreshed at h when it does not cover
+    the disk or GMRES does not reach GMRES_RTOL within its Krylov dimension.
+
+    Returns (dw or None, preconditioner, factorisations); None when the Hessian at h is not
+    positive definite on the free nodes (an iterate off the stable branch): the LU path
+    takes the step."""
+    n = h.size
+    D = problem.dpressure(h)
+    a, D_I, K_II = problem.areas[m:], D[m:], problem.K[m:, m:]
+
+    def apply_a(v):
+        return a * (K_II @ v + D_I * v)
+
+    rhs = -a * F_I
+    n_factor = 0
+    for attempt in range(2):
+        if attempt or not (isinstance(pre, TrailingCholesky) and pre.covers(m)):
+            # held nodes of the margin enter with D = 0 (they are fixed; when released the
+            # Krylov iteration corrects their stiffness)
+            m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            pre = TrailingCholesky(problem.S_sym, problem.areas, np.where(A, 0.0, D), m0)
+            n_factor += 1
+            if not pre.covers(m):
+                return None, pre, n_factor
+        dw, _, ok = gmres(apply_a, lambda r: pre.solve(m, r), rhs, GMRES_RTOL)
+        if ok:
+            return dw, pre, n_factor
+    return None, pre, n_factor
+
+
+def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chord_rate):
+    """A chord or Newton step dw on the free nodes from an LU of the collocation Jacobian
+    K_II + diag(P'(h_I)): a trailing LU of the disk (reused while it covers the disk and the
+    residual falls by ``chord_rate`` per step), or of the free block of any other set.
+    Returns (dw, lu, lu_I, fresh, res_prev, factorisations)."""
+    K, n = problem.K, h.size
+    n_factor = 0
+    # near the tolerance the residual approaches round-off and no step cuts it by
+    # CHORD_RATE; there a chord step only has to keep making progress
+    stalled = res > (chord_rate if res > 100 * tol else 0.7) * res_prev
+    if m is not None:
+        if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
+            m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            D = problem.dpressure(h)
+            cand = TrailingLU(K, np.where(A, 0.0, D), m0, problem.areas)
+            n_factor += 1
+            if not cand.covers(m):
+                # pivoting swapped rows inside the margin: factorise the disk's own block
+                # (it always covers itself; the general path would refactorise at the
+                # next iteration again, two factorisations per iteration)
+                cand = TrailingLU(K, D, m, problem.areas)
+                n_factor += 1
+            lu, lu_I, fresh = cand, None, True
+            res_prev = math.inf
+        else:
+            res_prev = res
+    if m is not None:
+        dw = -lu.solve(m, F_I)
+    else:
+        if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
+                or stalled:
+            idx = np.flatnonzero(I)
+            M = K[idx[:, None], idx]
+            M[np.diag_indices_from(M)] += problem.dpressure(h[I])
+            lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+            n_factor += 1
+            res_prev = math.inf
+        else:
+            res_prev = res
+        dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+    return dw, lu, lu_I, fresh, res_prev, n_factor
 
 
 def _count(stats, iterations, factorisations, stagnated):
@@ -260,6 +331,16 @@ def tangent(problem, state):
     D = problem.dpressure(state.h)
     rhs = D[I] - problem.K[np.ix_(I, A)].sum(axis=1)
     m = disk_size(A)
+    if isinstance(state.lu, TrailingCholesky) and m is not None and state.lu.covers(m):
+        a, K_II = problem.areas[m:], problem.K[m:, m:]
+        t_I, _, ok = gmres(lambda v: a * (K_II @ v + D[m:] * v),
+                           lambda r: state.lu.solve(m, r), a * rhs, GMRES_RTOL)
+        if not ok:
+            return np.zeros(state.w.size)  # no converged solve: zeroth order
+        t[I] = t_I
+        return t
+    if isinstance(state.lu, TrailingCholesky):
+        return np.zeros(state.w.size)
     if isinstance(state.lu, TrailingLU) and m is not None and state.lu.covers(m):
         t[I] = state.lu.solve(m, rhs)
         return t

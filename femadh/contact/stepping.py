@@ -174,7 +174,13 @@ def lattice_snap(problem, old, landed, g_old, g_landed):
 
 
 def _predict(problem, state, d):
-    """Predicted displacements at d (tangent of the last state) and the active set they imply."""
+    """Predicted displacements at d (tangent of the last state) and the active set they imply.
+
+    (A release of the contact ring predicted from the tangent of the contact pressure,
+    d lambda_A/dd = -(K t)_A, was measured: 6 % fewer corrector iterations on the Fig 4
+    retract, but near the pull-off its decision solve at the smallest step missed a stable
+    state the gap-only prediction finds, and moved the fold by one resolution step; the
+    fold's decision must not depend on the predictor, so the set only grows here.)"""
     if state.lu is not None:
         w = state.w + tangent(problem, state) * (d - state.d)
     else:
