@@ -73,6 +73,11 @@ KRYLOV = True
 #: predictor residual of ~1e-12 m the next step's 1e-18 m is below the scenes' 1e-19 m... the
 #: step after it)
 GMRES_RTOL = 1e-6
+#: ... on disks with more free nodes than this: a smaller LU costs less than the Python of a
+#: few Krylov iterations (measured, cpu time of the sweeps: Fig 8's N = 100 member 0.20 s all
+#: Krylov, 0.15 s with this floor; Fig 4's 142-node member 0.67 -> 0.60 s; its 285 nodes
+#: 1.47 s either way, against 1.71 s without Krylov)
+KRYLOV_MIN_FREE = 150
 
 
 def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
@@ -94,7 +99,9 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     decision that must not be cut short - a fold, a landing, a state of the estimate). A
     stagnated state says so in ``diagnostics["stagnated"]`` (iterations, residual, best
     residual); converged states carry no diagnostics. ``stats`` (dict, optional) accumulates
-    the work done: "iterations", "factorisations" and "stagnated" (solves that gave up).
+    the work done: "solves", "iterations", "factorisations" and "stagnated" (solves that
+    gave up); with a "history" list in it, each iteration appends (residual (m), active
+    nodes, active set unchanged).
     """
     K, b = problem.K, problem.contour(d)
     sigma = problem.sigma
@@ -135,7 +142,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         F_I = (K @ w)[I] - P[I]
         m = disk_size(A)
         dw = None
-        if m is not None and KRYLOV:
+        if m is not None and KRYLOV and n - m > KRYLOV_MIN_FREE:
             # a disk: a Newton step solved by GMRES on the exact Jacobian, preconditioned by
             # a Cholesky of the energy Hessian that covers every disk from its margin on
             dw, pre, nf = _krylov_step(problem, h, A, m, F_I, pre)
@@ -159,6 +166,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         else:
             new_A = A
         res = _residual(problem, w, P - pc)
+        if stats is not None and "history" in stats:
+            stats["history"].append((res, int(A.sum()), bool(np.array_equal(new_A, A))))
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
             factor = (pre if fresh == "krylov" else lu if isinstance(lu, TrailingLU)
                       else (lu, lu_I))
@@ -186,8 +195,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         if res_it < STALL_FACTOR * mark or steady:
             mark, it_mark = min(res_it, mark), it
         elif stall_iter is not None and it - it_mark >= stall_iter:
-            stagnated = {"iterations": it, "residual_m": res_it, "best_residual_m": mark,
-                         "since_iteration": it_mark}
+            stagnated = {"d_m": d, "iterations": it, "residual_m": res_it,
+                         "best_residual_m": mark, "since_iteration": it_mark}
             break
     h = b - w
     pc = np.zeros(n)
