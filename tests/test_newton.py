@@ -187,3 +187,29 @@ def test_gmres_meets_its_tolerance_or_says_it_did_not():
     Ainv = np.linalg.inv(A)
     x3, k3, ok3 = gmres(lambda v: A @ v, lambda v: Ainv @ v, b, 1e-10)
     assert ok3 and k3 == 1
+
+
+def test_the_stagnation_exit_turns_down_no_step_the_whole_budget_accepts(monkeypatch):
+    """Each trial step that gave up in its stagnation window, solved again from the same start
+    with the whole budget, is not a step the continuation accepts (measured on the N = 240
+    sweep: it either ran to max_iter or converged across the fold, to the other branch); and
+    the solve that decides each fold - the last one at its landing separation - had the whole
+    budget."""
+    p = _problem(N)
+    calls = []
+    real = stepping.solve_complementarity
+
+    def solve(problem, d, w0, **kw):
+        st = real(problem, d, w0, **kw)
+        calls.append((d, np.array(w0), kw, st))
+        return st
+    monkeypatch.setattr(stepping, "solve_complementarity", solve)
+    ap, re = _sweeps(p)
+    stalled = [c for c in calls if "stagnated" in c[3].diagnostics]
+    assert stalled
+    for d, w0, kw, st in stalled:
+        full = real(p, d, w0, **{**kw, "stall_iter": None, "stats": None})
+        assert not stepping._accept(full, w0, d), (d, full.n_iter)
+    for j in ap.jumps + re.jumps:
+        last = [c for c in calls if c[0] == j.d_land][-1]
+        assert last[2]["stall_iter"] is None

@@ -11,6 +11,23 @@ updated by  i in A  <=>  p_c,i + c (sigma - h_i) > 0, the semismooth Newton step
 min-complementarity function. Convergence is declared on the residual of the original equation
 w - C (P - p_c) (m) with an unchanged active set.
 
+The linear systems. While the contact is a disk (nodes 0..m-1) with more than KRYLOV_MIN_FREE
+free nodes, each Newton step solves diag(area)(K + diag P')_II dw = -area F_I by GMRES,
+preconditioned by a Cholesky factor of the energy Hessian sym(S) + diag(area P') taken from a
+margin inside the contact edge (:class:`~femadh.contact.linalg.TrailingCholesky`): the factor
+of every trailing block is a leading part of it, so one factorisation serves the contact edge
+as it moves node by node, for many states, and the Krylov iteration makes each step a Newton
+step of the exact Jacobian (quadratic convergence) however stale the preconditioner (the
+collocation Jacobian is not symmetric: 1.4 % of its norm on the Fig 4 grid). Elsewhere (any
+other set, a small system, a Hessian that is not positive definite at an iterate off the
+stable branch, eq 20's adhesion on the contact set) a trailing LU of the collocation Jacobian
+takes chord steps (:class:`~femadh.contact.linalg.TrailingLU`), refactorised when the residual
+stops falling by CHORD_RATE.
+
+The stagnation exit (``stall_iter``, opt-in) ends a solve that has not halved its residual
+for STALL_ITER iterations: a continuation step across a fold, where no equilibrium is near
+the prediction, is then halved after ~10 iterations instead of 40.
+
 Stability of a converged state: :mod:`femadh.contact.stability` (the energy Hessian's inertia).
 """
 import math

@@ -19,6 +19,11 @@ more energy than that bound crossed a fold (the snap dissipates it) and is halve
 rejected step; a smooth peak of G inside the step can also exceed the bound, and one halving
 puts the peak at an end of the step where the bound holds again (measured on the bundled
 scenes: legitimate steps reach 0.7 of the bound away from peaks, Fig 8's smoothed jump-in 1.8).
+
+The same balance sorts the landings at the smallest step: one that releases less than the
+step's work is a node snapping across the lattice (:func:`lattice_snap`), stepped over; a
+contact's snap (jump-in, pull-off) releases ~150x it and is a jump. A trial step's corrector
+gives up when it stagnates (the smallest step's, which decides a fold, has its whole budget).
 """
 from dataclasses import dataclass, field
 import math
