@@ -633,7 +633,11 @@ DEFECTS = [
       (("STALL_ITER, STALL_FACTOR = 8, 0.5", "STALL_ITER, STALL_FACTOR = 2, 0.5"),)),
     D("newton_stall_at_fold_decision", "stepping: the fold's decision solve cut short by the "
       "stagnation exit", "femadh/contact/stepping.py",
-      (("stall_iter=None if smallest else STALL_ITER,", "stall_iter=STALL_ITER,"),)),
+      (("stall = None if smallest or trapped else STALL_ITER",
+        "stall = None if trapped else STALL_ITER"),)),
+    D("newton_stall_on_trapped_grid", "stepping: the stagnation exit also where nodes snap "
+      "on their own (a lattice-trapped grid)", "femadh/contact/stepping.py",
+      (("trapped = problem.surface_force_stiffness()[0] >= 1.0", "trapped = False"),)),
     D("lattice_snap_threshold", "stepping: a contact snap (~150x the step's work) taken for a "
       "lattice snap", "femadh/contact/stepping.py",
       (("return bool(released <= FOLD_ENERGY_SHARE_MIN_STEP * work + noise)",

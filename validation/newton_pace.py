@@ -159,7 +159,11 @@ def main(argv=None):
             "BLAS thread; counts over the whole run (see the script's docstring). The load "
             "is the machine's 1-minute load average when the row started (2 cores): "
             "wall times above a load of 2 are inflated, counts are not.\n\n" + table(rows))
-    Path(args.out).write_text(text)
+    out = Path(args.out)
+    if out.exists() and "\n## Notes" in out.read_text():
+        # the hand-written reading of an earlier table is kept below the new one
+        text += out.read_text()[out.read_text().index("\n## Notes"):]
+    out.write_text(text)
     print(f"wrote {args.out}")
     return 0
 

@@ -269,7 +269,13 @@ def _krylov_step(problem, h, A, m, F_I, pre):
 def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chord_rate):
     """A chord or Newton step dw on the free nodes from an LU of the collocation Jacobian
     K_II + diag(P'(h_I)): a trailing LU of the disk (reused while it covers the disk and the
-    residual falls by ``chord_rate`` per step), or of the free block of any other set.
+    residual falls by ``chord_rate`` per step), or of the free block of any other set - the
+    corrector as it was before the Krylov steps, kept as it was: on a lattice-trapped grid
+    (a law softening beyond a node's stiffness) the states reached depend on the iterates,
+    and these keep the ones it always reached. (Measured and not landed: a trailing LU that
+    covers its own block whatever its pivoting, with the held margin nodes at D = 0, halves
+    the LU count of Fig 4's approach, but on the 1 %-smoothed eq 20 slider at N = 100 it
+    reaches other lattice states: 7 jumps instead of 4.)
     Returns (dw, lu, lu_I, fresh, res_prev, factorisations)."""
     K, n = problem.K, h.size
     n_factor = 0
@@ -279,17 +285,13 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
     if m is not None:
         if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
             m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-            D = problem.dpressure(h)
-            cand = TrailingLU(K, np.where(A, 0.0, D), m0, problem.areas)
+            cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
             n_factor += 1
-            if not cand.covers(m):
-                # pivoting swapped rows inside the margin: factorise the disk's own block
-                # (it always covers itself; the general path would refactorise at the
-                # next iteration again, two factorisations per iteration)
-                cand = TrailingLU(K, D, m, problem.areas)
-                n_factor += 1
-            lu, lu_I, fresh = cand, None, True
-            res_prev = math.inf
+            if cand.covers(m):
+                lu, lu_I, fresh = cand, None, True
+                res_prev = math.inf
+            else:  # pivoting swapped rows inside the block: use the general path
+                m = None
         else:
             res_prev = res
     if m is not None:

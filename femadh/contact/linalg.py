@@ -33,10 +33,7 @@ class TrailingLU:
         self._block = (None, None)
 
     def covers(self, m):
-        """Whether the block from node m is solvable with this factorisation: its own block
-        (m = m0, whatever the pivoting did) or a trailing one whose leading part saw no row
-        swap."""
-        return m == self.m0 or (m > self.m0 and self.n - m <= self.k_valid)
+        return m >= self.m0 and self.n - m <= self.k_valid
 
     def _lu_block(self, m):
         k = self.n - m

@@ -261,6 +261,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     if on_state:
         on_state(state)
     g_state = total_force(problem, state)
+    # a law that softens beyond a node's stiffness somewhere the surfaces can reach: nodes
+    # snap on their own and the states depend on the path (no stagnation exit there)
+    trapped = problem.surface_force_stiffness()[0] >= 1.0
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -291,11 +294,13 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             sweep.d_current = d_try
             w_pred, act = _predict(problem, state, d_try)
             # the smallest step decides a fold: its corrector gets the whole budget; a larger
-            # step that stagnates is only halved
+            # step that stagnates is only halved - unless a node softens beyond its own
+            # stiffness (it snaps on its own: a slow corrector there is the lattice, and a
+            # different path of halvings lands on other lattice states)
             smallest = abs(step) <= min_step * 1.5
+            stall = None if smallest or trapped else STALL_ITER
             new = solve_complementarity(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
-                                        active0=act, factor=state.lu,
-                                        stall_iter=None if smallest else STALL_ITER,
+                                        active0=act, factor=state.lu, stall_iter=stall,
                                         stats=sweep.work)
             sweep.n_solves += 1
             if _accept(new, w_pred, d_try):
