@@ -11,6 +11,23 @@ updated by  i in A  <=>  p_c,i + c (sigma - h_i) > 0, the semismooth Newton step
 min-complementarity function. Convergence is declared on the residual of the original equation
 w - C (P - p_c) (m) with an unchanged active set.
 
+The linear systems. While the contact is a disk (nodes 0..m-1) with more than KRYLOV_MIN_FREE
+free nodes, each Newton step solves diag(area)(K + diag P')_II dw = -area F_I by GMRES,
+preconditioned by a Cholesky factor of the energy Hessian sym(S) + diag(area P') taken from a
+margin inside the contact edge (:class:`~femadh.contact.linalg.TrailingCholesky`): the factor
+of every trailing block is a leading part of it, so one factorisation serves the contact edge
+as it moves node by node, for many states, and the Krylov iteration makes each step a Newton
+step of the exact Jacobian (quadratic convergence) however stale the preconditioner (the
+collocation Jacobian is not symmetric: 1.4 % of its norm on the Fig 4 grid). Elsewhere (any
+other set, a small system, a Hessian that is not positive definite at an iterate off the
+stable branch, eq 20's adhesion on the contact set) a trailing LU of the collocation Jacobian
+takes chord steps (:class:`~femadh.contact.linalg.TrailingLU`), refactorised when the residual
+stops falling by CHORD_RATE.
+
+The stagnation exit (``stall_iter``, opt-in) ends a solve that has not halved its residual
+for STALL_ITER iterations: a continuation step across a fold, where no equilibrium is near
+the prediction, is then halved after ~10 iterations instead of 40.
+
 Stability of a converged state: :mod:`femadh.contact.stability` (the energy Hessian's inertia).
 """
 import math
@@ -19,7 +36,7 @@ import numpy as np
 from scipy import linalg
 
 from ..interrupt import check as safe_point
-from .linalg import TrailingLU, disk_size
+from .linalg import TrailingCholesky, TrailingLU, disk_size, gmres
 from .stability import is_stable
 from .state import State
 
@@ -31,6 +48,14 @@ CHORD_RATE = 0.05
 LARGE_N, CHORD_RATE_LARGE = 600, 0.15
 #: largest fraction of the current gap one Newton step may close (keeps h > 0 for LJ)
 MAX_GAP_CLOSURE = 0.8
+#: stagnation exit: a solve whose residual has not fallen below STALL_FACTOR of its last
+#: progress mark for STALL_ITER iterations (while its contact disk does not move steadily
+#: one way) gives up: there is no equilibrium near the prediction (a step across a fold).
+#: Measured on the Fig 4 scene (285 nodes): converging solves mark progress every 1-3
+#: iterations (slowest: the x0.7 linear descent while the edge moves node by node, and the
+#: disk then moves one way); the 15 solves across a fold that ran to max_iter = 40 hovered
+#: within a factor 2 of 1e-13 or cycled their contact edge back and forth from iteration 3 on
+STALL_ITER, STALL_FACTOR = 8, 0.5
 
 
 def _damping(h, dh_closing):
@@ -58,9 +83,27 @@ def _residual(problem, w, p_net):
 
 #: extra nodes factorised inside the contact edge so a shrinking contact stays covered
 DISK_MARGIN_FRACTION = 0.05
+#: Newton steps on a disk-shaped active set by preconditioned GMRES (False: the LU path only).
+#: Not with eq 20's adhesion on the contact set: a contact node then holds a tension up to
+#: P_LJa, so a node at the edge is stable both in and out of contact and the set a corrector
+#: reaches depends on its iterates (the Fig 8 scene's approach: the Krylov steps reached
+#: states one node apart from the LU path's, r_c at zero force 2 % off, about its estimated
+#: error); there the established LU path keeps the states it always found
+KRYLOV = True
+#: relative residual of the linear Newton system GMRES reaches: an inexact Newton step whose
+#: error is 1e-6 of the step (quadratic convergence holds down to the tolerance: from a
+#: predictor residual of ~1e-12 m the next step's 1e-18 m is below the scenes' 1e-19 m... the
+#: step after it)
+GMRES_RTOL = 1e-6
+#: ... on disks with more free nodes than this: a smaller LU costs less than the Python of a
+#: few Krylov iterations (measured, cpu time of the sweeps: Fig 8's N = 100 member 0.20 s all
+#: Krylov, 0.15 s with this floor; Fig 4's 142-node member 0.67 -> 0.60 s; its 285 nodes
+#: 1.47 s either way, against 1.71 s without Krylov)
+KRYLOV_MIN_FREE = 150
 
 
-def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None):
+def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
+                          stall_iter=None, stats=None):
     """Equilibrium at separation d (m) from displacements w0 (m): semismooth Newton on the
     sigma-gap complementarity problem (without a gap, Newton on eq 6).
 
@@ -72,6 +115,15 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     mask the factorisation is reused (chord steps), and refreshed only when the residual stops
     falling by CHORD_RATE per step. The LJ stiffness P'(h) is a small, slowly varying diagonal
     next to K, so chord steps converge almost as fast as Newton steps at a fraction of the cost.
+
+    ``stall_iter``: iterations without progress after which the solve gives up (the
+    continuation's trial steps pass STALL_ITER; None, the default: run to ``max_iter``, for a
+    decision that must not be cut short - a fold, a landing, a state of the estimate). A
+    stagnated state says so in ``diagnostics["stagnated"]`` (iterations, residual, best
+    residual); converged states carry no diagnostics. ``stats`` (dict, optional) accumulates
+    the work done: "solves", "iterations", "factorisations" and "stagnated" (solves that
+    gave up); with a "history" list in it, each iteration appends (residual (m), active
+    nodes, active set unchanged).
     """
     K, b = problem.K, problem.contour(d)
     sigma = problem.sigma
@@ -86,12 +138,18 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     else:
         A = b - w < sigma
     seen = set()
+    pre = factor if isinstance(factor, TrailingCholesky) else None
     if isinstance(factor, TrailingLU):
         lu, lu_I = factor, None
+    elif pre is not None:
+        lu, lu_I = None, None
     else:
         lu, lu_I = factor if factor is not None else (None, None)
     fresh = False
     res, res_prev, it = math.inf, math.inf, 0
+    n_factor, res_it = 0, math.inf
+    mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
+    stagnated = None
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
         # this state is on disk yet (femadh.interrupt)
@@ -105,33 +163,18 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         P = problem.pressure(h)
         F_I = (K @ w)[I] - P[I]
         m = disk_size(A)
-        # near the tolerance the residual approaches round-off and no step cuts it by
-        # CHORD_RATE; there a chord step only has to keep making progress
-        stalled = res > (chord_rate if res > 100 * tol else 0.7) * res_prev
-        if m is not None:
-            if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
-                m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-                cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
-                if cand.covers(m):
-                    lu, lu_I, fresh = cand, None, True
-                    res_prev = math.inf
-                else:  # pivoting swapped rows inside the block: use the general path
-                    m = None
-            else:
-                res_prev = res
-        if m is not None:
-            dw = -lu.solve(m, F_I)
-        else:
-            if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
-                    or stalled:
-                idx = np.flatnonzero(I)
-                M = K[idx[:, None], idx]
-                M[np.diag_indices_from(M)] += problem.dpressure(h[I])
-                lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
-                res_prev = math.inf
-            else:
-                res_prev = res
-            dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+        dw = None
+        if m is not None and KRYLOV and not adhesion and n - m > KRYLOV_MIN_FREE:
+            # a disk: a Newton step solved by GMRES on the exact Jacobian, preconditioned by
+            # a Cholesky of the energy Hessian that covers every disk from its margin on
+            dw, pre, nf = _krylov_step(problem, h, A, m, F_I, pre)
+            n_factor += nf
+            if dw is not None:
+                fresh = "krylov"
+        if dw is None:
+            dw, lu, lu_I, fresh, res_prev, nf = _lu_step(problem, h, A, I, m, F_I, lu, lu_I,
+                                                         fresh, res, res_prev, tol, chord_rate)
+            n_factor += nf
         alpha = _damping(h[I], dw)
         w[I] += alpha * dw
         h = b - w
@@ -145,9 +188,14 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         else:
             new_A = A
         res = _residual(problem, w, P - pc)
+        if stats is not None and "history" in stats:
+            stats["history"].append((res, int(A.sum()), bool(np.array_equal(new_A, A))))
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
-            factor = lu if isinstance(lu, TrailingLU) else (lu, lu_I)
+            factor = (pre if fresh == "krylov" else lu if isinstance(lu, TrailingLU)
+                      else (lu, lu_I))
+            _count(stats, it, n_factor, False)
             return _finish(problem, d, w, h, pc, A, it, res, factor, fresh)
+        res_it = res
         key = new_A.tobytes()
         if key in seen and not np.array_equal(new_A, A):
             # The active set cycles (non-convex LJ near the contact edge): accept only the
@@ -160,13 +208,117 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # rather than refactorised: the contact edge moves node by node along a sweep)
             res, res_prev = math.inf, math.inf
         A = new_A
+        # progress: the residual halves against its mark, or the contact disk keeps moving
+        # one way (an edge advancing node by node at a flat residual)
+        m_new = int(A.sum())
+        step_dir = (m_new > m_last) - (m_new < m_last)
+        steady = step_dir != 0 and step_dir == m_trend
+        m_trend, m_last = (step_dir or m_trend), m_new
+        if res_it < STALL_FACTOR * mark or steady:
+            mark, it_mark = min(res_it, mark), it
+        elif stall_iter is not None and it - it_mark >= stall_iter:
+            stagnated = {"d_m": d, "iterations": it, "residual_m": res_it,
+                         "best_residual_m": mark, "since_iteration": it_mark}
+            break
     h = b - w
     pc = np.zeros(n)
     if sigma is not None and np.all(h[~A] > 0):
         pc[A] = problem.pressure(h)[A] - (K @ w)[A]
-    return State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300), A),
-                 _contact_pressure(problem, pc, A), A,
-                 _area_radius(problem, A), it, res, False, False, None)
+    _count(stats, it, n_factor, stagnated is not None)
+    st = State(d, w, h, _effect_pressures(problem, np.maximum(h, 1e-300), A),
+               _contact_pressure(problem, pc, A), A,
+               _area_radius(problem, A), it, res_it, False, False, None)
+    if stagnated is not None:
+        st.diagnostics["stagnated"] = stagnated
+    return st
+
+
+def _krylov_step(problem, h, A, m, F_I, pre):
+    """A Newton step dw on the free nodes m..n-1 of a disk contact: GMRES on the area-scaled
+    Jacobian diag(area)(K + diag(P'(h)))_II, preconditioned by ``pre`` (a
+    :class:`TrailingCholesky` of the energy Hessian), refreshed at h when it does not cover
+    the disk or GMRES does not reach GMRES_RTOL within its Krylov dimension.
+
+    Returns (dw or None, preconditioner, factorisations); None when the Hessian at h is not
+    positive definite on the free nodes (an iterate off the stable branch): the LU path
+    takes the step."""
+    n = h.size
+    D = problem.dpressure(h)
+    a, D_I, K_II = problem.areas[m:], D[m:], problem.K[m:, m:]
+
+    def apply_a(v):
+        return a * (K_II @ v + D_I * v)
+
+    rhs = -a * F_I
+    n_factor = 0
+    for attempt in range(2):
+        if attempt or not (isinstance(pre, TrailingCholesky) and pre.covers(m)):
+            # held nodes of the margin enter with D = 0 (they are fixed; when released the
+            # Krylov iteration corrects their stiffness)
+            m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            pre = TrailingCholesky(problem.S_sym, problem.areas, np.where(A, 0.0, D), m0)
+            n_factor += 1
+            if not pre.covers(m):
+                return None, pre, n_factor
+        dw, _, ok = gmres(apply_a, lambda r: pre.solve(m, r), rhs, GMRES_RTOL)
+        if ok:
+            return dw, pre, n_factor
+    return None, pre, n_factor
+
+
+def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chord_rate):
+    """A chord or Newton step dw on the free nodes from an LU of the collocation Jacobian
+    K_II + diag(P'(h_I)): a trailing LU of the disk (reused while it covers the disk and the
+    residual falls by ``chord_rate`` per step), or of the free block of any other set - the
+    corrector as it was before the Krylov steps, kept as it was: on a lattice-trapped grid
+    (a law softening beyond a node's stiffness) the states reached depend on the iterates,
+    and these keep the ones it always reached. (Measured and not landed: a trailing LU that
+    covers its own block whatever its pivoting, with the held margin nodes at D = 0, halves
+    the LU count of Fig 4's approach, but on the 1 %-smoothed eq 20 slider at N = 100 it
+    reaches other lattice states: 7 jumps instead of 4.)
+    Returns (dw, lu, lu_I, fresh, res_prev, factorisations)."""
+    K, n = problem.K, h.size
+    n_factor = 0
+    # near the tolerance the residual approaches round-off and no step cuts it by
+    # CHORD_RATE; there a chord step only has to keep making progress
+    stalled = res > (chord_rate if res > 100 * tol else 0.7) * res_prev
+    if m is not None:
+        if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
+            m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
+            n_factor += 1
+            if cand.covers(m):
+                lu, lu_I, fresh = cand, None, True
+                res_prev = math.inf
+            else:  # pivoting swapped rows inside the block: use the general path
+                m = None
+        else:
+            res_prev = res
+    if m is not None:
+        dw = -lu.solve(m, F_I)
+    else:
+        if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
+                or stalled:
+            idx = np.flatnonzero(I)
+            M = K[idx[:, None], idx]
+            M[np.diag_indices_from(M)] += problem.dpressure(h[I])
+            lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+            n_factor += 1
+            res_prev = math.inf
+        else:
+            res_prev = res
+        dw = -linalg.lu_solve(lu, F_I, check_finite=False)
+    return dw, lu, lu_I, fresh, res_prev, n_factor
+
+
+def _count(stats, iterations, factorisations, stagnated):
+    """Add one solve's work to ``stats`` (a dict, or None: not counted)."""
+    if stats is None:
+        return
+    stats["solves"] = stats.get("solves", 0) + 1
+    stats["iterations"] = stats.get("iterations", 0) + iterations
+    stats["factorisations"] = stats.get("factorisations", 0) + factorisations
+    stats["stagnated"] = stats.get("stagnated", 0) + int(stagnated)
 
 
 def _restrict_change(A, new_A):
@@ -212,6 +364,16 @@ def tangent(problem, state):
     D = problem.dpressure(state.h)
     rhs = D[I] - problem.K[np.ix_(I, A)].sum(axis=1)
     m = disk_size(A)
+    if isinstance(state.lu, TrailingCholesky) and m is not None and state.lu.covers(m):
+        a, K_II = problem.areas[m:], problem.K[m:, m:]
+        t_I, _, ok = gmres(lambda v: a * (K_II @ v + D[m:] * v),
+                           lambda r: state.lu.solve(m, r), a * rhs, GMRES_RTOL)
+        if not ok:
+            return np.zeros(state.w.size)  # no converged solve: zeroth order
+        t[I] = t_I
+        return t
+    if isinstance(state.lu, TrailingCholesky):
+        return np.zeros(state.w.size)
     if isinstance(state.lu, TrailingLU) and m is not None and state.lu.covers(m):
         t[I] = state.lu.solve(m, rhs)
         return t

@@ -1,4 +1,6 @@
-"""Factorisations that follow a moving contact edge."""
+"""Factorisations that follow a moving contact edge, and the Krylov solver they precondition."""
+import math
+
 import numpy as np
 from scipy import linalg
 
@@ -56,3 +58,134 @@ def disk_size(A):
     """m if the active set is exactly the nodes 0..m-1, else None."""
     m = int(A.sum())
     return m if A[:m].all() else None
+
+
+class TrailingCholesky:
+    """One Cholesky factorisation that preconditions every trailing block from m >= m0.
+
+    The matrix is the symmetric energy Hessian sym(S) + diag(area D) (N/m, S = diag(area) K;
+    :meth:`ContactProblem.energy_hessian`) in reversed node order, so that every trailing
+    block is a leading block, and the Cholesky factor U of a leading block is the leading part
+    of the full factor - there is no pivoting to spoil it (unlike :class:`TrailingLU`). It is
+    positive definite near a stable state; where it is not, ``k_valid`` is the largest leading
+    block that is (LAPACK potrf's info), and blocks beyond it are not covered. The inverse of
+    U is kept (the leading block of the inverse of a triangular matrix is the inverse of its
+    leading block), so a solve is two products with views of it: no copy per block.
+
+    It differs from the area-scaled collocation Jacobian diag(area)(K + D) by the
+    antisymmetric part of S (measured 1.4 % of its norm on the Fig 4 scene's 285-node grid)
+    and by the change of D since it was built: a preconditioner for :func:`gmres`, not a solver.
+    """
+
+    def __init__(self, S_sym, areas, D, m0):
+        from scipy.linalg import lapack
+
+        n = S_sym.shape[0]
+        M = np.array(S_sym[m0:, m0:][::-1, ::-1], order="F")
+        M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
+        u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
+        self.n, self.m0 = n, m0
+        self.k_valid = n - m0 if info == 0 else int(info) - 1
+        k = self.k_valid
+        self.uinv = self.uinv_t = np.zeros((0, 0))
+        if k > 0:
+            ui, info = lapack.dtrtri(np.asfortranarray(u[:k, :k]), lower=False)
+            if info != 0:       # a zero pivot in U: nothing beyond it is covered
+                self.k_valid = 0
+            else:
+                # kept in natural node order (the reversed order's leading blocks are its
+                # trailing blocks), with the transpose as its own contiguous copy: both
+                # products of a solve run in BLAS on views (a reversed, negative-stride
+                # vector would take numpy off BLAS: 100 us instead of 20 at k = 225)
+                self.uinv = np.ascontiguousarray(ui[::-1, ::-1])
+                self.uinv_t = np.ascontiguousarray(self.uinv.T)
+
+    @classmethod
+    def from_inverse(cls, uinv, n, m0, k_valid):
+        """The preconditioner from its kept inverse factor (a checkpoint's arrays)."""
+        out = cls.__new__(cls)
+        out.n, out.m0, out.k_valid = n, m0, k_valid
+        out.uinv = np.ascontiguousarray(uinv)
+        out.uinv_t = np.ascontiguousarray(out.uinv.T)
+        return out
+
+    def covers(self, m):
+        return m >= self.m0 and self.n - m <= self.k_valid
+
+    def solve(self, m, rhs):
+        """x with H[m:, m:] x = rhs (natural node order m..n-1): x = U^-1 U^-T rhs."""
+        k = self.n - m
+        if k <= 0:
+            return np.zeros(0)
+        if not self.covers(m):
+            raise ValueError(f"trailing block from node {m} is not covered (m0 = {self.m0}, "
+                             f"positive definite leading size {self.k_valid})")
+        return self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ rhs)
+
+
+#: Krylov dimension of one preconditioned solve before it counts as failed
+GMRES_MAX = 12
+
+
+def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
+    """Right-preconditioned GMRES for a small dense system A x = b (Givens rotations).
+
+    Parameters
+    ----------
+    apply_a, apply_m : callable(ndarray) -> ndarray
+        The product with A and the preconditioner's solve M^-1.
+    b : ndarray
+    rtol : float
+        Relative residual |b - A x| / |b| to reach.
+    maxiter : int
+        Krylov dimension (the cap of the loop).
+
+    Returns
+    -------
+    (x, iterations, converged)
+        x = M^-1 V y minimises |b - A x| over the Krylov space; converged: rtol met.
+    """
+    beta = float(np.linalg.norm(b))
+    n = b.size
+    if beta == 0.0 or n == 0:
+        return np.zeros(n), 0, True
+    V = np.empty((maxiter + 1, n))
+    Z = np.empty((maxiter, n))
+    R = np.zeros((maxiter + 1, maxiter))
+    cs, sn = np.zeros(maxiter), np.zeros(maxiter)
+    g = np.zeros(maxiter + 1)
+    g[0] = beta
+    V[0] = b / beta
+    j = 0
+    for j in range(maxiter):
+        Z[j] = apply_m(V[j])
+        w = apply_a(Z[j])
+        # classical Gram-Schmidt, twice (as stable as modified, in two BLAS calls each)
+        h = V[:j + 1] @ w
+        w = w - h @ V[:j + 1]
+        h2 = V[:j + 1] @ w
+        w = w - h2 @ V[:j + 1]
+        col = np.append(h + h2, np.linalg.norm(w))
+        for i in range(j):      # the earlier rotations on the new column
+            a, c = col[i], col[i + 1]
+            col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c
+        r = math.hypot(col[j], col[j + 1])
+        cs[j], sn[j] = (1.0, 0.0) if r == 0 else (col[j] / r, col[j + 1] / r)
+        breakdown = col[j + 1] <= 1e-14 * beta
+        V[j + 1] = w / col[j + 1] if not breakdown else 0.0
+        col[j], col[j + 1] = r, 0.0
+        R[:j + 1, j] = col[:j + 1]
+        g[j + 1] = -sn[j] * g[j]
+        g[j] = cs[j] * g[j]
+        if abs(g[j + 1]) <= rtol * beta or breakdown:
+            break
+    k = j + 1
+    y = _back_substitute(R[:k, :k], g[:k])
+    return y @ Z[:k], k, bool(abs(g[k]) <= rtol * beta)
+
+
+def _back_substitute(R, g):
+    """y with the upper triangular R y = g (small: GMRES's Hessenberg after rotation)."""
+    from scipy.linalg import solve_triangular
+
+    return solve_triangular(R, g, lower=False, check_finite=False)

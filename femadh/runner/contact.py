@@ -581,7 +581,7 @@ CHECKPOINT = "checkpoint.npz"
 def _save_checkpoint(folder, sink):
     """Write the last committed state whole (npz, no pickle), if the sweep has one this
     format holds (complementarity / smooth laws; the closure's states are re-solved)."""
-    from ..contact.linalg import TrailingLU
+    from ..contact.linalg import TrailingCholesky, TrailingLU
     from ..io.atomic import save_atomic
 
     if sink is None or sink.writer is None or sink.last_state is None:
@@ -603,6 +603,9 @@ def _save_checkpoint(folder, sink):
                     dims=np.array([lu.n, lu.m0, lu.k_valid]))
         if lu.scale is not None:
             data["scale"] = lu.scale
+    elif isinstance(lu, TrailingCholesky):
+        data.update(lu_kind=np.array("cholesky"), lu=lu.uinv, dims=np.array([lu.n, lu.m0,
+                                                                             lu.k_valid]))
     elif isinstance(lu, tuple) and len(lu) == 2 and isinstance(lu[0], tuple):
         data.update(lu_kind=np.array("dense"), lu=lu[0][0], piv=lu[0][1], lu_I=lu[1])
     else:
@@ -616,7 +619,7 @@ def _save_checkpoint(folder, sink):
 def _load_checkpoint(folder, k, d):
     """The whole state number k at separation d from the checkpoint, or None (absent, of
     another state, unreadable: the caller re-solves the state from fields.csv)."""
-    from ..contact.linalg import TrailingLU
+    from ..contact.linalg import TrailingCholesky, TrailingLU
 
     path = folder / CHECKPOINT
     if not path.exists():
@@ -632,6 +635,8 @@ def _load_checkpoint(folder, k, d):
                 lu.lu, lu.piv = z["lu"], z["piv"]
                 lu.scale = z["scale"] if "scale" in z.files else None
                 lu._block = (None, None)
+            elif kind == "cholesky":
+                lu = TrailingCholesky.from_inverse(z["lu"], *(int(x) for x in z["dims"]))
             elif kind == "dense":
                 lu = ((z["lu"], z["piv"]), z["lu_I"])
             else:
