@@ -112,7 +112,7 @@ def _note(msg):
 def _compare(scene, curve, offset, args):
     from .errors import FemadhError
     from .fitting.compare import compare, write_comparison
-    from .runner.contact import run
+    from .runner.run import run
 
     res = run(scene, None, figures=False, progress=False, estimate=False)
     if res.status != "converged":

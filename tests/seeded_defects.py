@@ -216,8 +216,8 @@ DEFECTS = [
     # -- layered substrates
     D("layered_sphere_compliance", "layered scene: the slider's own compliance dropped",
       "femadh/scene/build.py",
-      (("layers=body.layers,\n                                   sphere=body.slider)",
-        "layers=body.layers,\n                                   sphere=None)"),)),
+      (("FEOperator.layered(grid, body.disk, body.layers, body.slider, settings,",
+        "FEOperator.layered(grid, body.disk, body.layers, None, settings,"),)),
     D("hankel_sphere_twice", "Hankel layered operator: the sphere's compliance counted twice",
       "femadh/judges.py",
       (("+ GreenOperator(grid, sphere.plane_strain_modulus).compliance)",

@@ -1,8 +1,10 @@
 """The floors of the package, read from the source with ``ast`` (nothing is imported).
 
-- The solver packages (``femadh/elastic/``, ``femadh/contact/``, ``femadh/laws/``) import
-  neither the judges (``femadh.reference``: their independence is the point of a judge) nor
-  the layers built on the solvers (``femadh.runner``, ``femadh.studies``).
+- The solver packages (``femadh/elastic/``, ``femadh/contact/``, ``femadh/laws/``), the
+  discretisation (``femadh/discretisation/``) and the error machinery (``femadh/estimate/``)
+  import neither the judges (``femadh.reference``: their independence is the point of a
+  judge) nor the layers built on them (``femadh.runner``, ``femadh.studies``, which both use
+  the discretisation and the error machinery: a home of its own, not one of theirs).
 - Tests use public names only: no ``from femadh... import _name`` or
   ``from validation... import _name``, no private module in an import path.
 """
@@ -12,7 +14,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SOLVERS = ("elastic", "contact", "laws")
+SOLVERS = ("elastic", "contact", "laws", "discretisation", "estimate")
 FORBIDDEN = ("femadh.reference", "femadh.runner", "femadh.studies")
 
 

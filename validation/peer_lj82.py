@@ -104,4 +104,9 @@ effectivity ~4, conservative.
 
 
 if __name__ == "__main__":
+    import argparse
+
+    # no arguments: --help says what it writes instead of running it
+    argparse.ArgumentParser(prog="python -m validation.peer_lj82",
+                            description=__doc__.split("\n\n")[0]).parse_args()
     main()

@@ -21,7 +21,7 @@ except ModuleNotFoundError:
 
 from femadh.io.atomic import save_atomic
 from femadh.reference.gw import mean_plane_dominance_bound, paper1_table2_roughness
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.scene import scene_from_dict
 
 from .paper1 import (HEAD, _fmt, closure_sweeps, complementarity_sweeps, curve, jumps,

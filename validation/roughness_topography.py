@@ -152,7 +152,7 @@ def scene_runs(surfaces, folder):
         import tomllib
     except ModuleNotFoundError:
         import tomli as tomllib
-    from femadh.runner.contact import run
+    from femadh.runner.run import run
     from femadh.scene import load_scene
 
     base = (HERE / "scenes" / "paper1_slider_gw.toml").read_text()

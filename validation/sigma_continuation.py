@@ -14,7 +14,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from femadh.contact import trace  # noqa: E402
 from femadh.contact.forces import state_forces  # noqa: E402
 from femadh.contact.sigma_arclength import curve_state, path_w_at, trace_sigma_curve  # noqa
-from femadh.runner.contact import run  # noqa: E402
+from femadh.runner.run import run  # noqa: E402
 from femadh.scene import build_problem, load_scene, scene_from_dict  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

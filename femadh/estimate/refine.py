@@ -51,7 +51,7 @@ class Outcome:
         "met", "refinements" (the budget's refinements spent), "nodes" (the next refinement
         would exceed the budget's nodes) or "no refinement" (none addresses the failure).
     steps : list of dict
-        Per attempt: setting, nodes, error, why.
+        Per attempt: its setting, error and why (the caller keeps anything else it needs).
     """
 
     met: bool

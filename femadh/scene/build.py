@@ -10,11 +10,6 @@ key by construction.
 from .parts import content_hash
 
 
-def scene_grid(scene):
-    """The scene's radial nodes: its [solver.grid] member, else N uniform nodes."""
-    return discretisation_grid(scene.discretisation)
-
-
 def discretisation_grid(disc):
     """The radial nodes of a :class:`~femadh.scene.parts.Discretisation`: its banded grid's
     member, else N uniform nodes on [0, a]."""

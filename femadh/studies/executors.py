@@ -69,9 +69,6 @@ def study_operator_key(sc):
     return operator_key(*sc.operator_inputs)
 
 
-#: the name of earlier versions (femadh.fitting reads it)
-
-
 def worker_operator(sc):
     """``(operator, reused)``: the surface operator of a point's scene, the one kept in this
     process when its key matches (``reused``), else built and kept instead (one operator per
@@ -113,7 +110,7 @@ def run_point(point, root, estimate=True):
     (``finished``). A signal that stops the point's run is recorded ("interrupted") and then
     ends a pool worker with that signal, so that the driver's shutdown does not wait for it."""
     from .._threads import blas_threads
-    from ..runner.contact import run
+    from ..runner.run import run
     import warnings
 
     tune_malloc()

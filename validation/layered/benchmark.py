@@ -150,4 +150,7 @@ solved per state) costs {old_ms:.0f} ms per state on the homogeneous operator he
 
 
 if __name__ == "__main__":
+    from .common import no_arguments
+
+    no_arguments("validation.layered.benchmark", __doc__)
     main()

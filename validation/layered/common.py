@@ -19,6 +19,16 @@ from femadh.studies.smooth_sphere import lj_force
 RESULTS = Path(__file__).resolve().parents[1] / "results"
 
 
+def no_arguments(prog, doc, argv=None):
+    """The command line of a study that takes no arguments: ``--help`` prints ``doc``'s
+    first paragraph (what the study writes) instead of running it; anything else is refused
+    in one line."""
+    import argparse
+
+    argparse.ArgumentParser(prog=f"python -m {prog}", description=doc.split("\n\n")[0]
+                            ).parse_args(argv)
+
+
 def rel(w, ref):
     """max |w - ref| / max |ref|."""
     return float(np.max(np.abs(w - ref)) / np.max(np.abs(ref)))

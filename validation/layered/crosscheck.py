@@ -252,4 +252,7 @@ compliance is within O(0.5 - nu) of the incompressible one.
 
 
 if __name__ == "__main__":
+    from .common import no_arguments
+
+    no_arguments("validation.layered.crosscheck", __doc__)
     main()

@@ -240,4 +240,7 @@ contact DMT-like), and the glass's DMT limit 2 for t -> 0.
 
 
 if __name__ == "__main__":
+    from .common import no_arguments
+
+    no_arguments("validation.layered.film", __doc__)
     main()

@@ -72,4 +72,7 @@ def main():
 
 
 if __name__ == "__main__":
+    from .common import no_arguments
+
+    no_arguments("validation.layered.render", __doc__)
     main()

@@ -173,4 +173,7 @@ agree on the size and sign of every effect (to ~1e-6 of the force; the coat's ef
 
 
 if __name__ == "__main__":
+    from .common import no_arguments
+
+    no_arguments("validation.layered.slider", __doc__)
     main()

@@ -32,7 +32,7 @@ MATERIALS = Table("materials", "Elastic constants: disk and slider (composite mo
 ))
 
 #: the largest Poisson ratio the FE body takes (its mixed formulation eliminates the pressure
-#: with a finite lambda; equal to femadh.elastic.fe.operator.NU_LIMIT, tested)
+#: with a finite lambda; equal to femadh.elastic.fe.settings.NU_LIMIT, tested)
 LAYER_NU_LIMIT = 0.49999
 
 LAYER = Table("substrate.layers", "One bonded elastic layer (an element of the layers list, "

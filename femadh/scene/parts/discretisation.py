@@ -152,7 +152,7 @@ class Discretisation:
         that nobody changes the scene's through it), or None for the Green method."""
         if self.mesh is None:
             return None
-        from ...elastic.fe.operator import FESettings
+        from ...elastic.fe.settings import FESettings
 
         return FESettings(**self.mesh)
 
@@ -161,7 +161,7 @@ def fe_mesh(mesh, nu_default):
     """The FE mesh settings of a [solver.mesh] table (as :data:`MESH_SETTINGS` values) and the
     FE body's Poisson ratio (the table's, else ``nu_default``). The settings are checked by
     building them once (FESettings raises for values outside its ranges)."""
-    from ...elastic.fe.operator import FESettings
+    from ...elastic.fe.settings import FESettings
 
     settings = {k: mesh[k] for k in MESH_SETTINGS}
     FESettings(**settings)
