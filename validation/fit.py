@@ -190,4 +190,9 @@ def main():
 
 
 if __name__ == "__main__":
+    import argparse
+
+    # no arguments: --help says what it writes instead of running it
+    argparse.ArgumentParser(prog="python -m validation.fit",
+                            description=__doc__.split("\n\n")[0]).parse_args()
     main()

@@ -81,4 +81,9 @@ def main():
 
 
 if __name__ == "__main__":
+    import argparse
+
+    # no arguments: --help says what it writes instead of running it
+    argparse.ArgumentParser(prog="python -m validation.mems_verdict",
+                            description=__doc__.split("\n\n")[0]).parse_args()
     main()
