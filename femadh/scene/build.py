@@ -11,6 +11,13 @@ def scene_grid(scene):
         from ..discretisation import GridFamily
 
         g = scene.grid
+        if g.get("follow"):
+            # a band that follows the contact edge: its first member is centred on r = 0
+            # (the runner exchanges it as the edge moves, femadh.discretisation.moving)
+            from ..discretisation.moving import follow_family
+
+            return follow_family(scene.analysis_radius, g["follow"], g["grading"],
+                                 0.0).member(g["spacing"])
         return GridFamily(scene.analysis_radius, g["band"], g["grading"]).member(g["spacing"])
     return RadialGrid.uniform(scene.analysis_radius, scene.nodes)
 
