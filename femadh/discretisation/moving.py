@@ -124,3 +124,62 @@ def follow_family(radius, half, grading, center):
     surrounds a feature at radius ``center`` (m)."""
     return GridFamily(radius, min(radius, max(center, 0.0) + half), grading,
                       inner=max(center, 0.0) - half)
+
+
+class EdgeBand(MovingBand):
+    """A band that follows the features of a stepping sweep (all lengths in m).
+
+    The band spans [lo - half, hi + half] (clipped to [0, radius]): ``lo`` the outermost
+    radius where the gap is at most ``inner_gap`` (the contact or cohesive-zone edge: the
+    smallest feature gap of the laws), ``hi`` where it is at most ``edge_gap`` (the largest:
+    a meniscus edge far out at high humidity, or the cohesive zone's outer end). Where the
+    two coincide (LJ alone, a meniscus at low humidity) it is a band of width 2 half around
+    the edge; where they are far apart it covers both and what lies between.
+
+    :meth:`regrid` gives a new problem once ``lo`` or ``hi`` has moved more than half a
+    half-width from where the band was built for; the new band leads each moving edge by
+    half a half-width (it crosses the band's middle before the next exchange).
+    """
+
+    def __init__(self, radius, spacing, half, grading, build, edge_gap, inner_gap):
+        super().__init__(radius, spacing, half, grading, build, edge_gap)
+        self.inner_gap = min(inner_gap, edge_gap)
+        self.spans = {}
+
+    def span_family(self, lo, hi):
+        """The family whose band is [lo - half, hi + half] (clipped)."""
+        lo, hi = max(lo, 0.0), max(hi, lo, 0.0)
+        return GridFamily(self.radius, min(self.radius, hi + self.half), self.grading,
+                          inner=lo - self.half)
+
+    def problem(self, lo=0.0, hi=None):
+        """The problem on the member whose band surrounds the edges lo and hi (m)."""
+        hi = lo if hi is None else hi
+        pb = self.build(self.span_family(lo, hi).member(self.spacing), not self.spans)
+        self.spans[id(pb)] = (lo, hi)
+        self.centers[id(pb)] = 0.5 * (lo + hi)
+        return pb
+
+    def edges(self, problem, w, d):
+        """(lo, hi): the radii (m) of the inner and outer feature edges of a state."""
+        return (contact_edge(problem, w, d, self.inner_gap),
+                contact_edge(problem, w, d, self.edge_gap))
+
+    def band_offset(self, problem, edge):
+        """How far (in half-widths) ``edge`` lies beyond the span the band was built for (0
+        inside it; above 1 the edge is outside the fine band)."""
+        lo, hi = self.spans[id(problem)]
+        return max(0.0, lo - edge, edge - hi) / self.half
+
+    def regrid(self, problem, w, d):
+        """A grid whose band leads the moving edges, once either has moved more than half a
+        half-width from where the band was built; None while both are within it."""
+        lo0, hi0 = self.spans[id(problem)]
+        lo, hi = self.edges(problem, w, d)
+        lim = 0.5 * self.half
+        if abs(lo - lo0) <= lim and abs(hi - hi0) <= lim:
+            return None
+
+        def lead(x, x0):
+            return x + math.copysign(lim, x - x0) if abs(x - x0) > lim else x
+        return self.problem(lead(lo, lo0), lead(hi, hi0))

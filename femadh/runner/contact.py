@@ -542,21 +542,24 @@ class _Regrid(Exception):
 
 
 def _follower(scene, problem):
-    """The :class:`~femadh.discretisation.moving.MovingBand` of a scene whose [solver.grid]
-    sets ``follow`` (its edge: the outermost gap at the laws' feature gap), else None."""
+    """The :class:`~femadh.discretisation.moving.EdgeBand` of a scene whose [solver.grid]
+    sets ``follow`` (its edges: the outermost gaps at the laws' smallest and largest feature
+    gaps), else None."""
     g = scene.grid
     if not (g and g.get("follow")) or problem.sigma is None:
         return None
-    from ..discretisation.moving import MovingBand
+    from ..discretisation.moving import EdgeBand
     from ..discretisation.plan import feature_gap, reach_floor
     from ..elastic import GreenOperator
 
     def build(grid, first):
         return build_problem(scene, operator=GreenOperator(grid, scene.e_star))
-    band = MovingBand(problem.grid.radius, g["spacing"], g["follow"], g["grading"], build,
-                      feature_gap(problem.effects, reach_floor(problem.effects,
-                                                               problem.sigma)))
-    band.centers[id(problem)] = 0.0          # the scene's own first member (scene_grid)
+    floor = reach_floor(problem.effects, problem.sigma)
+    gaps = [feature_gap({k: e}, floor) for k, e in problem.effects.items()] or [floor]
+    band = EdgeBand(problem.grid.radius, g["spacing"], g["follow"], g["grading"], build,
+                    max(gaps), min(gaps))
+    band.spans[id(problem)] = (0.0, 0.0)     # the scene's own first member (scene_grid)
+    band.centers[id(problem)] = 0.0
     return band
 
 
@@ -565,7 +568,7 @@ def _regridded(band, sink, problem, state, scene):
     The sink and its writer write on the new grid from here on; the states the peak search
     and a branch's restart need are carried to it (their displacements interpolated: the
     search solves fresh states from them)."""
-    from ..discretisation.moving import carry_state, interpolate_state
+    from ..discretisation.moving import carry_state
 
     new = band.regrid(problem, state.w, state.d)
     if new is None:
@@ -576,17 +579,49 @@ def _regridded(band, sink, problem, state, scene):
             f"grid exchange at d = {state.d * 1e9:.6g} nm (band following the contact edge): "
             "the state carried to the new grid did not converge to a stable state",
             d=state.d, residual=st.residual, n_iter=st.n_iter)
+    _exchange(sink, problem, new)
+    return new, st
+
+
+def _exchange(sink, old, new):
+    """The sink (and its writer) on ``new``'s grid from here on; the committed states the
+    peak search and a branch's restart need carried to it (their displacements interpolated:
+    the search solves fresh states from them)."""
+    from ..discretisation.moving import interpolate_state
+
     snaps = ([s for s in sink.peak[2:] if s is not None] if sink.peak else []) + \
         list(sink.last.values())
     for snap in {id(x): x for x in snaps}.values():
         if getattr(snap, "w", None) is not None and np.ndim(snap.w) == 1 and \
-                snap.w.size == problem.grid.n:
-            snap.w, snap.active = interpolate_state(problem, new, snap.d, snap.w)
+                snap.w.size == old.grid.n:
+            snap.w, snap.active = interpolate_state(old, new, snap.d, snap.w)
     sink.problem = new
     if sink.writer is not None:
         sink.writer.problem = new
     sink.regrids = getattr(sink, "regrids", 0) + 1
-    return new, st
+
+
+def _widened(band, sink, problem, state, scene):
+    """(the static-band problem, ``state`` carried to it): the scene's [0, band] at the
+    follow band's spacing and grading (a landing's fallback, :func:`_trace_steps`)."""
+    from ..discretisation import GridFamily
+    from ..discretisation.moving import carry_state
+
+    g = scene.grid
+    wide = band.build(GridFamily(band.radius, g["band"], band.grading).member(band.spacing),
+                      False)
+    band.spans[id(wide)] = (0.0, g["band"])
+    band.centers[id(wide)] = 0.5 * g["band"]
+    st = carry_state(problem, wide, state, tol=scene.tolerance, max_iter=scene.max_iter)
+    if not (st.converged and st.stable):
+        raise ConvergenceError(
+            f"grid exchange at d = {state.d * 1e9:.6g} nm (to the static band after a failed "
+            "landing): the carried state did not converge to a stable state", d=state.d,
+            residual=st.residual, n_iter=st.n_iter)
+    _exchange(sink, problem, wide)
+    sink.widened = getattr(sink, "widened", 0) + 1
+    sink.wide = wide
+    return wide, st
 
 
 def _trace_steps(scene, problem, sink, resume):
@@ -612,22 +647,30 @@ def _trace_steps(scene, problem, sink, resume):
         elif start is None and prev is not None:    # resume at the start of this branch
             start = _restart_state(problem, scene, sink, prev)
         sink.plan(branch, len(d_vals) - skip_first, total)
+        wide = None                   # where this branch last went to the static band
         while True:
             first = [skip_first]
             seen = [0]
+            last = [start]            # the last committed state (on the current grid)
+            jumped = [0]              # jumps recorded since it
 
-            def on_state(st, branch=branch, d_vals=d_vals, first=first, seen=seen):
+            def on_state(st, branch=branch, d_vals=d_vals, first=first, seen=seen,
+                         last=last, jumped=jumped):
                 seen[0] += 1
                 if first[0]:          # the resumed (or carried) start state is on disk
                     first[0] = False
                     return
-                sink.state(branch, st)
+                # the edge left the band's middle: the state is committed on the new grid
+                # (every committed state on a grid whose band holds its edges)
                 moved = band and _regridded(band, sink, sink.problem, st, scene)
+                last[0], jumped[0] = (moved[1] if moved else st), 0
+                sink.state(branch, last[0])
                 if moved:
                     raise _Regrid(*moved, d_vals[seen[0] - 1:])
 
-            def on_jump(jump, d_vals=d_vals):
+            def on_jump(jump, d_vals=d_vals, jumped=jumped):
                 sink.jump(jump)
+                jumped[0] += 1
                 moved = band and _regridded(band, sink, sink.problem, jump.after, scene)
                 if moved:
                     # on from the landing: the separations beyond it
@@ -643,10 +686,23 @@ def _trace_steps(scene, problem, sink, resume):
                 if len(d_vals) > 1:
                     continue
                 sweep = None
+            except ConvergenceError:
+                # a fold whose landing failed on a follow grid (the surface snapped to where
+                # the grid is coarse, e.g. the jump-in from no contact): the step once more
+                # from the last committed state on the static band [0, band], which holds
+                # wherever the edge can go; the next exchange returns to the follow band
+                if band is None or jumped[0] or seen[0] == 0 or last[0] is None \
+                        or wide == last[0].d or problem is getattr(sink, "wide", None):
+                    raise
+                wide = last[0].d
+                problem, start = _widened(band, sink, problem, last[0], scene)
+                d_vals, skip_first = d_vals[seen[0] - 1:], True
+                continue
             break
         start, prev = (sweep.states[-1] if sweep is not None else start), branch
     if band is not None:
         sink.result.grid.update(follow_m=band.half, regrids=getattr(sink, "regrids", 0),
+                                widened=getattr(sink, "widened", 0),
                                 nodes_last=sink.problem.grid.n)
     sink.close()
 
