@@ -543,8 +543,9 @@ class _Regrid(Exception):
 
 def _follower(scene, problem):
     """The :class:`~femadh.discretisation.moving.EdgeBand` of a scene whose [solver.grid]
-    sets ``follow`` (its edges: the outermost gaps at the laws' smallest and largest feature
-    gaps), else None."""
+    sets ``follow`` (its edges: the contact edge, the outermost node at sigma, and the
+    outermost gap at the laws' largest feature gap: the cohesive zone's or the meniscus'
+    outer end), else None."""
     g = scene.grid
     if not (g and g.get("follow")) or problem.sigma is None:
         return None
@@ -555,9 +556,11 @@ def _follower(scene, problem):
     def build(grid, first):
         return build_problem(scene, operator=GreenOperator(grid, scene.e_star))
     floor = reach_floor(problem.effects, problem.sigma)
-    gaps = [feature_gap({k: e}, floor) for k, e in problem.effects.items()] or [floor]
+    # the inner edge at sigma itself (a node held at the floor, to round-off): the LJ
+    # cohesive zone sigma..10^(1/2) sigma is ~0.8 um wide on the Fig 4 slider, and a band
+    # around its outer end alone left the contact edge in the graded part
     band = EdgeBand(problem.grid.radius, g["spacing"], g["follow"], g["grading"], build,
-                    max(gaps), min(gaps))
+                    feature_gap(problem.effects, floor), floor * (1 + 1e-6))
     band.spans[id(problem)] = (0.0, 0.0)     # the scene's own first member (scene_grid)
     band.centers[id(problem)] = 0.0
     return band
