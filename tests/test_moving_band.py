@@ -200,3 +200,26 @@ def test_a_trapped_member_triggers_refinement_not_a_refusal(monkeypatch):
     assert res.status == "converged" and res.accuracy["met"], res.error
     assert res.grid["members"]
     assert adaptive.MAX_TRIALS >= len(steps)
+
+
+def test_nodes_held_at_sigma_count_in_the_band_not_deep_inside_the_contact():
+    """The trapping ratio of a state counts a node held at sigma where the grid has its
+    band's spacing (the edge, where nodes join and leave, lies there) and leaves out the
+    coarse nodes deep inside the contact of a follow grid (pinned by the constraint: at
+    sigma their softening would read 5x their stiffness on this grid). Free nodes count at
+    their own gaps; on a uniform grid every node counts."""
+    sc = fig4_short()
+    sigma = sc.gap.sigma
+    fam = GridFamily(RADIUS, 3.0e-6, HALF, inner=2.0e-6)
+    pb = problem_on(sc, fam, H)
+    r = pb.grid.nodes
+    h = np.where(r < 2.5e-6, sigma, 5e-9)           # contact out to the band's middle
+    soft = -pb.dpressure(h) / np.diag(pb.K)
+    band = (r >= 2.0e-6 - 1e-12) & (r <= 3.0e-6)
+    assert pb.node_softening_ratio(h) == pytest.approx(float(np.max(soft[band | (h > sigma)])),
+                                                       rel=1e-12, abs=0)
+    assert float(np.max(soft)) > 2 * pb.node_softening_ratio(h) > 0     # 0.63 vs 0.22
+    uni = problem_on(sc, GridFamily(RADIUS, RADIUS, HALF), 0.5e-6)
+    hu = np.where(uni.grid.nodes < 2.5e-6, sigma, 5e-9)
+    assert uni.node_softening_ratio(hu) == pytest.approx(
+        float(np.max(-uni.dpressure(hu) / np.diag(uni.K))), rel=1e-12, abs=0)
