@@ -206,7 +206,7 @@ def test_nodes_held_at_sigma_count_in_the_band_not_deep_inside_the_contact():
     """The trapping ratio of a state counts a node held at sigma where the grid has its
     band's spacing (the edge, where nodes join and leave, lies there) and leaves out the
     coarse nodes deep inside the contact of a follow grid (pinned by the constraint: at
-    sigma their softening would read 5x their stiffness on this grid). Free nodes count at
+    sigma their ratio reads 0.63 on this grid, the band's 0.22). Free nodes count at
     their own gaps; on a uniform grid every node counts."""
     sc = fig4_short()
     sigma = sc.gap.sigma
