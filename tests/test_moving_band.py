@@ -109,6 +109,7 @@ def test_a_carried_state_is_the_new_grids_own_equilibrium():
     assert carried.r_c == pytest.approx(own.r_c, rel=0, abs=1.01 * H)
 
 
+@pytest.mark.slow
 def test_the_fine_band_follows_the_edge_through_the_folds(followed):
     """Through the jump-in and the jump-out (two folds) the grid is exchanged as the edge
     moves, and every committed state's contact edge sits on nodes of the band's own spacing
@@ -144,6 +145,7 @@ def test_the_fine_band_follows_the_edge_through_the_folds(followed):
     assert (out / "profiles_and_forces.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_follow_band_agrees_with_the_static_band(followed):
     """The largest adhesion on the follow band and on the static band [0, 5.9 um] of the
     same spacing: the same to 2e-3 (measured 3.7e-4 on the full Fig 4 sweep at 39 nm,
@@ -157,6 +159,7 @@ def test_follow_band_agrees_with_the_static_band(followed):
     assert f == pytest.approx(f0, rel=2e-3, abs=0)   # measured 1.1e-3 (band at sigma)
 
 
+@pytest.mark.slow
 def test_a_resumed_follow_run_is_traced_again(followed, tmp_path):
     """A stopped follow run resumes by tracing again from its start (the files do not say on
     which grid each state was continued), and says so."""
