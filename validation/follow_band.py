@@ -123,11 +123,12 @@ def main():
               f"sigma {c['lj_width'] * 1e9:.3g} nm.", "",
               "A single node never snaps on its own at 3.5 nm (ratio below 1), yet the "
               "contact joins and leaves node by node (measured: on the retract from -5 nm a "
-              "fold every 0.0135 nm of d, one node of 3.5 nm each, 11-12 per 0.2-nm step): "
-              "the meniscus annulus, where 127 MPa act, is narrower than a spacing, so the "
-              "edge moves between nodes in jumps (lattice trapping of the edge, not of a "
-              "node). Resolving it needs spacings of order its width over the edge's whole "
-              "travel."]
+              "fold every 0.0135 nm of d, one node of 3.5 nm each, 11-12 per 0.2-nm step, "
+              "the stepping's solve budget per step until each fold brought its own): the "
+              "meniscus annulus, where 127 MPa act, spans only a few spacings, so the edge "
+              "moves between nodes in jumps (lattice trapping of the edge, not of a single "
+              "node). Resolving it smoothly needs spacings well below its width where the "
+              "edge travels."]
     (HERE / "results" / "follow_band.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
