@@ -65,10 +65,22 @@ def stiction_map(out):
             F[i, j] = rec["max_adhesion_N"]
             E[i, j] = rec.get("max_adhesion_N_error", math.nan)
         else:
-            fails.append((p.scene.gap.sigma, rel_of(p),
-                          rec.get("error") or rec.get("status")))
+            fails.append((p.scene.gap.sigma, rel_of(p), _reason(out, p, rec)))
     norm = 4 * math.pi * scene.sphere.radius * gamma
     return sig, rel, F, E, norm, wall, fails, len(points)
+
+
+def _reason(out, point, rec):
+    """Why a point of the map did not converge: its run's own status and error (a point
+    stopped by POINT_LIMIT reads "time limit" there; the study's record calls it unfinished)."""
+    import json
+
+    summ = Path(out) / "points" / point.id / "summary.json"
+    if summ.exists():
+        d = json.loads(summ.read_text())
+        if d.get("status") not in (None, "converged", "running"):
+            return f"{d['status']}: {d.get('error')}"
+    return rec.get("error") or rec.get("status")
 
 
 def figure(sig, rel, F, norm, png):
