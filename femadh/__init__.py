@@ -10,12 +10,17 @@ Python API::
     femadh.run(softer, "out/sigma-0.5")                # csv, json, figures into that folder
 """
 from ._version import __version__  # noqa: F401  (the package version, femadh.__version__)
-from .errors import (ConvergenceError, DependencyError, FemadhError, Interrupted,  # noqa: F401
-                     OutputError, SceneError, TimeLimitReached)
+from .errors import (ConvergenceError, DependencyError, DomainError,  # noqa: F401
+                     FemadhError, Interrupted, LawError, MeshResolutionWarning, OutputError,
+                     SceneError, TimeLimitReached)
 
-__all__ = ["load_scene", "scene_from_dict", "run", "Scene", "ContactResult",
-           "MeniscusRunResult", "FemadhError", "SceneError", "OutputError", "ConvergenceError",
-           "DependencyError", "Interrupted", "TimeLimitReached", "__version__"]
+#: the result types, loaded on first use (they load the numerical core, ~0.8 s)
+_RESULTS = ("RunResult", "ContactResult", "MeniscusRunResult")
+
+__all__ = ["load_scene", "scene_from_dict", "run", "Scene", *_RESULTS,
+           "FemadhError", "SceneError", "OutputError", "ConvergenceError", "DependencyError",
+           "LawError", "DomainError", "Interrupted", "TimeLimitReached",
+           "MeshResolutionWarning", "__version__"]
 
 
 def __getattr__(name):
@@ -23,10 +28,14 @@ def __getattr__(name):
     if name == "Scene":
         from .scene import Scene
         return Scene
-    if name in ("ContactResult", "MeniscusRunResult"):
+    if name in _RESULTS:
         from .runner import result
         return getattr(result, name)
     raise AttributeError(f"module 'femadh' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
 
 
 def load_scene(path):
@@ -52,7 +61,8 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         of its TOML file.
     out_dir : str or Path, optional
         Folder for curve.csv, fields.csv, diagnostics.csv, jumps.csv, summary.json and the
-        figures. None (default): nothing is written. ``""`` is refused (OutputError).
+        figures (a meniscus scene: meniscus.csv, profiles.csv). None (default): nothing is
+        written. ``""`` is refused (OutputError).
     figures : bool
         Draw the figures into ``out_dir`` (default True).
     progress : bool, optional
@@ -70,14 +80,20 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
         ``[solver] time_limit``. The result then has status "time limit".
     resume_from : int, optional
         Resume keeping only the first ``resume_from`` committed states.
-    operator, folder_id
-        For studies and adaptive runs (see :func:`femadh.runner.contact.run`).
+    operator : SurfaceOperator, optional
+        Reuse a surface operator built for this scene's grid (:func:`femadh.scene.
+        build_operator`; studies keep one per worker).
+    folder_id : str, optional
+        Claim ``out_dir`` under this scene id instead of the scene's own (an adaptive run's
+        trials are claimed under the user's scene).
 
     Returns
     -------
-    ContactResult or MeniscusRunResult
-        ``status`` is "converged", "failed" (``error`` says where) or "time limit";
-        ``curve(branch)``, ``headline``, ``estimates``, ``jumps``, ``timings``.
+    RunResult
+        A ContactResult or a MeniscusRunResult: ``status`` is "converged", "failed"
+        (``error`` says where) or "time limit" (``exit_code`` 6); ``headline`` (the numbers
+        and their ``<name>_error``), ``timings``, ``summary()``, ``to_csv(path)``; a contact
+        run also ``curve(branch)``, ``estimates``, ``jumps``, a meniscus run ``curves``.
 
     Raises
     ------
@@ -90,15 +106,10 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     SceneError, OutputError, DependencyError
         Before anything is computed.
     """
-    import signal
+    from .runner.lifecycle import raise_if_stopped
+    from .runner.run import run as _run
 
-    from .runner.contact import run as _run
-    res = _run(scene, out_dir, figures=figures, progress=progress, overwrite=overwrite,
-               resume=resume, estimate=estimate, time_limit=time_limit,
-               resume_from=resume_from, operator=operator, folder_id=folder_id)
-    if res.status == "interrupted":
-        if getattr(res, "exit_code", 130) == 128 + signal.SIGTERM:
-            raise SystemExit(res.exit_code)
-        raise KeyboardInterrupt(f"{res.error}: the states computed before it are kept"
-                                + (f" in {res.out_dir}" if res.out_dir else ""))
-    return res
+    return raise_if_stopped(_run(
+        scene, out_dir, figures=figures, progress=progress, overwrite=overwrite,
+        resume=resume, estimate=estimate, time_limit=time_limit, resume_from=resume_from,
+        operator=operator, folder_id=folder_id))

@@ -262,7 +262,7 @@ def _check(scene, path):
 def _run(scene, args):
     import shlex
 
-    from .runner.contact import run
+    from .runner.run import run
 
     out = args.out or scene.output_dir
     if args.resume_from is not None and args.resume_from < 0:
@@ -292,7 +292,7 @@ def _run(scene, args):
                             ("--force", args.force)) if on]
         _error(f"{res.error}: the states computed before it are kept in {res.out_dir}; "
                f"`{shlex.join(again)}` continues the run")
-        return getattr(res, "exit_code", 130)
+        return res.exit_code
     if res.status != "converged":
         _error(f"{res.error}; what was computed before it is kept in {res.out_dir}")
         return EXIT_SOLVE

@@ -81,12 +81,13 @@ def test_hysteresis_energy_identity(monkeypatch):
     """Work of the closed approach-retract cycle = energy released at the jumps (from the fold
     and landing states, which do not depend on the continuation's steps) = loop integral of
     F dd (trapezoid along the paths), which converges to it as the steps shrink."""
-    import femadh.contact.arclength as al
+    import femadh.studies.smooth_sphere as smooth_sphere
     from femadh.studies.regime import lj_sphere
 
     runs = []
     for target, ds_max in ((0.05, 0.5), (0.0125, 0.125)):   # steps ~4x shorter everywhere
-        monkeypatch.setattr(al, "TARGET_CORRECTION", target)
+        # (the map's own step control, passed to trace_curve)
+        monkeypatch.setattr(smooth_sphere, "TRACE_CORRECTION", target)
         # the legacy fixed grid: one grid for the whole curve (a moving band's grids would
         # change with the steps, and with them the discretisation of the two states)
         runs.append(lj_sphere(2.0, ds_max=ds_max, stiffness_target=0.4, min_nodes=120))

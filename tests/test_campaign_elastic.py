@@ -16,7 +16,7 @@ from conftest import E_STAR
 @pytest.fixture(scope="module")
 def fe():
     g = RadialGrid.uniform(1e-6, 10)
-    return FEOperator(g, E_STAR, 0.3, FESettings(1e3, 0.5, 1.0))
+    return FEOperator.homogeneous(g, E_STAR, 0.3, FESettings(1e3, 0.5, 1.0))
 
 
 def _field(fe, ur, uz):

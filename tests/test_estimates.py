@@ -1,6 +1,7 @@
 """The error estimate part by part, and the guards on both sides of their thresholds.
 
-The estimate of a headline number (femadh.runner.estimates) is a sum of magnitudes of parts:
+The estimate of a headline number (femadh.runner.estimates, on the error machinery of
+femadh.estimate shared with the regime map) is a sum of magnitudes of parts:
 grid (Richardson over the coarser members of the grid family), FE mesh, resolution, tail
 beyond the analysis radius, solver tolerance. On the bundled scenes the total is dominated by
 the tail, so each part is pinned here on its own: Richardson on manufactured sequences of
@@ -23,9 +24,10 @@ from femadh.discretisation.plan import member_ratio, safe_spacing, tail_delta, t
 from femadh.elastic import GreenOperator, RadialGrid
 from femadh.indenter import Sphere
 from femadh.laws import LennardJones
-from femadh.runner import estimates as est
-from femadh.runner.estimates import (GuardError, TrappingError, check_state,
-                                     coarser_members, discretisation, guard_bounds, variant)
+from femadh import estimate as est
+from femadh.estimate import (GuardError, TrappingError, check_state, discretisation,
+                             observed_order, richardson)
+from femadh.runner.estimates import coarser_members, guard_bounds, variant
 from femadh.scene import build_problem
 
 from conftest import E_STAR, HAMAKER, Z0
@@ -84,6 +86,40 @@ def test_a_diverging_sequence_gets_the_envelope_not_richardson():
     r, p = 2.0**0.5, est.ENVELOPE_ORDER
     e = discretisation({"q": 1.0}, {"q": 1.01}, {"q": 1.015}, ratio=r)["q"]
     assert e == pytest.approx(-0.01 / (r**p - 1), rel=1e-12, abs=0)
+
+
+def test_the_runner_and_the_regime_map_use_the_one_richardson():
+    """One home: the runner's estimate names are the shared machinery's objects, and the
+    regime map's two-member estimate at its order 2 is Richardson's (Q_h - Q_2h)/3 on a
+    manufactured order-2 pair (exact: effectivity 1 to round-off)."""
+    from femadh.runner import estimates as runner_est
+    from femadh.studies import regime
+
+    assert runner_est.discretisation is discretisation
+    assert runner_est.check_state is check_state and runner_est.GuardError is GuardError
+    h, c = 0.05, 0.4
+    vals = {k: 1.0 + k_i + c * h**2 for k_i, k in enumerate(regime.QUANTITIES)}
+    coarse = {k: 1.0 + k_i + c * (2 * h)**2 for k_i, k in enumerate(regime.QUANTITIES)}
+    errors = regime.estimate_errors(vals, coarse, 2.0)
+    for k in regime.QUANTITIES:
+        assert errors[k] == pytest.approx(c * h**2, rel=1e-9, abs=0)
+    assert richardson(1.0 + c * h**2, 1.0 + c * (2 * h)**2, 2.0, 2.0) == pytest.approx(
+        -c * h**2, rel=1e-9, abs=0)
+
+
+def test_observed_order_of_a_manufactured_sequence_and_its_refusals():
+    """The order three members of Q* + C h^p show is p (to round-off, at ratios 2 and 1.5);
+    an oscillating or diverging triple has none."""
+    for r, p in ((2.0, 1.0), (1.5, 2.0), (2.0**0.5, 1.37)):
+        (a,), (b,), (c,) = ([q["q"]] for q in sequence(0.3, 2.0, p, 0.01, r))
+        assert observed_order(a, b, c, r) == pytest.approx(p, rel=1e-9)
+    assert observed_order(1.0, 1.001, 0.99, 2.0) is None      # oscillating
+    assert observed_order(1.0, 1.01, 1.015, 2.0) is None      # diverging
+    # oscillating members whose finest difference (1e-3) nearly cancels: the envelope takes
+    # the coarser one, 1.1e-2 / r^p, with the finest difference's sign (identity on numbers)
+    r, p = 2.0, est.ENVELOPE_ORDER
+    e = discretisation({"q": 1.0}, {"q": 1.001}, {"q": 0.99}, ratio=r)["q"]
+    assert e == pytest.approx(-0.011 / r**p / (r**p - 1), rel=1e-12, abs=0)
 
 
 # --------------------------------------------------------------------------- family ratios

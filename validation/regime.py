@@ -10,6 +10,7 @@ estimated error, wall time). ``--mu-min``/``--mu-max`` bound the map (default 0.
 import argparse
 import csv
 import math
+import os
 from pathlib import Path
 import time
 import warnings
@@ -113,11 +114,13 @@ def main(argv=None):
     warnings.simplefilter("ignore")
     RESULTS.mkdir(exist_ok=True)
     mus = np.geomspace(args.mu_min, args.mu_max, 5 if args.quick else 20)
+    load0 = os.getloadavg()[0]
     t0 = time.perf_counter()
     pts = regime_map(mus, accuracy=1e-3, progress=lambda i, p: print(
         f"mu = {p.mu:.4g}: {'failed: ' + p.failed if p.failed else 'ok'} "
         f"({p.wall_time:.1f} s)", flush=True))
     wall = time.perf_counter() - t0
+    load1 = os.getloadavg()[0]
     with open(RESULTS / "regime_map.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(REGIME_HEADER)
@@ -134,7 +137,9 @@ negative load; fixed grip: vertical tangent of P(D), none below lambda = 0.938).
 {map_table(pts)}
 
 {len(pts)} points, mu = {mus[0]:.3g} ... {mus[-1]:.3g}: {wall:.1f} s wall time on a shared 2-core
-machine (indicative).
+machine, one BLAS thread, load average {load0:.1f} at the start and {load1:.1f} at the end
+(the times are indicative at a load above 2; the nodes, grids and folds are the counts).
+{len([p for p in pts if p.failed])} points failed.
 """
     (RESULTS / "regime_map.md").write_text(text)
     print(text)

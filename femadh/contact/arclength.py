@@ -276,7 +276,8 @@ def _negative_modes(problem, w, d):
 
 
 def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start=None,
-                max_points=5000, progress=None, regrid=None, stop=None, on_point=None):
+                max_points=5000, progress=None, regrid=None, stop=None, on_point=None,
+                target_correction=TARGET_CORRECTION):
     """Follow the equilibrium curve from separation d_start until it passes d_end (m).
 
     Parameters
@@ -294,6 +295,12 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         First step length (units of ``scale``); adapted afterwards.
     ds_max : float, optional
         Largest step length (default: 20 * ds).
+    target_correction : float, optional
+        The step length is tuned so that the corrector moves no gap by more than about this
+        fraction of itself (default TARGET_CORRECTION; a predictor 4x further off is
+        rejected). Where only the folds, landings and extrema of the curve are read (each
+        located on the curve itself, not interpolated between points) a larger value takes
+        fewer points.
     progress : callable(float), optional
         Called with the fraction of |d_end - d_start| covered so far.
     regrid : callable(problem, w, d) -> ContactProblem or None, optional
@@ -406,7 +413,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
         h_c = problem.contour(d) - w
         h_p = problem.contour(x_pred[n] * scale) - x_pred[:n] * scale
         corr = float(np.max(np.abs(h_c - h_p) / h_c))
-        if corr > 4 * TARGET_CORRECTION:
+        if corr > 4 * target_correction:
             # the predictor was poor: the point may sit on another branch
             shorten(f"the corrector moved a gap by {corr:.2g} of itself", d, res, it)
             continue
@@ -439,7 +446,7 @@ def trace_curve(problem, d_start, d_end, *, tol, scale, ds, ds_max=None, w_start
             curve.folds.append(fold)
         curve.points.append(q)
         step = min(ds_max, ceiling, step * min(2.0, max(0.5, math.sqrt(
-            TARGET_CORRECTION / max(corr, 1e-12)))))
+            target_correction / max(corr, 1e-12)))))
         ceiling *= CEILING_GROWTH
         if progress:
             progress(min(1.0, (d - d_start) / (d_end - d_start)))

@@ -1,6 +1,8 @@
 """A traced equilibrium curve (pseudo-arclength continuation) and the displacement-controlled
 approach and retract paths read off it: stable runs, folds, and the landing at fixed d on the
-next stable piece (:meth:`EquilibriumCurve.walk`, :meth:`EquilibriumCurve.branch`)."""
+next stable piece (:meth:`EquilibriumCurve.walk`, :meth:`EquilibriumCurve.branch`); what an
+experiment reads off it - pull-offs under load and displacement control, the jumps, the
+hysteresis - in :func:`read_curve`."""
 from dataclasses import dataclass, field
 import math
 
@@ -310,6 +312,88 @@ class EquilibriumCurve:
                     w = self.point_at(i, d_f, j)
                     here = (d_f, w, i)
         return total
+
+
+@dataclass
+class CycleReadout:
+    """What an experiment reads off a traced curve (SI units; forces attractive positive).
+
+    Attributes
+    ----------
+    pull_off : float
+        Load-controlled pull-off (N): the largest tension anywhere on the curve, refined
+        between the neighbours of the best traced point (:meth:`EquilibriumCurve.maximize`).
+    pull_off_displacement : float or None
+        Displacement-controlled pull-off (N): the tension at the fold where the retract path
+        leaves the contact (the last retract fold); None without folds.
+    pull_off_path : float
+        The largest tension (N) a displacement-controlled retract meets: ``pull_off`` where
+        its point is stable (the path passes through it), else the largest along the retract
+        path (its points, folds and landings).
+    jump_in, jump_out : float or None
+        Separations (m) of the approach path's first fold and the retract path's last.
+    hysteresis : float
+        Energy (J) released at the jumps of one approach-retract cycle (the energies of the
+        fold and landing states at the same d), i.e. the work the cycle dissipates.
+    loop_work : float
+        The same by the trapezoidal loop integral of F dd along both paths (a cross-check).
+    force : ndarray
+        F (N) at each point of the curve.
+    paths : dict
+        {"approach" | "retract": (d (m), F (N))} along the displacement-controlled paths.
+    """
+
+    pull_off: float
+    pull_off_displacement: float | None
+    pull_off_path: float
+    jump_in: float | None
+    jump_out: float | None
+    hysteresis: float
+    loop_work: float
+    force: np.ndarray
+    paths: dict
+
+
+def read_curve(curve, force):
+    """Pull-offs, jumps and hysteresis of a traced curve (:class:`CycleReadout`).
+
+    Parameters
+    ----------
+    curve : EquilibriumCurve
+    force : callable(problem, d, w) -> float
+        Force (N, attractive positive) of a state on a segment's problem (e.g. the law's
+        pressure integrated over the disk plus its exact tail beyond it).
+
+    The hysteresis is the energy released at the jumps: the work of the closed cycle, since
+    the interaction beyond the analysis radius is continuous in d and drops out; each jump
+    is from a fold state to the landing at the same d, energies from
+    ``problem.energy(w, d)`` of their segments' problems.
+    """
+    pb = curve.problem_of
+    paths = {k: curve.branch(k, segments=True) for k in ("approach", "retract")}
+    F = {k: np.array([force(pb(g), d, w) for _, d, w, g in v]) for k, v in paths.items()}
+    D = {k: np.array([d for _, d, _, _ in v]) for k, v in paths.items()}
+    released = 0.0
+    for v in paths.values():
+        for (k1, d1, w1, g1), (k2, _, w2, g2) in zip(v, v[1:]):
+            if k1 == "fold" and k2 == "land":
+                released += pb(g1).energy(w1, d1) - pb(g2).energy(w2, d1)
+    trap = getattr(np, "trapezoid", None) or np.trapz
+    loop = trap(F["retract"], D["retract"]) + trap(F["approach"], D["approach"])
+    pts = curve.points
+    cf = np.array([force(pb(p.seg), p.d, p.w) for p in pts])
+    i = int(np.argmax(cf))
+    pull = cf[i]
+    if 0 < i < len(pts) - 1:
+        seg = pb(pts[i].seg)
+        pull = max(pull, curve.maximize(i, lambda d, w: force(seg, d, w))[0])
+    r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
+    a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
+    pull_disp = force(pb(r_folds[-1][2]), *r_folds[-1][:2]) if r_folds else None
+    pull_path = float(pull) if pts[i].stable else float(np.max(F["retract"]))
+    return CycleReadout(float(pull), pull_disp, pull_path, a_folds[0] if a_folds else None,
+                        r_folds[-1][0] if r_folds else None, float(released), float(loop),
+                        cf, {k: (D[k], F[k]) for k in D})
 
 
 def bracketed_root(f, lo, hi, *, xtol):

@@ -148,21 +148,14 @@ def simulate(scene):
     import warnings
 
     from ..errors import MeshResolutionWarning
-    from ..runner.contact import run
-    from ..scene import build_operator
-    from ..studies import sweep
+    from ..runner.run import run
+    from ..studies.executors import tune_malloc, worker_operator
 
-    sweep._tune_malloc()
+    tune_malloc()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshResolutionWarning)
-            key = sweep._operator_key(scene)
-            op = None
-            if key is not None:
-                if key not in sweep.OPERATOR_CACHE:
-                    sweep.OPERATOR_CACHE.clear()          # one operator per worker
-                    sweep.OPERATOR_CACHE[key] = build_operator(scene)
-                op = sweep.OPERATOR_CACHE[key]
+            op, _ = worker_operator(scene)
             res = run(scene, None, figures=False, progress=False, estimate=False,
                       operator=op)
     except FemadhError as exc:

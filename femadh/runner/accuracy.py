@@ -2,11 +2,13 @@
 adhesion, the forces at the deepest separation) to a relative accuracy. femadh runs the scene,
 estimates the errors (:mod:`femadh.runner.estimates`), and refines - more nodes where the grid
 dominates, a larger analysis radius where the tail beyond it does, more nodes where a node
-would snap alone - until the estimate meets the target, within a budget; the result says what
-was chosen and every step (``result.accuracy``), or fails saying the target was not met."""
+would snap alone - until the estimate meets the target, within a budget (the refine-until-met
+loop of :mod:`femadh.estimate.refine`); the result says what was chosen and every step
+(``result.accuracy``), or fails saying the target was not met."""
 import math
 
 from ..scene import scene_id
+from ..estimate.refine import Budget, refine_until_met
 from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
 
 
@@ -32,52 +34,57 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
     from ..io.progress import phase
 
     target = scene.accuracy
-    nodes, delta = scene.nodes, scene.analysis_radius**2 / (2 * scene.sphere.radius)
-    steps = []
+    budget = Budget(MAX_REFINEMENTS, MAX_NODES)
     mode = {"overwrite": overwrite, "resume": resume}
-    res = None
-    for i in range(MAX_REFINEMENTS + 1):
+    records = []
+
+    def attempt(setting):
+        nodes, delta = setting
         trial = variant(scene, nodes=nodes, delta=delta)
+        i = len(records)
         # claimed under the user's scene: --resume and --overwrite recognise the folder
         # whichever trial it holds
         with phase(f"{'refinement ' + str(i) if i else 'grid'} (N = {nodes})"):
             res = run(trial, out_dir, figures=figures, progress=progress, estimate=True,
                       folder_id=scene_id(scene), **mode)
-        mode = {"overwrite": True, "resume": False}       # later trials replace earlier ones
+        mode.update(overwrite=True, resume=False)    # later trials replace earlier ones
         grid, tail = _relative(res) if res.status == "converged" else (math.inf, 0.0)
-        steps.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,
-                      "status": res.status, "grid_rel_error": grid, "tail_rel_error": tail,
-                      "wall_time_s": res.wall_time})
-        if res.status == "converged" and grid + tail <= target:
-            break
-        if res.status != "converged":
-            err = res.error or ""
-            if "analysis radius" in err:
-                delta *= 4
-                nodes *= 2
-            elif "snap on their own" in err or "Derjaguin" in err:
-                nodes *= 2
-            else:
-                break                       # a failure refinement does not address
-        else:
-            if tail > target / 3:
-                delta *= 4                  # a doubles; keep the spacing
-                nodes *= 2
-            if grid > 2 * target / 3:
-                nodes = int(min(4 * nodes, math.ceil(nodes * max(2.0, 1.2 * grid
-                                                                     / (2 * target / 3)))))
-        if nodes > MAX_NODES:
-            break
-    met = res.status == "converged" and steps[-1]["grid_rel_error"] + steps[-1][
-        "tail_rel_error"] <= target
+        records.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,
+                        "status": res.status, "grid_rel_error": grid,
+                        "tail_rel_error": tail, "wall_time_s": res.wall_time})
+        why = None if res.status == "converged" else (res.error or res.status)
+        return res, grid + tail, why
+
+    def refine(setting, res, error, why):
+        nodes, delta = setting
+        if why is not None:
+            if "analysis radius" in why:
+                return 2 * nodes, 4 * delta
+            if "snap on their own" in why or "Derjaguin" in why:
+                return 2 * nodes, delta
+            return None                     # a failure refinement does not address
+        grid, tail = records[-1]["grid_rel_error"], records[-1]["tail_rel_error"]
+        if tail > target / 3:
+            delta *= 4                      # a doubles; keep the spacing
+            nodes *= 2
+        if grid > 2 * target / 3:
+            nodes = int(min(4 * nodes, math.ceil(nodes * max(2.0, 1.2 * grid
+                                                                 / (2 * target / 3)))))
+        return nodes, delta
+
+    first = (scene.nodes, scene.analysis_radius**2 / (2 * scene.sphere.radius))
+    out = refine_until_met(first, attempt, refine, target, budget,
+                           nodes=lambda s, r, nxt: nxt[0])
+    res, steps = out.result, records
+    met = out.met
     res.accuracy = {"target": target, "met": met, "nodes": steps[-1]["nodes"],
                     "analysis_radius_m": steps[-1]["analysis_radius_m"], "steps": steps}
     if not met and res.status == "converged":
         res.status = "failed"
         res.error = (f"accuracy {target:g} not met: estimated relative error "
                      f"{steps[-1]['grid_rel_error'] + steps[-1]['tail_rel_error']:.2g} with "
-                     f"N = {steps[-1]['nodes']} (the budget: N <= {MAX_NODES}, "
-                     f"{MAX_REFINEMENTS} refinements)")
+                     f"N = {steps[-1]['nodes']} (the budget: N <= {budget.max_nodes}, "
+                     f"{budget.max_refinements} refinements)")
     if out_dir is not None:
         from ..io.run_folder import RunFolder
         from .result import contact_summary as summary

@@ -5,11 +5,12 @@ Nothing is lost: the output folder is claimed before anything is computed (one r
 folder, checked writable), ``summary.json`` says ``running`` from the start and is rewritten
 atomically at the end, every committed state is in every csv, SIGINT/SIGTERM stop after the
 current state with status ``interrupted``, and ``resume=True`` continues an interrupted or
-failed sweep from its last committed state.
+failed sweep from its last committed state (the run's status and summary:
+:mod:`.lifecycle`, the same for every scene kind; :func:`femadh.runner.run.run` dispatches
+every kind).
 """
 from dataclasses import dataclass
 import math
-import sys
 import time
 import warnings
 
@@ -18,14 +19,16 @@ import numpy as np
 from .._threads import blas_threads
 from ..contact import Jump, State, trace
 from ..contact.forces import state_forces
-from ..errors import ConvergenceError, Interrupted, MeshResolutionWarning, OutputError
+from ..errors import ConvergenceError, MeshResolutionWarning, OutputError  # noqa: F401
 from ..scene import build_problem, load_scene, scene_id  # noqa: F401 (scene_id: the API)
 from .. import interrupt
 from .estimates import GuardError
 from .figures import draw_figures
+from .lifecycle import lifecycle
 from .result import ContactResult
-from .result import contact_summary as summary
-from ..io.progress import advance, begin, display, phase
+from ..io.progress import advance, begin, phase
+# run() of every kind: its own module; here too for the callers of femadh.runner.contact.run
+from .run import run  # noqa: F401
 
 #: surface-force stiffness over single-node stiffness above which a run warns
 STIFFNESS_WARNING = 0.5
@@ -33,116 +36,36 @@ STIFFNESS_WARNING = 0.5
 PROFILES = 12
 
 
-def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
-        operator=None, estimate=True, folder_id=None, time_limit=None, resume_from=None):
-    """Solve a scene.
+def run_contact(scene, out_dir=None, *, figures=True, progress=False, overwrite=False,
+                resume=False, operator=None, estimate=True, folder_id=None, resume_from=None):
+    """Solve a contact scene (called by :func:`femadh.runner.run.run`, which documents the
+    arguments, inside the run's signal handling, time limit and progress display): an
+    adaptive grid or an accuracy target is refined over several runs, else one run into its
+    claimed folder, then its figures."""
+    if getattr(scene, "adaptive", False):
+        from .adaptive import run_adaptive
 
-    Parameters
-    ----------
-    scene : Scene, MeniscusScene, str or Path
-        A scene or the path of its TOML file.
-    out_dir : str or Path, optional
-        Folder for the csv/json/VTK outputs and figures. None (the default): nothing is
-        written (the command line passes the scene's ``[output] dir``). An empty string is
-        refused (it would mean the current folder).
-    figures : bool
-        Draw the scene's figures into ``out_dir``.
-    progress : bool, optional
-        Progress bar on stderr; default: only when stderr is a terminal.
-    overwrite, resume : bool
-        What to do with a folder that holds a previous run: replace it, or continue it
-        (an interrupted, failed or time-limited run of the same scene; every committed row is
-        checked first, see :mod:`femadh.io.resume_check`). Neither: refuse it.
-    operator : SurfaceOperator, optional
-        Reuse an operator built for this scene's grid (studies keep one per worker).
-    estimate : bool or "peak"
-        Estimate the error of the headline numbers (a coarser grid's run, the tail beyond the
-        analysis radius, the peak between the grid separations; see
-        :mod:`femadh.runner.estimates`); "peak": only locate the peak.
-    folder_id : str, optional
-        The scene id the output folder is claimed under (an adaptive run's trials claim it
-        under the user's scene, so that --resume and --overwrite recognise it).
-    time_limit : float or str, optional
-        Stop cleanly after this long (seconds, or a duration such as "10 min"); default the
-        scene's ``[solver] time_limit``. Status "time limit"; ``resume`` continues.
-    resume_from : int, optional
-        Resume keeping only the first ``resume_from`` committed states (a folder whose later
-        rows do not match their record).
+        return run_adaptive(scene, out_dir, run=run, figures=figures, progress=progress,
+                            overwrite=overwrite, resume=resume, estimate=estimate)
+    if getattr(scene, "accuracy", None) and estimate is True:
+        from .accuracy import run_to_accuracy
 
-    Returns
-    -------
-    ContactResult or MeniscusRunResult
-        Also when a step fails (status "failed", ``error`` says where), the run is
-        interrupted (status "interrupted") or reaches its time limit (status "time limit"):
-        every state computed before is in the result and on disk.
+        return run_to_accuracy(scene, out_dir, run=run, figures=figures,
+                               progress=progress, overwrite=overwrite, resume=resume)
+    if out_dir is None:
+        return _run(scene, None, progress=progress, operator=operator, estimate=estimate)
+    from ..io.run_folder import RunFolder
 
-    Raises
-    ------
-    SceneError, OutputError, DependencyError
-        Before anything is computed.
-    """
-    if not hasattr(scene, "kind"):
-        scene = load_scene(scene)
-    if out_dir is not None and not str(out_dir).strip():
-        from ..errors import OutputError
-
-        raise OutputError("output folder '' is empty: give a folder name (None writes "
-                          "nothing; '.' is the current folder)")
-    if resume_from is not None:
-        resume = True
-    limit = _time_limit(scene, time_limit)
-    if progress is None:
-        progress = sys.stderr.isatty()
-    from contextlib import nullcontext
-
-    # one display over the whole run (a meniscus run has its own bar)
-    shown = nullcontext() if scene.kind == "meniscus" else display(scene.name, progress)
-    with blas_threads(), interrupt.interruptible(limit), shown:
-        if scene.kind == "meniscus":
-            from .meniscus import run_meniscus
-
-            return run_meniscus(scene, out_dir, figures=figures, progress=progress,
-                                overwrite=overwrite)
-        if getattr(scene, "adaptive", False):
-            from .adaptive import run_adaptive
-
-            return run_adaptive(scene, out_dir, run=run, figures=figures, progress=progress,
-                                overwrite=overwrite, resume=resume, estimate=estimate)
-        if getattr(scene, "accuracy", None) and estimate is True:
-            from .accuracy import run_to_accuracy
-
-            return run_to_accuracy(scene, out_dir, run=run, figures=figures,
-                                   progress=progress, overwrite=overwrite, resume=resume)
-        if out_dir is None:
-            return _run(scene, None, progress=progress, operator=operator, estimate=estimate)
-        from ..io.run_folder import RunFolder
-
-        mode = "resume" if resume else "overwrite" if overwrite else "new"
-        with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
-            res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
-                       resume_from=resume_from)
-            if figures and res.status in ("converged", "failed") and any(
-                    len(next(iter(b.values()))) for b in res.branches.values()):
-                with phase("figures"):
-                    draw_figures(res, folder)
-                folder.write_summary(summary(res))
-            return res
-
-
-def _time_limit(scene, given):
-    """The run's time limit in seconds (None: none): the argument, else the scene's."""
-    if given is None:
-        return getattr(scene, "time_limit", None)
-    if isinstance(given, str):
-        from ..units import to_si
-
-        given = to_si(given, "time", file="time_limit", key="time_limit")
-    if not (isinstance(given, (int, float)) and given > 0 and math.isfinite(given)):
-        from ..errors import SceneError
-
-        raise SceneError("time_limit", "time_limit", given, "a positive duration such as "
-                         "'10 min' or a number of seconds")
-    return float(given)
+    mode = "resume" if resume else "overwrite" if overwrite else "new"
+    with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
+        res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
+                   resume_from=resume_from)
+        if figures and res.status in ("converged", "failed") and any(
+                len(next(iter(b.values()))) for b in res.branches.values()):
+            with phase("figures"):
+                draw_figures(res, folder)
+            folder.write_summary(res.summary())
+        return res
 
 
 def solve_sweeps(scene, problem=None):
@@ -215,84 +138,63 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
             "an instrument's readout needs every state of it in memory") + ")")
         resuming = False
     resume = None
-    writer = sink = None
-    checked = False         # a resumed folder's record has been checked (and is kept)
 
     def write_summary(status=None):
         if folder is not None:
-            folder.write_summary({**summary(res, status=status),
+            folder.write_summary({**res.summary(status),
                                   **({"trial": True} if trial else {})})
-    with interrupt.interruptible():
-        try:
-            if not resuming:
-                write_summary("running")
-            t1 = time.perf_counter()
-            # the build writes nothing but whole cache files: a signal stops it at once
-            with phase("operator"), interrupt.immediate():
-                problem = build_problem(scene, operator=operator, progress=say)
-            res.timings["operator_s"] = time.perf_counter() - t1
-            if resuming:
-                # every committed row checked before anything is appended (refused in one
-                # line, or the side files cut back to what is complete in all of them)
-                resume = _resume_point(folder, scene, problem, run_id, prev, resume_from, res)
-                checked = True
-            if resuming:
-                write_summary("running")
-            res.nodes = problem.grid.nodes.copy()
-            g = problem.grid
-            res.grid = {"kind": "uniform" if g.fine_radius is None else "banded", "nodes": g.n,
-                        "analysis_radius_m": g.radius}
-            if g.fine_radius is not None:
-                res.grid.update(band_m=g.fine_radius, spacing_m=float(g.nodes[1]),
-                                grading_m=scene.grid["grading"] if scene.grid else None)
-            res.warnings += _stiffness_warning(scene, problem)
-            interrupt.check()
-            if folder is not None:
-                from ..io.writers import ContactWriter
+    with lifecycle(res, write_summary, failures=(ConvergenceError, GuardError),
+                   announce=not resuming, t0=t0) as life:
+        if resuming:
+            # refused while checking the folder (one line): it is left as it was
+            life.untouched_on = (OutputError,)
+        t1 = time.perf_counter()
+        # the build writes nothing but whole cache files: a signal stops it at once
+        with phase("operator"), interrupt.immediate():
+            problem = build_problem(scene, operator=operator, progress=say)
+        res.timings["operator_s"] = time.perf_counter() - t1
+        if resuming:
+            # every committed row checked before anything is appended (refused in one
+            # line, or the side files cut back to what is complete in all of them)
+            resume = _resume_point(folder, scene, problem, run_id, prev, resume_from, res)
+            life.untouched_on = ()
+            life.write_summary("running")
+        res.nodes = problem.grid.nodes.copy()
+        g = problem.grid
+        res.grid = {"kind": "uniform" if g.fine_radius is None else "banded", "nodes": g.n,
+                    "analysis_radius_m": g.radius}
+        if g.fine_radius is not None:
+            res.grid.update(band_m=g.fine_radius, spacing_m=float(g.nodes[1]),
+                            grading_m=scene.grid["grading"] if scene.grid else None)
+        res.warnings += _stiffness_warning(scene, problem)
+        interrupt.check()
+        writer = None
+        if folder is not None:
+            from ..io.writers import ContactWriter
 
-                writer = ContactWriter(folder, problem, vtk=scene.vtk, resume=resume,
-                                       run_id=run_id)
-            sink = Sink(problem, res, writer, progress)
-            if resume:
-                sink.load(folder.path, resume)
-            t1 = time.perf_counter()
-            if scene.continuation == "arclength":
-                _trace_arclength(scene, problem, sink)
-            else:
-                _trace_steps(scene, problem, sink, resume)
-            res.timings["solve_s"] = time.perf_counter() - t1
-            if folder is not None and (folder.path / CHECKPOINT).exists():
-                (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
-            if res.status == "running":
-                res.status = "converged"
-                _finish(scene, res, problem, sink, estimate)
-                if folder is not None and res.instrument is not None:
-                    from ..io.writers import write_instrument
+            writer = ContactWriter(folder, problem, vtk=scene.vtk, resume=resume,
+                                   run_id=run_id)
+            life.cleanup(writer.close)
+        sink = Sink(problem, res, writer, progress)
+        # stopped inside the sweep: its last committed state saved whole (the checkpoint)
+        life.on_stop = lambda: _save_checkpoint(folder, sink)
+        if resume:
+            sink.load(folder.path, resume)
+        t1 = time.perf_counter()
+        if scene.continuation == "arclength":
+            _trace_arclength(scene, problem, sink)
+        else:
+            _trace_steps(scene, problem, sink, resume)
+        res.timings["solve_s"] = time.perf_counter() - t1
+        life.on_stop = None
+        if folder is not None and (folder.path / CHECKPOINT).exists():
+            (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
+        if res.status == "running":
+            _finish(scene, res, problem, sink, estimate)
+            if folder is not None and res.instrument is not None:
+                from ..io.writers import write_instrument
 
-                    write_instrument(folder.path, res)
-                # a signal that arrived after the last safe point is still a stop: the run
-                # never ends "converged" once the user has asked it to stop
-                interrupt.check()
-        except (ConvergenceError, GuardError) as exc:
-            res.status, res.error = "failed", str(exc)
-        except Interrupted as exc:
-            res.status, res.error = exc.status, str(exc)
-            res.exit_code = exc.exit_code
-            if sink is not None and res.timings.get("solve_s") is None:
-                _save_checkpoint(folder, sink)       # stopped inside the sweep
-        except BaseException as exc:
-            # an output fault, a law error, a bug: the summary must not say "converged"
-            res.status = "failed"
-            res.error = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
-            if resuming and not checked and isinstance(exc, OutputError):
-                # refused while checking the folder: it is left as it was
-                folder = None
-            raise
-        finally:
-            if writer is not None:
-                writer.close()
-            res.timings["total_s"] = time.perf_counter() - t0
-            write_summary()
+                write_instrument(folder.path, res)
     return res
 
 
@@ -517,7 +419,8 @@ def _stiffness_warning(scene, problem):
                             f"Use [solver.grid] spacing <= "
                             f"{float(problem.grid.nodes[1]) * STIFFNESS_WARNING / ratio:.3g} m "
                             "(or leave the grid to femadh)."))
-    warnings.warn(msg, MeshResolutionWarning, stacklevel=4)
+    # (the caller of run(): _run <- run_contact <- runner.run.run <- the caller)
+    warnings.warn(msg, MeshResolutionWarning, stacklevel=5)
     return [msg]
 
 

@@ -37,7 +37,11 @@ import numpy as np
 from scipy import optimize
 
 from ..contact.forces import tail_force
-from ..errors import FemadhError
+# the error machinery's one home (Richardson, the guards), re-exported for the runner
+from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError,  # noqa: F401
+                               TrappingError, check_state, outside_bounds)
+from ..estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F401
+                                   discretisation)
 
 #: convergence order of the P2 FE body in the headline forces under element-size halving
 #: (observed 3.0-3.6 on layered stacks, validation/results/layered_fe.md; 3.3 homogeneous)
@@ -46,63 +50,6 @@ FE_ORDER = 3
 MAX_NODES = 3200
 #: refinements accuracy mode may make
 MAX_REFINEMENTS = 5
-#: a node whose softening exceeds this multiple of its own stiffness snaps alone
-TRAPPING_LIMIT = 1.0
-#: the contact may reach this fraction of the analysis radius
-EDGE_FRACTION = 0.9
-#: assumed order of the discretisation error in the node spacing (conservative, see above)
-ORDER = 1.0
-#: order of the envelope of an oscillating convergence (the contact edge moving between
-#: nodes, a node at a time): the Fig 3 scene's banded family, spacings 175 -> 15.5 nm, shows
-#: local orders from 1.2 to 2.2 around a sign-changing mean; the smaller end is taken
-#: (validation/results/adaptive.md)
-ENVELOPE_ORDER = 1.5
-#: the largest order a monotone sequence of three members may claim: their coarsest member
-#: is often pre-asymptotic (Fig 3 banded, 175/87.5/43.75 nm: apparent order 3.4, while the
-#: finest pair converges at ~1.3 against a 7.5-nm reference: an order-2 estimate was 0.4x
-#: the true error), so the family's envelope order caps it
-MAX_ORDER = ENVELOPE_ORDER
-
-
-class GuardError(FemadhError):
-    """A state or result outside the model's validity: names the quantity, its value and the
-    setting to change."""
-
-
-class TrappingError(GuardError):
-    """Lattice trapping: a node's softening beyond its own stiffness (``ratio``); a trigger
-    for refinement where femadh chooses the grid."""
-
-    def __init__(self, msg, ratio):
-        super().__init__(msg)
-        self.ratio = ratio
-
-
-def check_state(problem, state, scene):
-    """Refuse a state whose contact reaches the analysis radius or whose nodes snap alone."""
-    a = problem.grid.radius
-    if state.r_c > EDGE_FRACTION * a or (state.active.size and state.active[-1]):
-        raise GuardError(
-            f"the contact reaches the analysis radius at d = {state.d * 1e9:.4g} nm (r_c = "
-            f"{state.r_c * 1e6:.4g} um of a = {a * 1e6:.4g} um): the sphere's load does not "
-            "fit the analysed disk; grow [solver] analysis_radius (e.g. delta) or stop the "
-            "sweep earlier")
-    ratio = problem.node_softening_ratio(state.h)
-    if ratio > TRAPPING_LIMIT:
-        raise TrappingError(
-            f"at d = {state.d * 1e9:.4g} nm a node's surface-force softening -P'(h) is "
-            f"{ratio:.2f} x its own stiffness: single nodes snap on their own (lattice "
-            f"trapping) and the result depends on the mesh; {_finer_advice(problem, ratio)}",
-            ratio=ratio)
-
-
-def _finer_advice(problem, ratio):
-    """What to change for a grid whose band nodes snap alone at this softening ratio."""
-    g = problem.grid
-    if g.fine_radius is None:
-        return f"use [solver] nodes >= {int(math.ceil(g.n * ratio / 0.5))}"
-    return (f"use [solver.grid] spacing <= {float(g.nodes[1]) * 0.5 / ratio:.3g} m "
-            "(or leave the grid to femadh)")
 
 
 def tolerance_force(problem, state, tol):
@@ -400,7 +347,7 @@ def guard_bounds(res, problem):
     if "max_adhesion_N" not in hl or "dmt_pull_off_N" not in hl:
         return
     F, bound, err = hl["max_adhesion_N"], hl["dmt_pull_off_N"], hl.get("max_adhesion_N_error", 0)
-    if F - err > bound * (1 + 1e-9):
+    if outside_bounds(F, err, upper=bound):
         raise GuardError(
             f"the largest adhesion {F:.6g} N (estimated error {err:.2g} N) exceeds the "
             f"Derjaguin-Bradley bound 2 pi R W = {bound:.6g} N of the scene's work of "
@@ -433,34 +380,6 @@ def coarser_members(scene, problem, green=None):
             break
         out.append((f"spacing {h * 1e9:.4g} nm", variant(scene, grid={**g, "spacing": h})))
     return r, out
-
-
-def discretisation(fine, coarse, coarser=None, ratio=2.0):
-    """Signed estimate of each headline number's discretisation error, Q_exact - Q_fine, from
-    the coarser members of its grid family (spacings r h and r^2 h; N/2 and N/4 for uniform
-    grids, r = 2): (Q_h - Q_rh) / (r^p - 1) with the order p observed over the three levels
-    (clamped to [ORDER, 3]; ORDER = 1 without the third level)."""
-    out = {}
-    for k, v in fine.items():
-        c = coarse.get(k)
-        if not (isinstance(v, float) and isinstance(c, float) and math.isfinite(v)
-                and math.isfinite(c)):
-            continue
-        p = ORDER
-        cc = (coarser or {}).get(k)
-        if isinstance(cc, float) and math.isfinite(cc) and v != c and cc != c:
-            d1, d2 = v - c, c - cc
-            if d1 * d2 > 0 and abs(d2) > abs(d1):
-                # monotone convergence: the order it shows
-                p = min(MAX_ORDER, max(ORDER, math.log(abs(d2) / abs(d1)) / math.log(ratio)))
-            else:
-                # oscillating (a contact edge hopping between nodes): the two differences
-                # may cancel by chance; the envelope of both at the family's order
-                p = ENVELOPE_ORDER
-                out[k] = math.copysign(max(abs(d1), abs(d2) / ratio**p), d1) / (ratio**p - 1)
-                continue
-        out[k] = (v - c) / (ratio**p - 1.0)
-    return out
 
 
 QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",

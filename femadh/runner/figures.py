@@ -17,5 +17,4 @@ def draw_figures(res, folder):
             contact_figures(res, folder.path)
         res.timings["figures_s"] = time.perf_counter() - t0
     except Interrupted as exc:
-        res.status, res.error = exc.status, f"{exc} while drawing the figures"
-        res.exit_code = exc.exit_code
+        res.stop(exc, " while drawing the figures")

@@ -1,7 +1,8 @@
 """Run a ``[meniscus]`` scene (paper 2): a p/psat sweep for every liquid, tip radius and method;
 ``meniscus.csv``, ``profiles.csv`` (meridians), ``summary.json``, the force figure and VTK
 surfaces of revolution. Same guarantees as a contact run: the folder is claimed first, rows
-are written in whole chunks, SIGINT/SIGTERM stop after the current point."""
+are written in whole chunks, SIGINT/SIGTERM stop after the current point (the run's life:
+:mod:`.lifecycle`)."""
 import math
 from pathlib import Path
 import sys
@@ -10,19 +11,15 @@ import time
 import numpy as np
 
 from .._threads import blas_threads
-from .._version import __version__
 from ..errors import Interrupted
 from ..meniscus.solve import sweep_points
 from .. import interrupt
-from .result import MeniscusRunResult
+from .lifecycle import lifecycle
+from .result import MENISCUS_NOTE as NOTE  # noqa: F401  (what the columns mean)
+from .result import MeniscusRunResult, meniscus_headline
 
 HEADER = ["method", "p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",
           "neck_radius_m", "force_error_N", "liquid", "tip_radius_m"]
-NOTE = ("Capillary force on the sphere, attractive positive, normalised by 4 pi R gamma with R "
-        "the solid tip radius; the adsorbed film (thickness h from the isotherm) covers sphere "
-        "and flat, the film-covered sphere has radius R + h and, in contact, D = -2h "
-        "(paper 2 Fig 2b); zero contact angle on the films. 'no-film' is the exact meniscus on "
-        "bare solids (h = 0).")
 COLUMNS = ("p_ratio", "film_m", "kelvin_radius_m", "force_N", "force_over_4piRgamma",
            "neck_radius_m", "force_error_N")
 #: observed order of the FE meridian's force in the element count (cG(2) nodal
@@ -45,7 +42,10 @@ def run_meniscus(scene, out_dir=None, *, figures=True, progress=None, overwrite=
         with RunFolder(out_dir, scene_id(scene), scene.name,
                        "overwrite" if overwrite else "new") as folder:
             res = _run(scene, folder, progress)
-            if figures and any(np.any(np.isfinite(c["force_N"])) for c in res.curves.values()):
+            # a stopped run draws no figure (as a contact run; it would report the stop
+            # again as one "while drawing the figure")
+            if figures and res.status in ("converged", "failed") and any(
+                    np.any(np.isfinite(c["force_N"])) for c in res.curves.values()):
                 from ..io.plots import meniscus_forces
 
                 t0 = time.perf_counter()
@@ -54,9 +54,8 @@ def run_meniscus(scene, out_dir=None, *, figures=True, progress=None, overwrite=
                         meniscus_forces(res, folder.path / "meniscus_force.png")
                     res.timings["figures_s"] = time.perf_counter() - t0
                 except Interrupted as exc:
-                    res.status, res.error = exc.status, f"{exc} while drawing the figure"
-                    res.exit_code = exc.exit_code
-                folder.write_summary(summary(res))
+                    res.stop(exc, " while drawing the figure")
+                folder.write_summary(res.summary())
             return res
 
 
@@ -66,61 +65,51 @@ def _run(scene, folder, progress):
     t0 = time.perf_counter()
     res = MeniscusRunResult(scene.name, scene, out_dir=None if folder is None
                             else str(folder.path))
-    logs = None
     combos = [(lq, R, m) for lq in scene.liquids for R in scene.radii for m in scene.methods]
-    bar = None
-    if progress:
-        from ..io.progress import bar as make_bar
 
-        bar = make_bar(len(combos) * len(scene.p_ratios), scene.name)
-    with interrupt.interruptible():
-        try:
-            if folder is not None:
-                folder.write_summary(summary(res, status="running"))
-                logs = (RowLog(folder.path / "meniscus.csv", HEADER),
-                        RowLog(folder.path / "profiles.csv",
-                               ["liquid", "tip_radius_m", "method", "p_ratio", "r_m", "z_m"]))
-            for lq, R, meth in combos:
-                iso = scene.isotherms[lq.name]
-                cur = {k: [] for k in COLUMNS}
-                res.curves[lq.name, R, meth] = cur
-                t1 = time.perf_counter()
-                points = []
-                for x, r in sweep_points(meth, R, lq, scene.temperature, iso, scene.p_ratios,
-                                         scene.separation, elements=scene.elements):
-                    points.append(r)
-                    err = _error_estimate(scene, meth, R, lq, r)
-                    _record(res, cur, lq, R, meth, x, r, logs, err)
-                    if bar is not None:
-                        bar.update(1)
-                    interrupt.check()
-                res.timings[f"{lq.name}/{R:g}/{meth}_s"] = time.perf_counter() - t1
-                if folder is not None and scene.vtk and meth == "fe":
-                    _write_vtk(folder.path, lq.name, R, scene.p_ratios, points)
-            res.status = "converged"
-        except Interrupted as exc:
-            res.status, res.error = exc.status, str(exc)
-            res.exit_code = exc.exit_code
-        except BaseException as exc:
-            res.status = "failed"
-            res.error = f"{type(exc).__name__}: {exc}"
-            raise
-        finally:
-            if bar is not None:
-                bar.close()
-            for log in logs or ():
-                log.close()
-            for cur in res.curves.values():
-                for k in cur:
-                    cur[k] = np.array(cur[k], float)
-            n_ok = sum(int(np.sum(np.isfinite(c["force_N"]))) for c in res.curves.values())
-            if res.status == "converged" and n_ok == 0:
-                res.status = "failed"
-                res.error = (f"no point of the scene has a meniscus ({len(res.errors)} points "
-                             f"failed; first: {res.errors[0]['error'] if res.errors else '-'})")
-            res.timings["total_s"] = time.perf_counter() - t0
-            if folder is not None:
-                folder.write_summary(summary(res))
+    def write_summary(status=None):
+        if folder is not None:
+            folder.write_summary(res.summary(status))
+
+    def arrays():
+        for cur in res.curves.values():
+            for k in cur:
+                cur[k] = np.array(cur[k], float)
+        res.headline = meniscus_headline(res.curves)
+    with lifecycle(res, write_summary, t0=t0) as life:
+        if progress:
+            from ..io.progress import bar as make_bar
+
+            bar = make_bar(len(combos) * len(scene.p_ratios), scene.name)
+            life.cleanup(bar.close)
+        logs = None
+        if folder is not None:
+            logs = (RowLog(folder.path / "meniscus.csv", HEADER),
+                    RowLog(folder.path / "profiles.csv",
+                           ["liquid", "tip_radius_m", "method", "p_ratio", "r_m", "z_m"]))
+            for log in logs:
+                life.cleanup(log.close)
+        life.cleanup(arrays)
+        for lq, R, meth in combos:
+            iso = scene.isotherms[lq.name]
+            cur = {k: [] for k in COLUMNS}
+            res.curves[lq.name, R, meth] = cur
+            t1 = time.perf_counter()
+            points = []
+            for x, r in sweep_points(meth, R, lq, scene.temperature, iso, scene.p_ratios,
+                                     scene.separation, elements=scene.elements):
+                points.append(r)
+                err = _error_estimate(scene, meth, R, lq, r)
+                _record(res, cur, lq, R, meth, x, r, logs, err)
+                if progress:
+                    bar.update(1)
+                interrupt.check()
+            res.timings[f"{lq.name}/{R:g}/{meth}_s"] = time.perf_counter() - t1
+            if folder is not None and scene.vtk and meth == "fe":
+                _write_vtk(folder.path, lq.name, R, scene.p_ratios, points)
+        if not any(np.any(np.isfinite(c["force_N"])) for c in res.curves.values()):
+            res.fail(f"no point of the scene has a meniscus ({len(res.errors)} points failed; "
+                     f"first: {res.errors[0]['error'] if res.errors else '-'})")
     return res
 
 
@@ -195,10 +184,3 @@ def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
         save_atomic(vdir / name, lambda p, mesh=mesh: meshio.write(p, mesh, file_format="vtu"))
         entries.append((x, f"vtk/{name}", 0))
     write_pvd(Path(out) / f"meniscus_{tag}.pvd", entries)
-
-
-def summary(res, status=None):
-    return {"femadh_version": __version__, "scene_file": res.scene.path,
-            "status": status or res.status, "error": res.error, "note": NOTE,
-            "scene": res.scene.resolved, "domain_errors": res.errors,
-            "timings_s": res.timings, "wall_time_s": res.wall_time}

@@ -1,15 +1,19 @@
 """What a run returns: data only (arrays and numbers, picklable, no solver internals).
 
-- :class:`ContactResult` - a contact scene: status, the approach/retract curves with every
-  force column, the jumps, the headline numbers with their error estimates, timings.
+- :class:`RunResult` - what every run has: its name and scene, ``status`` ("running" until
+  the run decides, then "converged", "failed", "interrupted" or "time limit"), ``error``,
+  ``exit_code`` of a stopped run, ``timings``, ``out_dir``, the ``headline`` numbers with
+  their estimated errors, :meth:`~RunResult.summary` (summary.json) and
+  :meth:`~RunResult.to_csv`.
+- :class:`ContactResult` - a contact scene: the approach/retract curves with every force
+  column, the jumps, the error breakdown, the grid, the instrument's record.
 - :class:`MeniscusRunResult` - a meniscus scene: one force curve per liquid, radius, method.
 
-Both have ``to_csv`` and ``status`` ("running" until the run decides, then "converged",
-"failed", "interrupted" or "time limit") and ``error``.
+The run's life (status "running" on disk from the start, the outcome mapped to a status, the
+final summary) is :mod:`femadh.runner.lifecycle`'s, the same for every kind.
 """
 import csv
 from dataclasses import dataclass, field
-
 import numpy as np
 
 #: short names of curve columns for :meth:`ContactResult.curve` (csv name -> short)
@@ -17,20 +21,87 @@ SHORT = {"d_m": "d", "h0_m": "h0", "F_LJ_N": "F_LJ", "F_el_N": "F_el", "F_ex_N":
          "r_c_m": "r_c", "n_iter": "n_iter", "residual_m": "residual",
          "converged": "converged", "stable": "stable", "F_cap_N": "F_cap", "F_LJa_N": "F_LJa",
          "F_ela_N": "F_ela"}
+#: the statuses of a run stopped at a safe point (resumable)
+STOPPED = ("interrupted", "time limit")
 
 
 @dataclass
-class ContactResult:
-    """A contact run.
+class RunResult:
+    """What every run returns (a contact, meniscus or study point's run).
 
     Attributes
     ----------
     name : str
+        The scene's name.
     scene : Scene
+        The scene that was run.
     status : str
         "running" until the run decides; then "converged", "failed" (``error`` says where),
-        "interrupted" or "time limit".
+        "interrupted" (SIGINT/SIGTERM) or "time limit".
     error : str or None
+        Why the run did not converge or stopped.
+    timings : dict
+        Seconds per phase; ``total_s`` the run's.
+    out_dir : str or None
+        The folder the outputs were written into (None: nothing written).
+    headline : dict
+        The headline numbers (e.g. max adhesion, N) and, as ``<name>_error``, their
+        estimated errors (same unit).
+    exit_code : int or None
+        A stopped run's exit code: 130 (SIGINT), 143 (SIGTERM), 6 (time limit); None for a
+        run that converged or failed (the command line exits 0 or 3).
+    """
+
+    name: str
+    scene: object
+    status: str = "running"
+    error: str | None = None
+    timings: dict = field(default_factory=dict)
+    out_dir: str | None = None
+    headline: dict = field(default_factory=dict)
+    exit_code: int | None = None
+
+    #: the scene kind ("contact", "meniscus")
+    kind = None
+
+    @property
+    def wall_time(self):
+        """The run's wall time (s)."""
+        return float(self.timings.get("total_s", 0.0))
+
+    def stop(self, exc, where=""):
+        """The run stopped at a safe point by ``exc`` (an Interrupted or TimeLimitReached):
+        its status, error (``where`` appended) and exit code."""
+        self.status, self.error, self.exit_code = exc.status, f"{exc}{where}", exc.exit_code
+
+    def fail(self, error):
+        """The run failed: ``error`` says where and why."""
+        self.status, self.error = "failed", error
+
+    def summary(self, status=None):
+        """summary.json of the run as a dict (``status`` overrides the result's)."""
+        raise NotImplementedError(f"{type(self).__name__} has no summary")
+
+    def table(self):
+        """(header, rows) of the run's csv (:meth:`to_csv`)."""
+        raise NotImplementedError(f"{type(self).__name__} has no table")
+
+    def to_csv(self, path):
+        """The run's curves as one csv (:meth:`table`); returns ``path``."""
+        header, rows = self.table()
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(header)
+            w.writerows(rows)
+        return path
+
+
+@dataclass
+class ContactResult(RunResult):
+    """A contact run (the fields of :class:`RunResult` and these).
+
+    Attributes
+    ----------
     branches : dict
         "approach" / "retract" -> dict of arrays keyed by the curve.csv columns (d_m, h0_m,
         F_LJ_N, F_el_N, F_ex_N, r_c_m, n_iter, residual_m, converged, stable, and one force
@@ -59,43 +130,29 @@ class ContactResult:
     grid : dict
         The discretisation used: kind (uniform/banded), nodes, analysis radius, band and
         spacing (banded), the spacing ratio of the estimate's coarser members and their labels.
-    timings : dict
-        Seconds per phase.
     warnings : list of str
-    out_dir : str or None
     """
 
-    name: str
-    scene: object
-    status: str = "running"
-    error: str | None = None
     branches: dict = field(default_factory=dict)
     jumps: list = field(default_factory=list)
     equilibrium_curve: dict | None = None
     profiles: dict = field(default_factory=dict)
     nodes: np.ndarray | None = None
-    headline: dict = field(default_factory=dict)
     estimates: dict = field(default_factory=dict)
-    timings: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
-    out_dir: str | None = None
     accuracy: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
     instrument: dict | None = None
 
     kind = "contact"
 
-    @property
-    def wall_time(self):
-        return float(self.timings.get("total_s", 0.0))
-
     def curve(self, branch):
         """Arrays of one branch with short names: d, h0, F_LJ, F_el, F_ex, r_c, n_iter,
         residual, converged, stable, and F_cap / F_LJa / F_ela where the scene has them."""
         return {SHORT.get(k, k): v for k, v in self.branches[branch].items()}
 
-    def to_csv(self, path):
-        """Both branches in one csv (the columns of curve.csv)."""
+    def table(self):
+        """Both branches in one table (the columns of curve.csv after a "branch" column)."""
         rows = []
         header = None
         for b, cols in self.branches.items():
@@ -103,11 +160,11 @@ class ContactResult:
             n = len(next(iter(cols.values())))
             for i in range(n):
                 rows.append([b] + [_cell(cols[k][i]) for k in cols])
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(header or ["branch"])
-            w.writerows(rows)
-        return path
+        return header or ["branch"], rows
+
+    def summary(self, status=None):
+        """summary.json of a contact run (:func:`contact_summary`)."""
+        return contact_summary(self, status)
 
 
 def _cell(x):
@@ -118,38 +175,70 @@ def _cell(x):
     return repr(float(x))
 
 
-@dataclass
-class MeniscusRunResult:
-    """A meniscus run: ``curves[(liquid, tip_radius_m, method)]`` is a dict of arrays
-    (p_ratio, film_m, kelvin_radius_m, force_N, force_over_4piRgamma, neck_radius_m and the
-    estimated error force_error_N; nan where no meniscus exists), ``errors`` the points without
-    one (dicts naming liquid, radius, method, p/psat and why)."""
+#: what meniscus.csv and summary.json say the meniscus columns mean
+MENISCUS_NOTE = (
+    "Capillary force on the sphere, attractive positive, normalised by 4 pi R gamma with R "
+    "the solid tip radius; the adsorbed film (thickness h from the isotherm) covers sphere "
+    "and flat, the film-covered sphere has radius R + h and, in contact, D = -2h "
+    "(paper 2 Fig 2b); zero contact angle on the films. 'no-film' is the exact meniscus on "
+    "bare solids (h = 0).")
+MENISCUS_COLUMNS = ["liquid", "tip_radius_m", "method", "p_ratio", "film_m", "kelvin_radius_m",
+                    "force_N", "force_over_4piRgamma", "neck_radius_m", "force_error_N"]
 
-    name: str
-    scene: object
-    status: str = "running"
-    error: str | None = None
+
+@dataclass
+class MeniscusRunResult(RunResult):
+    """A meniscus run (the fields of :class:`RunResult` and these).
+
+    Attributes
+    ----------
+    curves : dict
+        ``(liquid, tip_radius_m, method)`` -> dict of arrays (p_ratio, film_m,
+        kelvin_radius_m, force_N, force_over_4piRgamma, neck_radius_m and the estimated error
+        force_error_N; nan where no meniscus exists).
+    errors : list of dict
+        The points without a meniscus (liquid, tip_radius_m, method, p_ratio and why).
+    headline : dict
+        ``max_force_N[liquid,R,method]``: the largest capillary force of each curve (N) and,
+        as ``..._error``, the estimated error at it (nan: not estimated, the circular
+        approximation); set when the run ends.
+    """
+
     curves: dict = field(default_factory=dict)
     errors: list = field(default_factory=list)
-    timings: dict = field(default_factory=dict)
-    out_dir: str | None = None
 
     kind = "meniscus"
 
-    @property
-    def wall_time(self):
-        return float(self.timings.get("total_s", 0.0))
+    def table(self):
+        """Every curve in one table (:data:`MENISCUS_COLUMNS`)."""
+        rows = [[liq, repr(R), meth] + [repr(float(c[k][i])) for k in MENISCUS_COLUMNS[3:]]
+                for (liq, R, meth), c in self.curves.items() for i in range(len(c["p_ratio"]))]
+        return MENISCUS_COLUMNS, rows
 
-    def to_csv(self, path):
-        cols = ["liquid", "tip_radius_m", "method", "p_ratio", "film_m", "kelvin_radius_m",
-                "force_N", "force_over_4piRgamma", "neck_radius_m", "force_error_N"]
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(cols)
-            for (liq, R, meth), c in self.curves.items():
-                for i in range(len(c["p_ratio"])):
-                    w.writerow([liq, repr(R), meth] + [repr(float(c[k][i])) for k in cols[3:]])
-        return path
+    def summary(self, status=None):
+        """summary.json of a meniscus run."""
+        from .._version import __version__
+
+        return {"femadh_version": __version__, "scene_file": self.scene.path,
+                "status": status or self.status, "error": self.error, "note": MENISCUS_NOTE,
+                "scene": self.scene.resolved, "domain_errors": self.errors,
+                "timings_s": self.timings, "wall_time_s": self.wall_time}
+
+
+def meniscus_headline(curves):
+    """The largest force of each meniscus curve (N) and its estimated error (the error of
+    that point; nan where not estimated): ``max_force_N[liquid,R,method]`` and
+    ``max_force_N[liquid,R,method]_error`` (R in m, as ``%g``)."""
+    out = {}
+    for (liq, R, meth), c in curves.items():
+        f = np.asarray(c["force_N"], float)
+        if not np.any(np.isfinite(f)):
+            continue
+        k = int(np.nanargmax(f))
+        key = f"max_force_N[{liq},{R:g},{meth}]"
+        out[key] = float(f[k])
+        out[f"{key}_error"] = float(np.asarray(c["force_error_N"], float)[k])
+    return out
 
 
 def contact_summary(res, status=None):

@@ -8,7 +8,8 @@ in scenes built in code (:func:`scene_from_dict`, :meth:`Scene.from_dict`, and
 unknown keys (with a "did you mean"), missing keys, wrong units, values out of range - is
 reported at once, each naming the file, the key, the value and what was expected
 (:class:`~femadh.errors.SceneError`). A scene with a ``[meniscus]`` table is a capillary
-(paper 2) scene (:class:`MeniscusScene`); otherwise a contact scene (:class:`Scene`).
+(paper 2) scene (:class:`MeniscusScene`); otherwise a contact scene (:class:`Scene`), made of
+frozen parts (:mod:`femadh.scene.parts`: body, laws, discretisation, sweep, output).
 ``femadh keys`` prints every key (:func:`reference_page`).
 """
 import copy
@@ -22,13 +23,15 @@ except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
 from ..errors import SceneError
-from .build import build_operator, build_problem
+from .build import build_operator, build_problem, operator_key
 from .contact import Scene, parse_contact
 from .meniscus import MeniscusScene, parse_meniscus
+from .parts import Body, Discretisation, Laws, Output, Sweep
 from .reader import Reader
 
-__all__ = ["Scene", "MeniscusScene", "load_scene", "scene_from_dict", "apply_overrides",
-           "build_operator", "build_problem", "reference_page", "scene_id"]
+__all__ = ["Scene", "MeniscusScene", "Body", "Laws", "Discretisation", "Sweep", "Output",
+           "load_scene", "scene_from_dict", "apply_overrides", "build_operator",
+           "build_problem", "operator_key", "reference_page", "scene_id"]
 
 
 def load_scene(path):

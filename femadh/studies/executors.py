@@ -51,22 +51,42 @@ NOT_PHYSICAL = (OutputError, DependencyError, Interrupted)
 
 # --------------------------------------------------------------------------- the worker
 
+#: the surface operator a worker keeps: {operator key: operator}, one at a time
 OPERATOR_CACHE = {}
 _IN_POOL = False
 
 
-def _operator_key(sc):
-    """Everything :func:`femadh.scene.build_operator` reads, as a string (FESettings and the
-    material records are not hashable; repr of a float is exact)."""
+def study_operator_key(sc):
+    """The key under which a worker keeps a point's surface operator: the content hash of the
+    pair it is built from, ``(scene.body, scene.discretisation)``
+    (:func:`femadh.scene.operator_key`), so that no field the operator reads can be left out.
+    None when no operator is kept: a meniscus scene, or an adaptive run (it builds the grid
+    members it chooses)."""
     if sc.kind != "contact" or sc.adaptive:
-        return None                 # an adaptive run builds the members it chooses
-    fe = None
-    if sc.method == "fe":
-        fe = (sc.fe_settings, sc.fe_poisson_ratio)
-        if sc.layers:
-            fe += (tuple(sc.layers), sc.disk, sc.slider)
-    grid = None if sc.grid is None else sorted(sc.grid.items())
-    return repr((sc.method, sc.nodes, grid, sc.analysis_radius, sc.e_star, fe))
+        return None
+    from ..scene import operator_key
+
+    return operator_key(*sc.operator_inputs)
+
+
+#: the name of earlier versions (femadh.fitting reads it)
+
+
+def worker_operator(sc):
+    """``(operator, reused)``: the surface operator of a point's scene, the one kept in this
+    process when its key matches (``reused``), else built and kept instead (one operator per
+    worker: bounded memory); ``(None, False)`` when the scene keeps none
+    (:func:`study_operator_key`)."""
+    from ..scene import build_operator
+
+    key = study_operator_key(sc)
+    if key is None:
+        return None, False
+    if key in OPERATOR_CACHE:
+        return OPERATOR_CACHE[key], True
+    OPERATOR_CACHE.clear()
+    OPERATOR_CACHE[key] = build_operator(sc)
+    return OPERATOR_CACHE[key], False
 
 
 def finished(rec):
@@ -87,17 +107,16 @@ def write_record(folder, rec):
 def run_point(point, root, estimate=True):
     """Run one point into ``root/points/<id>/`` and return its record (a small dict).
 
-    Runs in a worker: the surface operator of each distinct grid/mesh is built once per
-    process and reused. Never raises for a failed solve or a fault of the point: the record
-    says what happened and whether it is final (``finished``). A signal that stops the
-    point's run is recorded ("interrupted") and then ends a pool worker with that signal,
-    so that the driver's shutdown does not wait for it."""
+    Runs in a worker: the surface operator of each distinct body and discretisation is built
+    once per process and reused (:func:`worker_operator`). Never raises for a failed solve or
+    a fault of the point: the record says what happened and whether it is final
+    (``finished``). A signal that stops the point's run is recorded ("interrupted") and then
+    ends a pool worker with that signal, so that the driver's shutdown does not wait for it."""
     from .._threads import blas_threads
     from ..runner.contact import run
-    from ..scene import build_operator
     import warnings
 
-    _tune_malloc()
+    tune_malloc()
     t0 = time.perf_counter()
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
@@ -110,15 +129,7 @@ def run_point(point, root, estimate=True):
         # terminal of the study
         with blas_threads(), warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshResolutionWarning)
-            key = _operator_key(point.scene)
-            op = None
-            if key is not None:
-                if key in OPERATOR_CACHE:
-                    rec["operator_reused"] = True
-                else:
-                    OPERATOR_CACHE.clear()          # one operator per worker: bounded memory
-                    OPERATOR_CACHE[key] = build_operator(point.scene)
-                op = OPERATOR_CACHE[key]
+            op, rec["operator_reused"] = worker_operator(point.scene)
             res = run(point.scene, folder, figures=False, progress=False, overwrite=True,
                       operator=op, estimate=estimate)
         rec["status"], rec["error"] = res.status, res.error
@@ -192,7 +203,7 @@ def _pool_init():
 _MALLOC_TUNED = False
 
 
-def _tune_malloc():
+def tune_malloc():
     """Undo dask's MALLOC_TRIM_THRESHOLD_ for femadh's allocation pattern (once per process).
 
     A dask nanny starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which also switches

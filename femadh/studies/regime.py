@@ -16,25 +16,22 @@ displacement-controlled experiment follow from it. Read off the curve:
 Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277; Feng 2000,
 J. Colloid Interface Sci. 238, 318.
 
-Grid (JKR side): the law acts in a cohesive zone at the contact edge whose width scales like the
-elastocohesive length E* z0^2 / dg, while the contact radius grows like mu^(1/2): at mu = 20
-(R = 1 um) the zone is ~1 z0 wide at a contact of ~800 z0. A node coarser than the zone snaps on
-its own (lattice trapping: extra folds, an early jump-out). The grid is therefore a band of
-uniform fine spacing around the *current* contact edge, coarsening linearly with the distance
-from it (:meth:`RadialGrid.banded`), and it moves with the edge during the trace (a new grid
-when the edge leaves the middle of the band; :func:`trace_curve`'s ``regrid``, also through
-the folds, where on the JKR side the edge travels ~0.05 z0 R / ell while |dd/ds| < 0.05:
-~200 ell at mu = 20; ``band_offset`` reports how far it strayed): the node count
-no longer grows like mu^2. The lateral length that sets the spacing is the smaller of the
-elastocohesive length and sqrt(R z0 / 8) (the DMT side, where the contact is smaller than the
-cohesive zone and the law's range over the paraboloid sets the scale).
+Grid: a band of uniform fine spacing that follows the contact edge, graded beyond it
+(:class:`~femadh.studies.smooth_sphere.PointSetup`, :class:`Resolution`); ``band_offset``
+reports how far the edge strayed from the band's centre, the guards refuse a point whose edge
+left it, whose nodes snap alone or whose contact reaches the analysis radius.
 
 Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
 grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).
 ``accuracy=`` chooses the spacing from the measured error model, capped so that the coarser
-member stays below 0.075 elastocohesive lengths on the JKR side (coarser, lattice wiggles
-move the flat jump-out fold and Richardson no longer applies), and refines until the
-estimate meets the request.
+member stays below 0.075 elastocohesive lengths on the JKR side when the fixed-grip pull-off
+is judged (coarser, lattice wiggles move the flat jump-out fold and Richardson no longer
+applies; ``judged=`` names the quantities the request is asked of), and refines until the
+estimate meets the request. Richardson, the guards and the refine-until-met loop with its
+budget are the runner's too (:mod:`femadh.estimate`); the curve readout is
+:func:`femadh.contact.curve.read_curve`, the smooth-sphere problem
+:mod:`femadh.studies.smooth_sphere`, the moving band and the contact edge
+:mod:`femadh.discretisation.moving`: this module keeps the map.
 
 Stability: each fold flips it unless another Hessian mode is already negative there (at
 mu >= 5 a second mode turns negative after the jump-in and back: four folds, the piece
@@ -47,39 +44,20 @@ import warnings
 
 import numpy as np
 
-from ..contact import ContactProblem
-from ..contact.arclength import trace_curve
-from ..discretisation.moving import MovingBand, contact_edge
-from ..elastic import GreenOperator
+from ..contact.curve import read_curve
+from ..discretisation.moving import contact_edge
 from ..errors import ConvergenceError, MeshResolutionWarning
-from ..indenter import Sphere
+from ..estimate import (TRAPPING_LIMIT, Budget, discretisation, outside_bounds,
+                        refine_until_met, trapping_message, worst_relative)
 from ..laws import LennardJones
-from ..reference.adhesion import jkr_contact_radius
-from ..reference.maugis import (lj_dugdale_lambda, maugis_fixed_grip_pull_off,
-                                maugis_length_units, maugis_pull_off)
-from .smooth_sphere import (FINE_MARGIN, PRELOAD, STIFFNESS_TARGET, deepest_separation,
-                            e_star_length, lateral_length, lj_force, lj_sphere_problem)
+from ..reference.maugis import lj_dugdale_lambda, maugis_fixed_grip_pull_off, maugis_pull_off
+# the smooth-sphere problem of one point (re-exported: the map's public names)
+from .smooth_sphere import (ANALYSIS_RADIUS, BAND, BAND_MU, DS_MAX,  # noqa: F401
+                            EDGE_GAP, GRADING, SPACING, TRACE_CORRECTION, PointSetup,  # noqa
+                            Resolution, e_star_length, lateral_length, lj_force, trace_point)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
-#: a posteriori: above this local ratio -P'(h_k)/K_kk (on any traced state) a node can snap on
-#: its own (lattice trapping): the point is not a converged result
-TRAPPING_LIMIT = 1.0
-#: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
-#: it is added to the force exactly); at least sqrt(2 R 20 z0) (the rigid gap there is 20 z0)
-ANALYSIS_RADIUS = 8.0
-#: banded grid family (lengths in units of the lateral length ell, see lateral_length):
-#: band spacing (the family parameter), half-width of the fine band, and the grading length
-#: over which the spacing grows by one band spacing
-SPACING = 0.1
-BAND = 4.0
-GRADING = 2.0
-#: above this Tabor parameter the band's half-width grows like mu: near the flat jump-out
-#: fold the two grids of an exchange disagree on the side of the fold (measured at mu = 20,
-#: band 4 ell: 43 exchanges refused while the edge travelled ~3 ell, and it left the band)
-BAND_MU = 10.0
-#: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
-EDGE_GAP = 1.5
 #: a contact edge further than this fraction of the band's half-width from its centre is
 #: not resolved (the cohesive zone, ~0.7 ell wide, reaches the graded part); exchanges keep
 #: it within ~0.55 (measured max 0.53-0.74 at mu = 3-20, band 4 ell)
@@ -97,6 +75,8 @@ MAX_REFINEMENTS = 4
 #: node budget of a refinement (a dense grid of N nodes costs ~N^2 per Krylov iteration at
 #: every continuation step: 1600 nodes ~ 10x the cost of 500)
 MAX_NODES = 1600
+#: the budget of an accuracy request (:func:`femadh.estimate.refine.refine_until_met`)
+BUDGET = Budget(MAX_REFINEMENTS, MAX_NODES)
 #: the headline quantities and the accuracy they are judged by
 QUANTITIES = ("pull_off", "pull_off_displacement", "jump_in", "jump_out", "hysteresis")
 #: proven bounds of the load-controlled pull-off / (pi R dg) for a paraboloid (see
@@ -107,54 +87,6 @@ DERJAGUIN, JKR = 2.0, 1.5
 class ResolutionError(ConvergenceError):
     """A traced state is not resolved by the grid (lattice trapping, a contact reaching the
     analysis radius) or a result leaves its proven bounds: not a converged map point."""
-
-
-@dataclass(frozen=True)
-class Resolution:
-    """Discretisation of one regime-map point.
-
-    Attributes
-    ----------
-    spacing : float
-        Fine-band node spacing / lateral length ell (the grid family's parameter).
-    band, grading : float
-        Half-width of the fine band (units of ell; x mu / BAND_MU beyond BAND_MU) and grading
-        length (units of ell).
-    analysis_radius : float
-        Analysis radius in units of Maugis' a_unit (at least sqrt(40 R z0)).
-    ds_max : float or None
-        Largest continuation step (units of z0); None: from the trace's length.
-    stiffness_target, min_nodes : float, int or None
-        Legacy fixed graded grid (today's explicit settings, no moving band): when either is
-        set the grid is :func:`~femadh.studies.smooth_sphere.lj_sphere_problem`'s and its
-        coarser member has twice the spacing.
-    """
-
-    spacing: float = SPACING
-    band: float = BAND
-    grading: float = GRADING
-    analysis_radius: float = ANALYSIS_RADIUS
-    ds_max: float | None = None
-    stiffness_target: float | None = None
-    min_nodes: int | None = None
-
-    @property
-    def legacy(self):
-        return self.stiffness_target is not None or self.min_nodes is not None
-
-    def coarser(self, factor=2.0):
-        """A coarser member of the same grid family (spacing x factor)."""
-        if self.legacy:
-            return replace(self, stiffness_target=factor * (self.stiffness_target or
-                                                            STIFFNESS_TARGET),
-                           min_nodes=max(8, int((self.min_nodes or 120) / factor)))
-        return replace(self, spacing=factor * self.spacing)
-
-    def finer(self, factor=2.0):
-        if self.legacy:
-            return replace(self, stiffness_target=(self.stiffness_target or STIFFNESS_TARGET)
-                           / factor, min_nodes=int((self.min_nodes or 120) * factor))
-        return replace(self, spacing=self.spacing / factor)
 
 
 @dataclass
@@ -193,6 +125,7 @@ class RegimePoint:
     accuracy: float | None = None  # the requested relative accuracy (None: explicit settings)
     failed: str | None = None      # why the point is not a converged result (None: it is)
     band_offset: float = math.nan  # largest |contact edge - band centre| / band half-width
+    judged: tuple = QUANTITIES     # the quantities the accuracy was asked of
 
     def error(self, name):
         """Estimated absolute error of quantity ``name`` (None if it does not exist)."""
@@ -213,154 +146,35 @@ class RegimePoint:
     hysteresis_error = property(lambda self: self.error("hysteresis"))
 
 
-class PointSetup:
-    """Physical problem of one map point and the grids of one resolution."""
-
-    def __init__(self, mu, radius, law, res):
-        self.mu, self.radius, self.law, self.res = mu, radius, law, res
-        dg, z0 = law.work_of_adhesion, law.z0
-        self.dg, self.z0 = dg, z0
-        self.e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
-        a_unit, d_unit = maugis_length_units(radius, self.e_star, dg)
-        self.a = max(res.analysis_radius * a_unit, math.sqrt(2 * radius * 20 * z0))
-        self.ell = lateral_length(law, radius, self.e_star)
-        # DMT side (the range, not an edge, sets ell): one grid, fine over the whole travel
-        # of the edge (up to the JKR radius at PRELOAD, which bounds Maugis-Dugdale's); a
-        # moving band would carry states across the narrow loops near the cusp
-        self.fixed_band = None
-        if self.ell < e_star_length(law, self.e_star):
-            a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, self.e_star, dg)
-            self.fixed_band = min(FINE_MARGIN * a_max, 0.5 * self.a)
-        self.spacing = res.spacing * self.ell
-        # half-width of the moving band (m): wider beyond BAND_MU, where the jump-out fold is
-        # so flat that the grids' folds lie apart and exchanges are refused over a window
-        self.half = res.band * self.ell * max(1.0, mu / BAND_MU)
-        self.d_end = deepest_separation(mu, radius, self.e_star, law)
-        # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
-        # its landing on the approach branch is on the curve
-        fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
-        d_out = z0 - (fg[1] * d_unit if fg else 0.0)
-        self.d_start = max(12 * z0, 1.5 * d_out)
-        self.ds_max = res.ds_max if res.ds_max else max(0.5, 0.02 * self.d_start / z0)
-        self.sphere = Sphere(radius)
-
-        def build(grid, first):
-            return ContactProblem(GreenOperator(grid, self.e_star), self.sphere,
-                                  {"law": self.law}, check_laws=first)
-        # the grid family of this resolution: a band following the contact edge (one home
-        # for the moving band: femadh.discretisation.moving)
-        self.band = MovingBand(self.a, self.spacing, self.half, res.grading * self.ell, build,
-                               EDGE_GAP * z0, fixed=self.fixed_band)
-
-    def problem(self, center=0.0):
-        """The problem on a grid fine around the contact edge at ``center`` (m)."""
-        if self.res.legacy:
-            if not isinstance(self.law, LennardJones):
-                raise ValueError("the legacy fixed grid is defined for LennardJones only")
-            return lj_sphere_problem(self.mu, self.radius, self.law.hamaker, self.z0,
-                                     self.res.stiffness_target or STIFFNESS_TARGET,
-                                     self.res.min_nodes or 120)[0]
-        return self.band.problem(center)
-
-    def stop(self, curve):
-        """End the trace once the stable branch after the folds has passed both the smallest
-        fold separation (so the jump-in's landing is on the curve) and its largest tension
-        (the tension falls again between the last two points: the load-controlled pull-off
-        is behind). Curves without folds run to d_end."""
-        pts = curve.points
-        if not curve.folds or curve.folds[-1].index >= len(pts) - 2:
-            return False
-        p, q = pts[-2], pts[-1]
-        if not (q.stable and p.stable and p.seg == q.seg and q.d < p.d):
-            return False
-        if q.d >= min(f.d for f in curve.folds):
-            return False
-        pb = curve.problem_of(q.seg)
-        return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
-
-    def band_offset(self, problem, edge):
-        """|edge - band centre| / band half-width (0 for a fixed band or the legacy grid)."""
-        return 0.0 if self.res.legacy else self.band.band_offset(problem, edge)
-
-    def regrid(self, problem, w, d):
-        """A grid whose band leads the edge (:meth:`MovingBand.regrid`)."""
-        return None if self.res.legacy else self.band.regrid(problem, w, d)
-
-
-def trace_point(setup, tol, progress):
-    """The equilibrium curve of one map point (a :class:`PointSetup`) by pseudo-arclength
-    continuation on its moving band, from ``setup.d_start`` to its stop rule.
-
-    Parameters
-    ----------
-    setup : PointSetup
-    tol : float
-        Residual tolerance of each state (m).
-    progress : callable or None
-        Progress callback of :func:`femadh.contact.arclength.trace_curve`.
-
-    Returns
-    -------
-    The traced curve (points, folds, the problems of its grids).
-    """
-    z0 = setup.z0
-    return trace_curve(setup.problem(0.0), setup.d_start, setup.d_end, tol=tol, scale=z0,
-                       ds=0.2, ds_max=setup.ds_max, progress=progress,
-                       regrid=None if setup.res.legacy else setup.regrid,
-                       stop=setup.stop, max_points=20000)
-
-
 def _read(setup, curve):
-    """Headline quantities and diagnostics of a traced curve (dict)."""
-    law, z0, radius = setup.law, setup.z0, setup.radius
-    scale = math.pi * radius * setup.dg
+    """Headline quantities (units of the map) and diagnostics of a traced curve (dict): the
+    readout of :func:`femadh.contact.curve.read_curve` with the smooth sphere's force (grid
+    plus exact tail), the grids' resolution diagnostics."""
+    law, z0 = setup.law, setup.z0
+    scale = math.pi * setup.radius * setup.dg
     pb = curve.problem_of
-
-    def force(seg):
-        return lambda d, w: lj_force(pb(seg), law, d, w)
-
-    paths = {k: curve.branch(k, segments=True) for k in ("approach", "retract")}
-    F = {k: np.array([force(g)(d, w) for _, d, w, g in v]) for k, v in paths.items()}
-    D = {k: np.array([d for _, d, _, _ in v]) for k, v in paths.items()}
-    # hysteresis: the work of the closed cycle is the energy released at the jumps (the
-    # interaction beyond a is continuous in d and drops out); the loop integral checks it
-    released = 0.0
-    for v in paths.values():
-        for (k1, d1, w1, g1), (k2, _, w2, g2) in zip(v, v[1:]):
-            if k1 == "fold" and k2 == "land":
-                released += pb(g1).energy(w1, d1) - pb(g2).energy(w2, d1)
-    trap = getattr(np, "trapezoid", None) or np.trapz
-    loop = trap(F["retract"], D["retract"]) + trap(F["approach"], D["approach"])
-    # load control: the largest tension anywhere on the curve, refined between the
-    # neighbours of the best traced point
+    ro = read_curve(curve, lambda problem, d, w: lj_force(problem, law, d, w))
     pts = curve.points
-    cf = np.array([force(p.seg)(p.d, p.w) for p in pts])
-    i = int(np.argmax(cf))
-    pull = cf[i]
-    if 0 < i < len(pts) - 1:
-        pull = max(pull, curve.maximize(i, force(pts[i].seg))[0])
-    # displacement control: the tension at the fold where the retract path leaves contact
-    r_folds = [(d, w, g) for kind, d, w, g in paths["retract"] if kind == "fold"]
-    a_folds = [d for kind, d, _, _ in paths["approach"] if kind == "fold"]
-    pull_disp = force(r_folds[-1][2])(*r_folds[-1][:2]) / scale if r_folds else None
     trapping = max(pb(p.seg).node_softening_ratio(pb(p.seg).contour(p.d) - p.w) for p in pts)
     edges = [contact_edge(pb(p.seg), p.w, p.d, EDGE_GAP * z0) for p in pts]
-    edge = max(edges)
     band_offset = max((setup.band_offset(pb(p.seg), e) for p, e in zip(pts, edges)),
                       default=0.0)
+    (da, fa), (dr, fr) = ro.paths["approach"], ro.paths["retract"]
     return {
-        "pull_off": float(pull / scale), "pull_off_displacement": pull_disp,
-        "jump_in": a_folds[0] / z0 if a_folds else None,
-        "jump_out": r_folds[-1][0] / z0 if r_folds else None,
-        "hysteresis": float(released / (scale * z0)),
-        "hysteresis_trapezoid": float(loop / (scale * z0)),
-        "trapping": float(trapping), "edge_ratio": edge / setup.a,
+        "pull_off": float(ro.pull_off / scale),
+        "pull_off_displacement": (None if ro.pull_off_displacement is None
+                                  else ro.pull_off_displacement / scale),
+        "jump_in": None if ro.jump_in is None else ro.jump_in / z0,
+        "jump_out": None if ro.jump_out is None else ro.jump_out / z0,
+        "hysteresis": float(ro.hysteresis / (scale * z0)),
+        "hysteresis_trapezoid": float(ro.loop_work / (scale * z0)),
+        "trapping": float(trapping), "edge_ratio": max(edges) / setup.a,
         "band_offset": band_offset,
         "nodes": max(t.problem.grid.n for t in curve.tracers),
-        "curves": {"curve_d": curve.d / z0, "curve_F": cf / scale,
+        "curves": {"curve_d": curve.d / z0, "curve_F": ro.force / scale,
                    "curve_stable": np.array([p.stable for p in pts]),
-                   "approach_d": D["approach"] / z0, "approach_F": F["approach"] / scale,
-                   "retract_d": D["retract"] / z0, "retract_F": F["retract"] / scale,
+                   "approach_d": da / z0, "approach_F": fa / scale,
+                   "retract_d": dr / z0, "retract_F": fr / scale,
                    "n_factor": curve.n_factor, "n_krylov": curve.n_krylov},
     }
 
@@ -368,11 +182,11 @@ def _read(setup, curve):
 def _unresolved(setup, q):
     """Why the traced states are not resolved (str naming quantity, value and the setting to
     change), or None."""
-    if q["trapping"] > TRAPPING_LIMIT:
-        return (f"mu = {setup.mu:g}: a traced state reached the node softening ratio "
-                f"-P'(h)/K_kk = {q['trapping']:.2f} > {TRAPPING_LIMIT} (nodes can snap alone: "
-                f"lattice trapping); refine the grid (spacing = {setup.res.spacing:g} ell, "
-                f"stiffness_target = {setup.res.stiffness_target}) or give accuracy=")
+    trapped = trapping_message(q["trapping"], TRAPPING_LIMIT)
+    if trapped:
+        return (f"mu = {setup.mu:g}: on a traced state {trapped}; refine the grid (spacing = "
+                f"{setup.res.spacing:g} ell, stiffness_target = "
+                f"{setup.res.stiffness_target}) or give accuracy=")
     if q["band_offset"] > BAND_LIMIT:
         return (f"mu = {setup.mu:g}: the contact edge left the fine band (|edge - centre| = "
                 f"{q['band_offset']:.2f} half-widths > {BAND_LIMIT}): the grid did not follow "
@@ -384,32 +198,28 @@ def _unresolved(setup, q):
     return None
 
 
-def _estimate(fine, coarse, ratio=2.0):
-    """Richardson estimates of the fine result's absolute errors from a coarser member whose
-    spacing is ``ratio`` times the fine one."""
+def estimate_errors(fine, coarse, ratio=2.0):
+    """Estimates of the fine result's absolute errors from a coarser member whose spacing is
+    ``ratio`` times the fine one: Richardson at the family's measured ORDER
+    (:func:`femadh.estimate.richardson.discretisation` on two members); a quantity the coarse
+    grid missed (no fold there) has its own size as the estimate."""
+    rich = discretisation({k: fine[k] for k in QUANTITIES},
+                          {k: coarse[k] for k in QUANTITIES}, None, ratio, order=ORDER)
     out = {}
     for k in QUANTITIES:
-        a, b = fine[k], coarse[k]
-        if a is None:
+        if fine[k] is None:
             out[k] = None
-        elif b is None:   # the coarse grid missed the feature: its size is the estimate
-            out[k] = abs(a)
+        elif coarse[k] is None:   # the coarse grid missed the feature: its size is the estimate
+            out[k] = abs(fine[k])
         else:
-            out[k] = abs(a - b) / (ratio**ORDER - 1.0)
+            out[k] = abs(rich[k])
     return out
 
 
-def _worst(q, errors):
-    """(name, relative error) of the quantity furthest from its accuracy."""
-    worst = (None, 0.0)
-    for k in QUANTITIES:
-        e, v = errors.get(k), q[k]
-        if e is None or v is None:
-            continue
-        rel = e / (max(abs(v), HYSTERESIS_FLOOR) if k == "hysteresis" else abs(v))
-        if rel > worst[1]:
-            worst = (k, rel)
-    return worst
+def _worst(q, errors, judged=QUANTITIES):
+    """(name, relative error) of the judged quantity furthest from its accuracy."""
+    return worst_relative({k: q[k] for k in judged}, {k: errors[k] for k in judged},
+                          {"hysteresis": HYSTERESIS_FLOOR})
 
 
 def _check_bounds(mu, q, errors):
@@ -421,11 +231,11 @@ def _check_bounds(mu, q, errors):
     The fixed-grip tension at the jump-out is a point of the curve: it cannot exceed the
     largest tension on it (proven), and lies above the JKR fixed-grip 5/6 (empirical)."""
     p, e = q["pull_off"], errors.get("pull_off") or 0.0
-    if not (JKR - e <= p <= DERJAGUIN + e):
+    if outside_bounds(p, e, JKR, DERJAGUIN, rel=0.0):
         raise ResolutionError(f"mu = {mu:g}: pull-off {p:.6f} pi R dg outside [{JKR}, "
                               f"{DERJAGUIN}] (estimated error {e:.2g}): not a resolved result")
     pd = q["pull_off_displacement"]
-    if pd is not None and pd > p * (1 + 1e-9) + e:
+    if pd is not None and outside_bounds(pd, e, upper=p):
         raise ResolutionError(f"mu = {mu:g}: fixed-grip pull-off {pd:.6f} exceeds the largest "
                               f"tension on the curve {p:.6f}")
 
@@ -471,7 +281,7 @@ def _coarse_member(mu, radius, law, res, tol):
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
               accuracy=None, resolution=None, spacing=None, stiffness_target=None,
-              min_nodes=None, ds_max=None, progress=None):
+              min_nodes=None, ds_max=None, progress=None, judged=QUANTITIES):
     """One regime-map point: trace the curve at Tabor parameter mu and read it.
 
     Parameters
@@ -489,6 +299,12 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         Requested relative accuracy of the headline quantities (pull-offs, jump separations,
         hysteresis relative to max(value, HYSTERESIS_FLOOR)). The spacing starts from the
         measured error model and is halved until the a-posteriori estimate meets it.
+    judged : tuple of str
+        The quantities the accuracy is asked of (default: all of QUANTITIES; every one is
+        reported with its estimate). Without "pull_off_displacement" the lattice cap of the
+        flat jump-out fold (:func:`lattice_cap`) does not bound the spacing: the largest
+        tension is a smooth maximum that coarser grids resolve (peer problem, mu = 3: 1.4e-4
+        at 0.133 ell, where the fold's tension is 1.7e-3 off).
     resolution : Resolution, optional
         Explicit discretisation (default: :class:`Resolution` defaults); ``spacing`` (units of
         ell), ``stiffness_target``/``min_nodes`` (legacy fixed grid) and ``ds_max`` (z0)
@@ -516,33 +332,53 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     if accuracy is not None:
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
+        unknown = set(judged) - set(QUANTITIES)
+        if unknown or not judged:
+            raise ValueError(f"judged must name some of {', '.join(QUANTITIES)}, got "
+                             f"{', '.join(sorted(unknown)) or 'none'}")
         if "spacing" not in over and not res.legacy:
-            res = replace(res, spacing=initial_spacing(accuracy, _lattice_cap(mu, radius,
-                                                                               law)))
-    coarse, ratio = _coarse_member(mu, radius, law, res, tol)
-    for attempt in range(MAX_REFINEMENTS + 1):
+            cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged
+                   else None)
+            res = replace(res, spacing=initial_spacing(accuracy, cap))
+    member = {}
+    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
+
+    def attempt(res):
         fine = solve_point(mu, radius, law, res, tol, progress)
-        why = _unresolved(fine["setup"], fine)
-        errors = _estimate(fine, coarse, ratio)
-        name, rel = _worst(fine, errors)
-        if accuracy is None or (why is None and rel <= accuracy):
-            break
-        if attempt == MAX_REFINEMENTS:
-            why = why or (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
-                          f"requested {accuracy:g} after {MAX_REFINEMENTS} refinements "
-                          f"(spacing {res.spacing:g} ell)")
-            raise ResolutionError(why, n_iter=attempt)
-        if why is None and 2 * fine["nodes"] > MAX_NODES:
-            raise ResolutionError(
-                f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > requested "
-                f"{accuracy:g} at spacing {res.spacing:g} ell ({fine['nodes']} nodes); the "
-                f"next refinement would exceed MAX_NODES = {MAX_NODES}", n_iter=attempt)
+        errors = estimate_errors(fine, member["coarse"], member["ratio"])
+        fine["errors"], fine["worst"] = errors, _worst(fine, errors, judged)
+        return fine, fine["worst"][1], _unresolved(fine["setup"], fine)
+
+    def refine(res, fine, rel, why):
         if fine["edge_ratio"] > EDGE_LIMIT:
-            res = replace(res, analysis_radius=1.5 * res.analysis_radius)
-        else:
-            coarse, ratio, res = fine, 2.0, res.finer()
+            return replace(res, analysis_radius=1.5 * res.analysis_radius)
+        # the fine member becomes the coarser member of the next estimate (ratio 2)
+        member["coarse"], member["ratio"] = fine, 2.0
+        return res.finer()
+
+    def nodes(res, fine, nxt):
+        return 2 * fine["nodes"] if nxt.spacing < res.spacing else fine["nodes"]
+
+    if accuracy is None:
+        fine, _, why = attempt(res)
+    else:
+        out = refine_until_met(res, attempt, refine, accuracy, BUDGET, nodes)
+        res, fine, why = out.setting, out.result, out.why
+        name, rel = fine["worst"]
+        if not out.met:
+            if why is None and out.stop == "nodes":
+                why = (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
+                       f"requested {accuracy:g} at spacing {res.spacing:g} ell "
+                       f"({fine['nodes']} nodes); the next refinement would exceed the "
+                       f"budget's max_nodes = {BUDGET.max_nodes}")
+            elif why is None:
+                why = (f"mu = {mu:g}: estimated relative error of {name} {rel:.2g} > "
+                       f"requested {accuracy:g} after {len(out.steps) - 1} refinements "
+                       f"(spacing {res.spacing:g} ell)")
+            raise ResolutionError(why, n_iter=len(out.steps) - 1)
     if why is not None:
         raise ResolutionError(why)
+    errors = fine["errors"]
     _check_bounds(mu, fine, errors)
     if fine["trapping"] > 0.5 * TRAPPING_LIMIT:
         warnings.warn(f"mu = {mu:g}: node softening ratio {fine['trapping']:.2f} is within 2x "
@@ -557,19 +393,19 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["hysteresis"], fine["hysteresis_trapezoid"], fine["n_folds"], fine["trapping"],
         fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
         fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
-        fine["n_grids"], accuracy, band_offset=fine["band_offset"])
+        fine["n_grids"], accuracy, band_offset=fine["band_offset"], judged=tuple(judged))
 
 
 def initial_spacing(accuracy, cap=None):
     """Band spacing (units of ell) expected to meet a relative accuracy: the measured error
     model rel_err ~ C_SPACING * spacing^ORDER (largest C over the headline quantities and the
     map, validation/results/accuracy_regime.md), with a safety factor of 2 on the error, at
-    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`_lattice_cap`)."""
+    most ``cap`` (default MAX_SPACING / COARSE_RATIO; see :func:`lattice_cap`)."""
     cap = MAX_SPACING / COARSE_RATIO if cap is None else cap
     return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
 
 
-def _lattice_cap(mu, radius, law):
+def lattice_cap(mu, radius, law):
     """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
     below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
     jump-out fold) and below MAX_SPACING ell. On the DMT side (ell = sqrt(R z0 / 8) <

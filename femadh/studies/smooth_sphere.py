@@ -4,15 +4,34 @@ its deepest separation, its lateral length scales and its force with the exact t
 Shared by the regime map (:mod:`femadh.studies.regime`), the peer benchmark, the layered-film
 study in ``validation/`` and the tests. The Tabor parameter mu = (R dg^2 / (E*^2 z0^3))^(1/3)
 with dg = A / (16 pi z0^2) (paper 1 eq 19) fixes E* at given R, A, z0.
+
+One point of the map as a problem: :class:`PointSetup` (E* from mu, the analysis radius, the
+lateral length ell, the band that follows the contact edge, where the trace starts and ends)
+at a :class:`Resolution` (the grid family's spacing, band and grading in units of ell), traced
+through its folds by :func:`trace_point`.
+
+Grid (JKR side): the law acts in a cohesive zone at the contact edge whose width scales like the
+elastocohesive length E* z0^2 / dg, while the contact radius grows like mu^(1/2): at mu = 20
+(R = 1 um) the zone is ~1 z0 wide at a contact of ~800 z0. A node coarser than the zone snaps on
+its own (lattice trapping: extra folds, an early jump-out). The grid is therefore a band of
+uniform fine spacing around the *current* contact edge, coarsening linearly with the distance
+from it (:meth:`RadialGrid.banded`), and it moves with the edge during the trace
+(:class:`~femadh.discretisation.moving.MovingBand`). The lateral length that sets the spacing is
+the smaller of the elastocohesive length and sqrt(R z0 / 8) (the DMT side, where the contact is
+smaller than the cohesive zone and the law's range over the paraboloid sets the scale).
 """
+from dataclasses import dataclass, replace
 import math
 
 from ..contact import ContactProblem
+from ..contact.arclength import trace_curve
+from ..discretisation.moving import MovingBand
 from ..elastic import GreenOperator, RadialGrid
 from ..indenter import Sphere
 from ..laws import LennardJones
 from ..reference.adhesion import dmt_contact_radius, jkr_contact_radius
-from ..reference.maugis import jkr_approach, maugis_length_units
+from ..reference.maugis import (jkr_approach, lj_dugdale_lambda, maugis_fixed_grip_pull_off,
+                                maugis_length_units)
 
 #: a priori: LJ softening stiffness below this fraction of a node's (fixed graded grid)
 STIFFNESS_TARGET = 0.4
@@ -83,3 +102,173 @@ def lj_force(problem, lj, d, w):
     h = problem.contour(d) - w
     tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))
     return problem.grid.force(problem.pressure(h)) + tail
+
+
+#: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
+#: it is added to the force exactly); at least sqrt(2 R 20 z0) (the rigid gap there is 20 z0)
+ANALYSIS_RADIUS = 8.0
+#: banded grid family (lengths in units of the lateral length ell, see lateral_length):
+#: band spacing (the family parameter), half-width of the fine band, and the grading length
+#: over which the spacing grows by one band spacing
+SPACING = 0.1
+BAND = 4.0
+GRADING = 2.0
+#: above this Tabor parameter the band's half-width grows like mu: near the flat jump-out
+#: fold the two grids of an exchange disagree on the side of the fold (measured at mu = 20,
+#: band 4 ell: 43 exchanges refused while the edge travelled ~3 ell, and it left the band)
+BAND_MU = 10.0
+#: gap (units of z0) that marks the contact edge: the outermost r with h <= EDGE_GAP z0
+EDGE_GAP = 1.5
+#: the continuation's step control (:func:`~femadh.contact.arclength.trace_curve`): the
+#: corrector may move a gap by about this fraction of itself, and the largest step (units of
+#: z0, or 2 % of the start separation). Larger steps take fewer points (mu = 4: 154 instead
+#: of 193 at 0.15 and 1.5) but move the contact edge further between grid exchanges (a
+#: 1-ell band: the edge strays 0.87-1.05 half-widths from its centre instead of 0.65)
+TRACE_CORRECTION = 0.05
+DS_MAX = 0.5
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Discretisation of one regime-map point.
+
+    Attributes
+    ----------
+    spacing : float
+        Fine-band node spacing / lateral length ell (the grid family's parameter).
+    band, grading : float
+        Half-width of the fine band (units of ell; x mu / BAND_MU beyond BAND_MU) and grading
+        length (units of ell).
+    analysis_radius : float
+        Analysis radius in units of Maugis' a_unit (at least sqrt(40 R z0)).
+    ds_max : float or None
+        Largest continuation step (units of z0); None: from the trace's length.
+    stiffness_target, min_nodes : float, int or None
+        Legacy fixed graded grid (today's explicit settings, no moving band): when either is
+        set the grid is :func:`~femadh.studies.smooth_sphere.lj_sphere_problem`'s and its
+        coarser member has twice the spacing.
+    """
+
+    spacing: float = SPACING
+    band: float = BAND
+    grading: float = GRADING
+    analysis_radius: float = ANALYSIS_RADIUS
+    ds_max: float | None = None
+    stiffness_target: float | None = None
+    min_nodes: int | None = None
+
+    @property
+    def legacy(self):
+        return self.stiffness_target is not None or self.min_nodes is not None
+
+    def coarser(self, factor=2.0):
+        """A coarser member of the same grid family (spacing x factor)."""
+        if self.legacy:
+            return replace(self, stiffness_target=factor * (self.stiffness_target or
+                                                            STIFFNESS_TARGET),
+                           min_nodes=max(8, int((self.min_nodes or 120) / factor)))
+        return replace(self, spacing=factor * self.spacing)
+
+    def finer(self, factor=2.0):
+        if self.legacy:
+            return replace(self, stiffness_target=(self.stiffness_target or STIFFNESS_TARGET)
+                           / factor, min_nodes=int((self.min_nodes or 120) * factor))
+        return replace(self, spacing=self.spacing / factor)
+
+
+class PointSetup:
+    """Physical problem of one map point and the grids of one resolution."""
+
+    def __init__(self, mu, radius, law, res):
+        self.mu, self.radius, self.law, self.res = mu, radius, law, res
+        dg, z0 = law.work_of_adhesion, law.z0
+        self.dg, self.z0 = dg, z0
+        self.e_star = math.sqrt(radius * dg * dg / (mu**3 * z0**3))
+        a_unit, d_unit = maugis_length_units(radius, self.e_star, dg)
+        self.a = max(res.analysis_radius * a_unit, math.sqrt(2 * radius * 20 * z0))
+        self.ell = lateral_length(law, radius, self.e_star)
+        # DMT side (the range, not an edge, sets ell): one grid, fine over the whole travel
+        # of the edge (up to the JKR radius at PRELOAD, which bounds Maugis-Dugdale's); a
+        # moving band would carry states across the narrow loops near the cusp
+        self.fixed_band = None
+        if self.ell < e_star_length(law, self.e_star):
+            a_max = jkr_contact_radius(PRELOAD * math.pi * radius * dg, radius, self.e_star, dg)
+            self.fixed_band = min(FINE_MARGIN * a_max, 0.5 * self.a)
+        self.spacing = res.spacing * self.ell
+        # half-width of the moving band (m): wider beyond BAND_MU, where the jump-out fold is
+        # so flat that the grids' folds lie apart and exchanges are refused over a window
+        self.half = res.band * self.ell * max(1.0, mu / BAND_MU)
+        self.d_end = deepest_separation(mu, radius, self.e_star, law)
+        # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
+        # its landing on the approach branch is on the curve
+        fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
+        d_out = z0 - (fg[1] * d_unit if fg else 0.0)
+        self.d_start = max(12 * z0, 1.5 * d_out)
+        self.ds_max = res.ds_max if res.ds_max else max(DS_MAX, 0.02 * self.d_start / z0)
+        self.sphere = Sphere(radius)
+
+        def build(grid, first):
+            return ContactProblem(GreenOperator(grid, self.e_star), self.sphere,
+                                  {"law": self.law}, check_laws=first)
+        # the grid family of this resolution: a band following the contact edge (one home
+        # for the moving band: femadh.discretisation.moving)
+        self.band = MovingBand(self.a, self.spacing, self.half, res.grading * self.ell, build,
+                               EDGE_GAP * z0, fixed=self.fixed_band)
+
+    def problem(self, center=0.0):
+        """The problem on a grid fine around the contact edge at ``center`` (m)."""
+        if self.res.legacy:
+            if not isinstance(self.law, LennardJones):
+                raise ValueError("the legacy fixed grid is defined for LennardJones only")
+            return lj_sphere_problem(self.mu, self.radius, self.law.hamaker, self.z0,
+                                     self.res.stiffness_target or STIFFNESS_TARGET,
+                                     self.res.min_nodes or 120)[0]
+        return self.band.problem(center)
+
+    def stop(self, curve):
+        """End the trace once the stable branch after the folds has passed both the smallest
+        fold separation (so the jump-in's landing is on the curve) and its largest tension
+        (the tension falls again between the last two points: the load-controlled pull-off
+        is behind). Curves without folds run to d_end."""
+        pts = curve.points
+        if not curve.folds or curve.folds[-1].index >= len(pts) - 2:
+            return False
+        p, q = pts[-2], pts[-1]
+        if not (q.stable and p.stable and p.seg == q.seg and q.d < p.d):
+            return False
+        if q.d >= min(f.d for f in curve.folds):
+            return False
+        pb = curve.problem_of(q.seg)
+        return lj_force(pb, self.law, q.d, q.w) < lj_force(pb, self.law, p.d, p.w)
+
+    def band_offset(self, problem, edge):
+        """|edge - band centre| / band half-width (0 for a fixed band or the legacy grid)."""
+        return 0.0 if self.res.legacy else self.band.band_offset(problem, edge)
+
+    def regrid(self, problem, w, d):
+        """A grid whose band leads the edge (:meth:`MovingBand.regrid`)."""
+        return None if self.res.legacy else self.band.regrid(problem, w, d)
+
+
+def trace_point(setup, tol, progress):
+    """The equilibrium curve of one map point (a :class:`PointSetup`) by pseudo-arclength
+    continuation on its moving band, from ``setup.d_start`` to its stop rule.
+
+    Parameters
+    ----------
+    setup : PointSetup
+    tol : float
+        Residual tolerance of each state (m).
+    progress : callable or None
+        Progress callback of :func:`femadh.contact.arclength.trace_curve`.
+
+    Returns
+    -------
+    The traced curve (points, folds, the problems of its grids).
+    """
+    z0 = setup.z0
+    return trace_curve(setup.problem(0.0), setup.d_start, setup.d_end, tol=tol, scale=z0,
+                       ds=0.2, ds_max=setup.ds_max, progress=progress,
+                       regrid=None if setup.res.legacy else setup.regrid,
+                       stop=setup.stop, max_points=20000,
+                       target_correction=TRACE_CORRECTION)

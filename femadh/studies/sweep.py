@@ -21,7 +21,8 @@ point's result is ``points/<id>/`` (its curve and summary, as a single run write
 a physical reason; see :mod:`femadh.studies.executors`). Running the same study again reuses
 the finished points, runs the interrupted or crashed ones again ("redone") and the others
 ("new"). The study's table ``study.csv`` (:mod:`femadh.io.study_table`) is rewritten as points
-finish, its figure at the end. Workers keep the surface operator of each distinct grid/mesh.
+finish, its figure at the end. Workers keep the surface operator of each distinct body and
+discretisation (:func:`femadh.studies.executors.worker_operator`).
 """
 from dataclasses import dataclass, field
 import itertools
@@ -32,8 +33,8 @@ import time
 from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
 from ..io.study_table import study_figure, write_table
-from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable, _operator_key,  # noqa: F401
-                        _tune_malloc, _worker_init, driver_signals, execute, finished,
+from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable,  # noqa: F401
+                        tune_malloc, _worker_init, driver_signals, execute, finished,
                         run_point, write_record)
 from ..scene.values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
 

@@ -16,7 +16,7 @@ the load it grows like h_s + growth z), neighbouring columns are merged two into
 transition row, so thick layers do not carry the surface's fine columns down. Every interface
 is a row boundary, i.e. a mesh line, and every triangle knows its region.
 
-The radial refinement for thin layers (see :func:`~femadh.elastic.fe.operator.layered_surface_size`)
+The radial refinement for thin layers (see :func:`~femadh.elastic.fe.settings.layered_surface_size`)
 serves the layers only. Below the stack a few more structured rows, doubling in height, merge
 the columns two into one per row back to the grid's own surface size, then follow the size law
 until it is twice that (the substrate sees the same law as under a homogeneous surface, and

@@ -187,14 +187,8 @@ def build_layered_mesh(spec: MeshSpec, path):
     return Path(path)
 
 
-def read_mesh(path, scale=1.0, regions=False):
-    """Read a .msh with meshio; returns (points (n, 2) times ``scale``, triangles (m, 3)).
-
-    Meshes are stored in units of the loaded radius; pass scale = a for SI coordinates. With
-    ``regions`` also returns each triangle's region id: the physical tag - 1, i.e. the layer
-    index from the top (0 ...) and the layer count for the substrate; a homogeneous mesh
-    (one physical group "solid") gives 0 everywhere.
-    """
+def _read_meshio(path):
+    """The meshio Mesh of a .msh file, quietly."""
     import contextlib
     import io
 
@@ -203,19 +197,110 @@ def read_mesh(path, scale=1.0, regions=False):
     # meshio's gmsh 4.1 reader prints a bare newline to stdout, which would end up in a
     # user's piped output
     with contextlib.redirect_stdout(io.StringIO()):
-        m = meshio.read(str(path))
+        return meshio.read(str(path))
+
+
+def _triangles(m, regions):
+    """(points (n, 2), triangles (m, 3) into them, remap of the file's points[, tags]) of a
+    meshio Mesh, the points not used by any triangle dropped."""
     blocks = [i for i, c in enumerate(m.cells) if c.type == "triangle"]
     tri = np.concatenate([m.cells[i].data for i in blocks])
     used = np.unique(tri)
     # drop points not used by triangles (gmsh keeps geometry points such as the arc centre)
     remap = -np.ones(len(m.points), int)
     remap[used] = np.arange(used.size)
+    points = m.points[used, :2]
     if not regions:
-        return m.points[used, :2] * scale, remap[tri]
+        return points, remap[tri], remap
     tag = np.concatenate([m.cell_data["gmsh:physical"][i] for i in blocks]).astype(int)
     if "solid" in m.field_data:
         tag = np.ones_like(tag)
-    return m.points[used, :2] * scale, remap[tri], tag - 1
+    return points, remap[tri], remap, tag - 1
+
+
+def read_mesh(path, scale=1.0, regions=False):
+    """Read a .msh with meshio; returns (points (n, 2) times ``scale``, triangles (m, 3)).
+
+    Meshes are stored in units of the loaded radius; pass scale = a for SI coordinates. With
+    ``regions`` also returns each triangle's region id: the physical tag - 1, i.e. the layer
+    index from the top (0 ...) and the layer count for the substrate; a homogeneous mesh
+    (one physical group "solid") gives 0 everywhere.
+    """
+    out = _triangles(_read_meshio(path), regions)
+    if not regions:
+        return out[0] * scale, out[1]
+    return out[0] * scale, out[1], out[3]
+
+
+#: the named boundaries (1D physical groups) every half-space mesh carries
+BOUNDARIES = ("surface", "axis", "far")
+
+
+def named_boundaries(m, remap, facets):
+    """Facet indices of every 1D physical group of a meshio Mesh ``m``.
+
+    Parameters
+    ----------
+    m : meshio.Mesh
+        As read from the .msh (gmsh 4.1 from gmsh, 2.2 from the layered mesher: both carry
+        ``gmsh:physical`` line tags and the group names in ``field_data``).
+    remap : ndarray of int
+        The file's point index -> the mesh's (-1: dropped).
+    facets : ndarray (2, nf)
+        The scikit-fem mesh's facets (vertex pairs).
+
+    Returns
+    -------
+    dict of str -> ndarray of int
+        Sorted facet indices per group name (``surface``, ``axis``, ``far``, ``interface_<i>``).
+    """
+    names = {int(v[0]): k for k, v in m.field_data.items() if int(v[1]) == 1}
+    n = int(facets.max()) + 1
+    lo, hi = np.sort(facets, axis=0)
+    key = lo.astype(np.int64) * n + hi
+    order = np.argsort(key)
+    out = {}
+    for cells, tags in zip(m.cells, m.cell_data["gmsh:physical"]):
+        if cells.type != "line":
+            continue
+        e = np.sort(remap[cells.data], axis=1)
+        if np.any(e < 0):
+            raise ValueError("a named boundary edge has a vertex of no triangle")
+        k = e[:, 0].astype(np.int64) * n + e[:, 1]
+        pos = np.searchsorted(key, k, sorter=order).clip(0, key.size - 1)
+        found = order[pos]
+        if not np.array_equal(key[found], k):
+            raise ValueError("a named boundary edge is no edge of the mesh")
+        for tag in np.unique(tags):
+            name = names.get(int(tag), f"tag_{int(tag)}")
+            out.setdefault(name, []).append(found[tags == tag])
+    return {k: np.unique(np.concatenate(v)) for k, v in out.items()}
+
+
+def load_mesh(path, scale=1.0):
+    """The scikit-fem mesh of a .msh with its named boundaries, and each triangle's region.
+
+    Points are scaled by ``scale`` (meshes are stored in units of the loaded radius a: pass
+    scale = a for SI coordinates); ``mesh.boundaries`` maps every 1D physical group (at least
+    :data:`BOUNDARIES`) to its facets, so boundary DOFs are found by name
+    (``basis.get_dofs("far")``). Regions as :func:`read_mesh`.
+
+    Raises
+    ------
+    ValueError
+        If a group of :data:`BOUNDARIES` is missing (naming the file and the group).
+    """
+    from skfem import MeshTri
+
+    m = _read_meshio(path)
+    points, tri, remap, region = _triangles(m, True)
+    mesh = MeshTri(np.ascontiguousarray((points * scale).T), np.ascontiguousarray(tri.T))
+    bnd = named_boundaries(m, remap, mesh.facets)
+    missing = [b for b in BOUNDARIES if b not in bnd]
+    if missing:
+        raise ValueError(f"mesh {path} has no boundary group {', '.join(map(repr, missing))} "
+                         f"(expected the 1D physical groups {', '.join(BOUNDARIES)})")
+    return mesh.with_boundaries(bnd), region
 
 
 def mesh_search_path():

@@ -114,3 +114,59 @@ def projected_volumetric(ubasis, pbasis, elements):
     cols = np.tile(dofs, (1, n_loc)).ravel()
     M_inv = coo_matrix((inv.ravel(), (rows, cols)), shape=M.shape).tocsr()
     return B, M_inv
+
+
+def surface_pressure_form(pressure=None):
+    """Linear form of a normal pressure on the surface z = 0: int p(r) v_z 2 pi r dr over the
+    facets of a FacetBasis (v the vector test field; p > 0 pulls the surface up, +z).
+
+    ``pressure``: a callable p(r) (Pa, r in m) or None for p = 1 (per Pa)."""
+    from skfem import LinearForm
+
+    @LinearForm
+    def form(v, w):
+        r = w.x[0]
+        p = 1.0 if pressure is None else pressure(r)
+        return 2 * math.pi * r * p * v[1]
+
+    return form
+
+
+def surface_facet_basis(mesh, element, facets, degree=0):
+    """FacetBasis of ``element`` on ``facets`` whose quadrature integrates the surface load
+    exactly: the trace of the element (degree maxdeg) times r times a pressure polynomial of
+    ``degree``."""
+    from skfem import FacetBasis
+
+    return FacetBasis(mesh, element, facets=facets, intorder=element.maxdeg + 1 + degree)
+
+
+def annulus_load_matrix(basis, columns, n_columns):
+    """Consistent nodal forces (N per Pa) of a unit pressure on groups of surface facets.
+
+    Parameters
+    ----------
+    basis : skfem FacetBasis
+        On the loaded surface facets (:func:`surface_facet_basis`).
+    columns : ndarray of int
+        Per facet of ``basis``: its column (the pressure annulus it lies in).
+    n_columns : int
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (basis.N, n_columns)
+        Column j: int N_i v_z 2 pi r over the facets of column j, i.e. the load vector of
+        unit pressure there; built from the facet-by-facet contributions of
+        :func:`surface_pressure_form` (the element's own trace, so a changed element changes
+        the load with it).
+    """
+    from scipy.sparse import coo_matrix
+
+    local = surface_pressure_form().elemental(basis)
+    rows = local.indices[0]
+    nf = basis.nelems
+    # skfem lays the contributions out shape function by shape function, facets inside
+    cols = np.tile(np.asarray(columns), rows.size // nf)
+    B = coo_matrix((local.data, (rows, cols)), shape=(basis.N, n_columns)).tocsr()
+    B.eliminate_zeros()
+    return B
