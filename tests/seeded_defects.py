@@ -650,6 +650,26 @@ DEFECTS = [
     D("moving_edge_interpolation", "moving band: contact edge interpolated with the wrong sign",
       "femadh/discretisation/moving.py", (("(gap - h[k]) / (h[k + 1] - h[k])",
                                            "(h[k] - gap) / (h[k + 1] - h[k])"),)),
+    D("edgeband_lead_sign", "follow band: the new band lags the moving edge instead of "
+      "leading it", "femadh/discretisation/moving.py",
+      (("return x + math.copysign(lim, x - x0) if abs(x - x0) > lim else x",
+        "return x - math.copysign(lim, x - x0) if abs(x - x0) > lim else x"),)),
+    D("edgeband_inner_gap", "follow band: inner edge at the cohesive zone's outer end, not "
+      "at sigma", "femadh/runner/contact.py",
+      (("feature_gap(problem.effects, floor), floor * (1 + 1e-6))",
+        "feature_gap(problem.effects, floor), feature_gap(problem.effects, floor))"),)),
+    D("carry_unclipped", "carried state: the interpolated surface may cut below sigma",
+      "femadh/discretisation/moving.py", (("    w = np.minimum(w, b - new.sigma)\n", ""),)),
+    D("carry_wrong_d", "carried state re-solved 0.01 nm off its separation",
+      "femadh/discretisation/moving.py",
+      (("st = solve_complementarity(new, state.d, w0, tol=tol, max_iter=max_iter, "
+        "active0=active0)",
+        "st = solve_complementarity(new, state.d + 1e-11, w0, tol=tol, max_iter=max_iter, "
+        "active0=active0)"),)),
+    D("guard_skips_band_contact", "trapping guard: nodes held at sigma in the band left out",
+      "femadh/contact/problem.py",
+      (("keep = (h > self.sigma * (1 + 1e-9)) | self.finest_nodes",
+        "keep = h > self.sigma * (1 + 1e-9)"),)),
     D("kelvin_saturation_guard", "Kelvin: p/psat = 1 let through (log 0 division)",
       "femadh/meniscus/kelvin.py", (("if not 0.0 < p_ratio < 1.0:", "if not 0.0 < p_ratio <= 1.0:"),)),
     D("bet_isotherm", "BET isotherm: (1 + c x) for (1 - x + c x)",

@@ -145,5 +145,26 @@ class ContactProblem:
     def node_softening_ratio(self, h):
         """max_k -P'(h_k) / K_kk at the gaps h of a state: the a-posteriori twin of
         :meth:`surface_force_stiffness` (each node against its own stiffness, at the gap it
-        actually reached). Near 1 a node can snap on its own (lattice trapping)."""
-        return float(np.max(-self.dpressure(h) / np.diag(self.K)))
+        actually reached). Near 1 a node can snap on its own (lattice trapping).
+
+        Nodes held at the floor (h = sigma) coarser than the grid's finest spacing are left
+        out: inside the contact of a grid whose fine band follows the edge (coarse there by
+        design) they are pinned by the constraint, and the edge, where nodes are released or
+        join, is always in the band. On a uniform grid or a static band [0, r_b] every node
+        that reaches the floor has the finest spacing (the ratio is the max over all)."""
+        ratio = -self.dpressure(h) / np.diag(self.K)
+        if self.sigma is not None:
+            keep = (h > self.sigma * (1 + 1e-9)) | self.finest_nodes
+            return float(np.max(ratio[keep])) if keep.any() else 0.0
+        return float(np.max(ratio))
+
+    @property
+    def finest_nodes(self):
+        """Mask of the nodes whose spacing to both neighbours is within 2 % of the grid's
+        smallest (all nodes of a uniform grid; the band of a banded one)."""
+        if getattr(self, "_finest", None) is None:
+            dr = np.diff(self.grid.nodes)
+            left = np.r_[dr[0], dr]
+            right = np.r_[dr, dr[-1]]
+            self._finest = np.maximum(left, right) <= 1.02 * float(np.min(dr))
+        return self._finest

@@ -271,7 +271,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         solves_here, jumps_here, crawl_run = 0, 0, 0
         beyond = None       # a stable state past a fold that the energy check turned down
         while state.d != d_next:
-            if solves_here >= MAX_SOLVES_PER_STEP:
+            # each fold apart from the last (a contact unzipping node by node past a meniscus
+            # edge) brings its own budget; a crawl is cut by crawl_run below
+            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here):
                 # the folds of the crawl are not physical snaps: keep them out of the result
                 crawl = sweep.jumps[len(sweep.jumps) - jumps_here:] if jumps_here else []
                 del sweep.jumps[len(sweep.jumps) - jumps_here:]
@@ -345,7 +347,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             if crawl_run > MAX_JUMPS_PER_STEP:
                 # fold after fold at the smallest step: not a physical snap but a branch the
                 # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
-                solves_here = MAX_SOLVES_PER_STEP
+                solves_here = MAX_SOLVES_PER_STEP * (1 + jumps_here)
             state, g_state = landed, g_landed
         sweep.states.append(state)
         if on_state:

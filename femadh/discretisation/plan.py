@@ -138,7 +138,13 @@ def trapping_ratio(problem):
     for law in problem.effects.values():
         if not isinstance(law, SmoothStepLaw):
             soft = max(soft, float(np.max(-law.dpressure(h))))
-    k = np.diag(problem.K)[problem.grid.fine]
+    # the band's nodes: [0, r_b] of a static band; a band that follows the edge is coarse
+    # towards the centre (its nodes there are inside the contact, pinned), so only the
+    # nodes of the band's own spacing count
+    grid = problem.grid
+    fine = grid.fine if grid.nodes[1] <= 1.02 * float(np.min(np.diff(grid.nodes))) \
+        else problem.finest_nodes
+    k = np.diag(problem.K)[fine]
     return float(max(soft, 0.0) / np.min(k))
 
 

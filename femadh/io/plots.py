@@ -363,10 +363,12 @@ def paper1_panels(res, path):
     n = len(prof["d_m"])
     for i in range(n):
         c = cmap(i / max(1, n - 1))
-        ax[0].plot(res.nodes * rs, prof["w_m"][i] * 1e9, color=c,
+        # each profile on its own nodes (a grid that follows the contact edge changes them)
+        r = np.asarray(prof["r_m"][i] if "r_m" in prof else res.nodes, float)
+        ax[0].plot(r * rs, prof["w_m"][i] * 1e9, color=c,
                    label=f"{round(prof['d_m'][i] * 1e9, 2) + 0.0:.2f}")  # no "-0.00"
-        ax[1].plot(res.nodes * rs, prof["P_LJ_Pa"][i] * 1e-6, color=c)
-        ax[2].plot(res.nodes * rs, prof["P_el_Pa"][i] * 1e-6, color=c)
+        ax[1].plot(r * rs, prof["P_LJ_Pa"][i] * 1e-6, color=c)
+        ax[2].plot(r * rs, prof["P_el_Pa"][i] * 1e-6, color=c)
     ax[0].set(xlabel=f"r ({rl})", ylabel="w (nm)", title=f"(a) disk deformation, {first}")
     ax[0].legend(title="d (nm)", fontsize=6, ncol=2)
     ax[1].set(xlabel=f"r ({rl})", ylabel="P_LJ (MPa)", title="(b) LJ pressure")

@@ -49,10 +49,10 @@ def _relative(res):
 def _feature_radius(res, problem_shape, gap):
     """Largest radius (m) where a kept surface profile's gap is at most ``gap``."""
     out = 0.0
-    nodes = res.nodes
     for prof in res.profiles.values():
-        for d, w in zip(prof["d_m"], prof["w_m"]):
-            h = d + problem_shape - w
+        for i, (d, w) in enumerate(zip(prof["d_m"], prof["w_m"])):
+            nodes = np.asarray(prof["r_m"][i], float) if "r_m" in prof else res.nodes
+            h = d + problem_shape(nodes) - w
             close = np.flatnonzero(h <= gap)
             if close.size:
                 out = max(out, float(nodes[close[-1]]))
@@ -131,7 +131,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                 h *= 0.5
             steps[-1]["refined_after"] = err_text
             continue
-        edge = _feature_radius(res, trial.sphere.shape(res.nodes), plan.feature_gap)
+        edge = _feature_radius(res, trial.sphere.shape, plan.feature_gap)
         if edge > BAND_FILL * family.band and family.band < family.radius:
             # the feature left the band: widen it (the spacing stays)
             family = GridFamily(family.radius, min(family.radius, 1.2 * edge / BAND_FILL),

@@ -128,11 +128,14 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
                             f"({rows('equilibrium_curve.csv')} curve points and "
                             f"{rows('curve.csv')} branch states of the previous run replaced)")
         resuming = False
-    elif resuming and getattr(scene, "instrument", None) is not None:
+    elif resuming and (getattr(scene, "instrument", None) is not None
+                       or (getattr(scene, "grid", None) or {}).get("follow")):
         # an instrument's readout refines between the sweep's own states and its jumps'
         # fold and landing states, which the files do not hold: the sweep is run again
-        res.warnings.append("resume: the sweep was computed again from its start (an "
-                            "instrument's readout needs every state of it in memory)")
+        res.warnings.append("resume: the sweep was computed again from its start (" + (
+            "its grid follows the contact edge: the files do not say which grid each state "
+            "was continued on" if getattr(scene, "instrument", None) is None else
+            "an instrument's readout needs every state of it in memory") + ")")
         resuming = False
     resume = None
 
@@ -200,6 +203,7 @@ def _finish(scene, res, problem, sink, estimate):
     from .estimates import estimate_errors, guard_bounds, refine_peak
     from .headline import headline
 
+    problem = sink.problem          # the last grid of a band that follows the edge
     t1 = time.perf_counter()
     res.headline = headline(res, problem)
     if estimate:
@@ -240,7 +244,8 @@ class Sink:
 
         self.problem, self.result, self.writer = problem, result, writer
         self.progress = progress
-        self._row = lambda st: state_row(problem, st, self._extra)
+        # (self.problem: a band that follows the contact edge exchanges the grid mid-sweep)
+        self._row = lambda st: state_row(self.problem, st, self._extra)
         self._extra = extra_outputs(problem)
         self.columns = (["d_m", "h0_m", "F_LJ_N", "F_el_N", "F_ex_N", "r_c_m", "n_iter",
                          "residual_m", "converged", "stable", "F_tail_N"]
@@ -290,6 +295,7 @@ class Sink:
         prof = self.result.profiles.setdefault(
             branch, {"d_m": [], "w_m": [], "P_LJ_Pa": [], "P_el_Pa": []})
         prof["d_m"].append(d)
+        prof.setdefault("r_m", []).append(self.problem.grid.nodes.copy())
         prof["w_m"].append(w.copy())
         prof["P_LJ_Pa"].append(p_lj.copy())
         prof["P_el_Pa"].append(p_el.copy())
@@ -340,7 +346,9 @@ class Sink:
             self.bar = None
         for prof in self.result.profiles.values():
             for k in list(prof):
-                prof[k] = np.array(prof[k])
+                # profiles on exchanged grids (a band following the edge) differ in length
+                same = len({np.size(x) for x in prof[k]}) <= 1
+                prof[k] = np.array(prof[k]) if same else np.array(prof[k], dtype=object)
 
     def load(self, folder, resume):
         """Resume: the committed states and jumps of the previous run, into the result, as
@@ -426,9 +434,112 @@ def _plan(scene):
     return [("retract", d)]
 
 
+class _Regrid(Exception):
+    """Raised from a trace's callback: the contact edge left the middle of the band that
+    follows it; the sweep goes on from ``state`` (the last state, carried to ``problem``'s
+    grid) through ``remaining`` separations (the first is the state's own)."""
+
+    def __init__(self, problem, state, remaining):
+        super().__init__("regrid")
+        self.problem, self.state, self.remaining = problem, state, remaining
+
+
+def _follower(scene, problem):
+    """The :class:`~femadh.discretisation.moving.EdgeBand` of a scene whose [solver.grid]
+    sets ``follow`` (its edges: the contact edge, the outermost node at sigma, and the
+    outermost gap at the laws' largest feature gap: the cohesive zone's or the meniscus'
+    outer end), else None."""
+    g = scene.grid
+    if not (g and g.get("follow")) or problem.sigma is None:
+        return None
+    from ..discretisation.moving import EdgeBand
+    from ..discretisation.plan import feature_gap, reach_floor
+    from ..elastic import GreenOperator
+
+    def build(grid, first):
+        return build_problem(scene, operator=GreenOperator(grid, scene.e_star))
+    floor = reach_floor(problem.effects, problem.sigma)
+    # the inner edge at sigma itself (a node held at the floor, to round-off): the LJ
+    # cohesive zone sigma..10^(1/2) sigma is ~0.8 um wide on the Fig 4 slider, and a band
+    # around its outer end alone left the contact edge in the graded part
+    band = EdgeBand(problem.grid.radius, g["spacing"], g["follow"], g["grading"], build,
+                    feature_gap(problem.effects, floor), floor * (1 + 1e-6))
+    band.spans[id(problem)] = (0.0, 0.0)     # the scene's own first member (scene_grid)
+    band.centers[id(problem)] = 0.0
+    return band
+
+
+def _regridded(band, sink, problem, state, scene):
+    """(new problem, the state carried to it) if the edge left the band's middle, else None.
+    The sink and its writer write on the new grid from here on; the states the peak search
+    and a branch's restart need are carried to it (their displacements interpolated: the
+    search solves fresh states from them)."""
+    from ..discretisation.moving import carry_state
+
+    new = band.regrid(problem, state.w, state.d)
+    if new is None:
+        return None
+    st = carry_state(problem, new, state, tol=scene.tolerance, max_iter=scene.max_iter)
+    if not (st.converged and st.stable):
+        raise ConvergenceError(
+            f"grid exchange at d = {state.d * 1e9:.6g} nm (band following the contact edge): "
+            "the state carried to the new grid did not converge to a stable state",
+            d=state.d, residual=st.residual, n_iter=st.n_iter)
+    _exchange(sink, problem, new)
+    return new, st
+
+
+def _exchange(sink, old, new):
+    """The sink (and its writer) on ``new``'s grid from here on; the committed states the
+    peak search and a branch's restart need carried to it (their displacements interpolated:
+    the search solves fresh states from them)."""
+    from ..discretisation.moving import interpolate_state
+
+    snaps = ([s for s in sink.peak[2:] if s is not None] if sink.peak else []) + \
+        list(sink.last.values())
+    for snap in {id(x): x for x in snaps}.values():
+        if getattr(snap, "w", None) is not None and np.ndim(snap.w) == 1 and \
+                snap.w.size == old.grid.n:
+            snap.w, snap.active = interpolate_state(old, new, snap.d, snap.w)
+    sink.problem = new
+    if sink.writer is not None:
+        sink.writer.problem = new
+    sink.regrids = getattr(sink, "regrids", 0) + 1
+
+
+def _widened(band, sink, problem, state, scene):
+    """(the static-band problem, ``state`` carried to it): the scene's [0, band] at the
+    follow band's spacing and grading (a landing's fallback, :func:`_trace_steps`)."""
+    from ..discretisation import GridFamily
+    from ..discretisation.moving import carry_state
+
+    g = scene.grid
+    wide = band.build(GridFamily(band.radius, g["band"], band.grading).member(band.spacing),
+                      False)
+    band.spans[id(wide)] = (0.0, g["band"])
+    band.centers[id(wide)] = 0.5 * g["band"]
+    st = carry_state(problem, wide, state, tol=scene.tolerance, max_iter=scene.max_iter)
+    if not (st.converged and st.stable):
+        raise ConvergenceError(
+            f"grid exchange at d = {state.d * 1e9:.6g} nm (to the static band after a failed "
+            "landing): the carried state did not converge to a stable state", d=state.d,
+            residual=st.residual, n_iter=st.n_iter)
+    _exchange(sink, problem, wide)
+    sink.widened = getattr(sink, "widened", 0) + 1
+    sink.wide = wide
+    return wide, st
+
+
 def _trace_steps(scene, problem, sink, resume):
-    """Stepping continuation of every branch of the scene's plan, from the resume point."""
+    """Stepping continuation of every branch of the scene's plan, from the resume point.
+
+    With a band that follows the contact edge ([solver.grid] ``follow``), the grid is
+    exchanged after a committed state or a landing whose edge left the band's middle half
+    (:class:`~femadh.discretisation.moving.MovingBand`): the state is carried to the new
+    grid at its own separation and the sweep goes on from it. Every committed state is
+    written on the grid it was solved on (fields.csv's r column)."""
     start, prev = None, None
+    band = _follower(scene, problem)
     for branch, d_vals in _plan(scene):
         done = len(sink.rows.get(branch, []))
         skip_first = False
@@ -442,16 +553,63 @@ def _trace_steps(scene, problem, sink, resume):
         elif start is None and prev is not None:    # resume at the start of this branch
             start = _restart_state(problem, scene, sink, prev)
         sink.plan(branch, len(d_vals) - skip_first, total)
-        first = [skip_first]
+        wide = None                   # where this branch last went to the static band
+        while True:
+            first = [skip_first]
+            seen = [0]
+            last = [start]            # the last committed state (on the current grid)
+            jumped = [0]              # jumps recorded since it
 
-        def on_state(st, branch=branch):
-            if first[0]:              # the resumed start state is already on disk
-                first[0] = False
-                return
-            sink.state(branch, st)
-        sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance, start=start,
-                      max_iter=scene.max_iter, on_state=on_state, on_jump=sink.jump)
-        start, prev = sweep.states[-1], branch
+            def on_state(st, branch=branch, d_vals=d_vals, first=first, seen=seen,
+                         last=last, jumped=jumped):
+                seen[0] += 1
+                if first[0]:          # the resumed (or carried) start state is on disk
+                    first[0] = False
+                    return
+                # the edge left the band's middle: the state is committed on the new grid
+                # (every committed state on a grid whose band holds its edges)
+                moved = band and _regridded(band, sink, sink.problem, st, scene)
+                last[0], jumped[0] = (moved[1] if moved else st), 0
+                sink.state(branch, last[0])
+                if moved:
+                    raise _Regrid(*moved, d_vals[seen[0] - 1:])
+
+            def on_jump(jump, d_vals=d_vals, jumped=jumped):
+                sink.jump(jump)
+                jumped[0] += 1
+                moved = band and _regridded(band, sink, sink.problem, jump.after, scene)
+                if moved:
+                    # on from the landing: the separations beyond it
+                    sign = math.copysign(1.0, d_vals[-1] - d_vals[0])
+                    raise _Regrid(*moved, [jump.d_land] + [
+                        d for d in d_vals if (d - jump.d_land) * sign > 0])
+            try:
+                sweep = trace(problem, d_vals, branch=branch, tol=scene.tolerance,
+                              start=start, max_iter=scene.max_iter, on_state=on_state,
+                              on_jump=on_jump)
+            except _Regrid as rg:
+                problem, start, d_vals, skip_first = rg.problem, rg.state, rg.remaining, True
+                if len(d_vals) > 1:
+                    continue
+                sweep = None
+            except ConvergenceError:
+                # a fold whose landing failed on a follow grid (the surface snapped to where
+                # the grid is coarse, e.g. the jump-in from no contact): the step once more
+                # from the last committed state on the static band [0, band], which holds
+                # wherever the edge can go; the next exchange returns to the follow band
+                if band is None or jumped[0] or seen[0] == 0 or last[0] is None \
+                        or wide == last[0].d or problem is getattr(sink, "wide", None):
+                    raise
+                wide = last[0].d
+                problem, start = _widened(band, sink, problem, last[0], scene)
+                d_vals, skip_first = d_vals[seen[0] - 1:], True
+                continue
+            break
+        start, prev = (sweep.states[-1] if sweep is not None else start), branch
+    if band is not None:
+        sink.result.grid.update(follow_m=band.half, regrids=getattr(sink, "regrids", 0),
+                                widened=getattr(sink, "widened", 0),
+                                nodes_last=sink.problem.grid.n)
     sink.close()
 
 

@@ -133,7 +133,8 @@ def variant(scene, **changes):
     if "grid" in changes:
         # a banded member (lengths in m): replaces the uniform nodes
         solver.pop("nodes", None)
-        solver["grid"] = {k: f"{float(v)!r} m" for k, v in changes["grid"].items()}
+        solver["grid"] = {k: f"{float(v)!r} m" for k, v in changes["grid"].items()
+                          if v is not None}        # (follow: None is a static band)
     solver.pop("accuracy", None)
     raw.pop("study", None)
     return scene_from_dict(raw, scene.path, bare_numbers=True)

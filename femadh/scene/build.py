@@ -19,6 +19,13 @@ def discretisation_grid(disc):
         from ..discretisation import GridFamily
 
         g = disc.grid
+        if g.get("follow"):
+            # a band that follows the contact edge: its first member is centred on r = 0
+            # (the runner exchanges it as the edge moves, femadh.discretisation.moving)
+            from ..discretisation.moving import follow_family
+
+            return follow_family(disc.analysis_radius, g["follow"], g["grading"],
+                                 0.0).member(g["spacing"])
         return GridFamily(disc.analysis_radius, g["band"], g["grading"]).member(g["spacing"])
     return RadialGrid.uniform(disc.analysis_radius, disc.nodes)
 

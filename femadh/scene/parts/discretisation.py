@@ -52,6 +52,10 @@ GRID = Table("solver.grid", "A banded radial grid (Green method): uniform spacin
     Key("band", "length", "Outer radius of the band of uniform spacing.", lo=0.0),
     Key("grading", "length", "Length over which the spacing beyond the band grows by h.",
         lo=0.0),
+    Key("follow", "length", "Half-width of a fine band that follows the contact edge during "
+        "a stepping sweep (the grid is exchanged as the edge moves, the state carried over); "
+        "the band [0, band] is then where the edge may travel. Default: a static band.",
+        default=None, lo=0.0),
 ))
 
 SOLVER = Table("solver", "Discretisation and solver.", (
