@@ -172,9 +172,9 @@ def test_both_runners_stop_at_their_time_limit_keeping_what_they_committed(tmp_p
 def test_a_solver_failure_inside_a_contact_run_keeps_every_committed_state(tmp_path,
                                                                             monkeypatch,
                                                                             summaries):
-    import femadh.runner.contact as contact
+    import femadh.runner.tracing as tracing
 
-    real = contact.trace
+    real = tracing.trace
 
     def failing(problem, d_vals, *, on_state, **kw):
         def state(st):
@@ -182,14 +182,14 @@ def test_a_solver_failure_inside_a_contact_run_keeps_every_committed_state(tmp_p
                 raise ConvergenceError("seeded failure", d=st.d, n_iter=3)
             on_state(st)
         return real(problem, d_vals, on_state=state, **kw)
-    monkeypatch.setattr(contact, "trace", failing)
+    monkeypatch.setattr(tracing, "trace", failing)
     scene = short_scene(tmp_path)
     res = femadh.run(scene, tmp_path / "out", figures=False, progress=False, estimate=False)
     assert res.status == "failed" and res.error.startswith("seeded failure; d = ")
     assert summaries == ["running", "failed"]
     rows = _rows(tmp_path / "out" / "curve.csv")
     assert len(rows) == 4 and len(res.branches["approach"]["d_m"]) == 4
-    monkeypatch.setattr(contact, "trace", real)
+    monkeypatch.setattr(tracing, "trace", real)
     ref = femadh.run(scene, tmp_path / "ref", figures=False, progress=False, estimate=False)
     assert rows == _rows(tmp_path / "ref" / "curve.csv")[:4]
     assert ref.status == "converged"

@@ -83,7 +83,7 @@ def peak_adhesion(problem, prev, best, nxt, scene):
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). The states may be
-    :class:`~femadh.runner.contact.Committed` records (d, w, active, r_c, f_ex) as the files
+    :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
     hold them. Returns (F, d, half-width of the final d bracket)."""
     from ..contact.forces import state_forces
 

@@ -1,0 +1,109 @@
+"""Resuming a contact run: where its committed rows end (every file checked first) and the
+checkpoint that lets a stopped sweep continue bit for bit."""
+import numpy as np
+
+from ..contact import State
+
+
+def resume_point(folder, scene, problem, run_id, prev, resume_from, res):
+    """What a resumed run keeps of the folder (:mod:`femadh.io.resume_check`): its committed
+    states whose rows match their record and are complete in every file, their field rows,
+    the jumps before them; None to start from the first state. Notes of a repair go to the
+    result's warnings; a damaged record raises DamagedFolder (one line)."""
+    from ..io.resume_check import DamagedFolder, check_curve, check_side_files, kept_jumps
+
+    k, rows, notes = check_curve(folder.path, scene, problem, run_id, resume_from)
+    if str(prev.get("status", "")).startswith("unknown"):
+        # summary.json lost or unreadable: the checksum of the first row, seeded with the
+        # scene id, is the proof that the folder holds this scene's run
+        if k == 0:
+            raise DamagedFolder(f"{folder.path}: summary.json is missing or unreadable and "
+                                "curve.csv has no committed row to show it is this scene's "
+                                "run; use --overwrite")
+        notes.append("resume: summary.json was missing or unreadable; rewritten (curve.csv's "
+                     "rows check with this scene)")
+    if k:
+        k, more = check_side_files(folder.path, rows, problem.grid.n)
+        notes += more
+    res.warnings += notes
+    if k == 0:
+        return None
+    return {"states": k, "fields_rows": k * problem.grid.n,
+            "jumps": kept_jumps(folder.path, rows[:k]), "rows": rows[:k]}
+
+
+#: the last committed state of a sweep stopped by a signal or its time limit, whole (its
+#: factorisation included): a resumed sweep continues from it bit for bit
+CHECKPOINT = "checkpoint.npz"
+
+
+def save_checkpoint(folder, sink):
+    """Write the last committed state whole (npz, no pickle), if the sweep has one this
+    format holds (complementarity / smooth laws; the closure's states are re-solved)."""
+    from ..contact.linalg import TrailingCholesky, TrailingLU
+    from ..io.atomic import save_atomic
+
+    if sink is None or sink.writer is None or sink.last_state is None:
+        return
+    k, branch, st = sink.last_state
+    if st.diagnostics or sink.problem.contact_model == "hertz-closure":
+        return
+    data = {"k": np.array(k), "branch": np.array(branch), "d": np.array(st.d), "w": st.w,
+            "h": st.h, "p_contact": st.p_contact, "active": st.active,
+            "r_c": np.array(st.r_c), "n_iter": np.array(st.n_iter),
+            "residual": np.array(st.residual), "flags": np.array([st.converged, st.stable]),
+            "effects": np.array(list(st.p_effects))}
+    data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
+    lu = st.lu
+    if lu is None:
+        data["lu_kind"] = np.array("none")
+    elif isinstance(lu, TrailingLU):
+        data.update(lu_kind=np.array("trailing"), lu=lu.lu, piv=lu.piv,
+                    dims=np.array([lu.n, lu.m0, lu.k_valid]))
+        if lu.scale is not None:
+            data["scale"] = lu.scale
+    elif isinstance(lu, TrailingCholesky):
+        data.update(lu_kind=np.array("cholesky"), lu=lu.uinv, dims=np.array([lu.n, lu.m0,
+                                                                             lu.k_valid]))
+    elif isinstance(lu, tuple) and len(lu) == 2 and isinstance(lu[0], tuple):
+        data.update(lu_kind=np.array("dense"), lu=lu[0][0], piv=lu[0][1], lu_I=lu[1])
+    else:
+        return
+    def write(path):
+        with open(path, "wb") as f:
+            np.savez(f, **data)
+    save_atomic(folder.path / CHECKPOINT, write)
+
+
+def load_checkpoint(folder, k, d):
+    """The whole state number k at separation d from the checkpoint, or None (absent, of
+    another state, unreadable: the caller re-solves the state from fields.csv)."""
+    from ..contact.linalg import TrailingCholesky, TrailingLU
+
+    path = folder / CHECKPOINT
+    if not path.exists():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if int(z["k"]) != k or float(z["d"]) != d:
+                return None
+            kind = str(z["lu_kind"])
+            if kind == "trailing":
+                lu = TrailingLU.__new__(TrailingLU)
+                lu.n, lu.m0, lu.k_valid = (int(x) for x in z["dims"])
+                lu.lu, lu.piv = z["lu"], z["piv"]
+                lu.scale = z["scale"] if "scale" in z.files else None
+                lu._block = (None, None)
+            elif kind == "cholesky":
+                lu = TrailingCholesky.from_inverse(z["lu"], *(int(x) for x in z["dims"]))
+            elif kind == "dense":
+                lu = ((z["lu"], z["piv"]), z["lu_I"])
+            else:
+                lu = None
+            conv, stable = (bool(x) for x in z["flags"])
+            return State(float(z["d"]), z["w"], z["h"],
+                         {str(n): z[f"pe_{n}"] for n in z["effects"]}, z["p_contact"],
+                         z["active"], float(z["r_c"]), int(z["n_iter"]),
+                         float(z["residual"]), conv, stable, lu)
+    except (OSError, ValueError, KeyError):
+        return None
