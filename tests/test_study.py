@@ -354,7 +354,7 @@ def test_typed_values_need_units_and_absurd_ones_are_refused(tmp_path, capsys):
 
 def test_study_progress_counts_done_failed_reused(capsys):
     """In a terminal the study's bar counts points done, failed and reused."""
-    from femadh.studies.sweep import StudyProgress
+    from femadh.io.progress import StudyProgress
 
     bar = StudyProgress(4, 2, "demo")
     bar.point({"status": "failed"})

@@ -195,3 +195,28 @@ def bar(total, desc, enabled=True, unit="state"):
 
     return tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stderr,
                 ncols=width(), dynamic_ncols=False)
+
+
+class StudyProgress:
+    """The study's bar in a terminal: points done of all, with failed and reused counts."""
+
+    def __init__(self, total, reused, name):
+        self.failed, self.reused = 0, reused
+        self.bar = bar(total, f"study {name}", unit="point")
+        if self.bar is not None:
+            self.bar.update(reused)
+            self._postfix()
+
+    def _postfix(self):
+        self.bar.set_postfix_str(f"failed {self.failed}, reused {self.reused}")
+
+    def point(self, rec):
+        if self.bar is None:
+            return
+        self.failed += rec.get("status") != "converged"
+        self.bar.update(1)
+        self._postfix()
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()

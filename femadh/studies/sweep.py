@@ -32,6 +32,7 @@ import time
 
 from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
+from ..io.progress import StudyProgress
 from ..io.study_table import study_figure, write_table
 from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable,  # noqa: F401
                         tune_malloc, _worker_init, driver_signals, execute, finished,
@@ -255,30 +256,3 @@ def failure_reasons(records):
         reason = r.get("error") or r.get("status", "failed")
         groups.setdefault(mask_numbers(reason), [reason, []])[1].append(r.get("index"))
     return sorted(((g[0], g[1]) for g in groups.values()), key=lambda g: -len(g[1]))
-
-
-class StudyProgress:
-    """The study's bar in a terminal: points done of all, with failed and reused counts."""
-
-    def __init__(self, total, reused, name):
-        from ..io.progress import bar
-
-        self.failed, self.reused = 0, reused
-        self.bar = bar(total, f"study {name}", unit="point")
-        if self.bar is not None:
-            self.bar.update(reused)
-            self._postfix()
-
-    def _postfix(self):
-        self.bar.set_postfix_str(f"failed {self.failed}, reused {self.reused}")
-
-    def point(self, rec):
-        if self.bar is None:
-            return
-        self.failed += rec.get("status") != "converged"
-        self.bar.update(1)
-        self._postfix()
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
