@@ -93,7 +93,7 @@ def test_adaptive_run_meets_its_target_against_a_finer_member(fig3_adaptive):
     """The adaptive Fig 3 run at 3e-3 meets it by its own estimate, and the estimate brackets
     the error against the family's member at a quarter of its spacing (that member's own
     error is ~16x smaller at the family's order 2): effectivity within 0.3-5 (measured
-    0.73-1.3 at 1e-3, validation/results/adaptive.md)."""
+    0.73-1.3 at 1e-3, validation/results/accuracy.md)."""
     res = fig3_adaptive
     assert res.status == "converged" and res.accuracy["met"]
     assert res.grid["kind"] == "banded"
@@ -113,7 +113,7 @@ def test_adaptive_run_meets_its_target_against_a_finer_member(fig3_adaptive):
         true = abs(res.headline[q] - ref.headline[q])
         est = res.headline[q + "_error"]
         assert est <= 3e-3 * abs(res.headline[q])
-        # never optimistic beyond 0.3x (measured 0.51-4.8 on this scene, adaptive.md)
+        # never optimistic beyond 0.3x (measured 0.51-4.8 on this scene, accuracy.md)
         assert est >= 0.3 * true, q
     # the largest adhesion converges steadily: not pessimistic beyond 5x (measured 1.36 at
     # 3e-3). F_LJ at the deepest state oscillates with the edge's node (its envelope is

@@ -39,7 +39,9 @@ JUMPS = ("jump_in_d_m", "jump_out_d_m")
 #: scene -> (uniform node counts, requested accuracies, reference band spacing (m), quantities)
 CASES = {
     "paper1_fig3": ((200, 400, 800), (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), 7.5e-9, QUANT),
-    "paper1_fig4": ((200, 400, 800), (1e-2, 3e-3, 1e-3, 1e-4), 5e-9, QUANT + JUMPS),
+    # 1e-4 on Fig 4 is not in the table: its second trial plans 2904 nodes on the static band
+    # (> 190 s; its first, 871 nodes, reaches 6.1e-4 in 27 s), beyond the reference itself
+    "paper1_fig4": ((200, 400, 800), (1e-2, 3e-3, 1e-3), 5e-9, QUANT + JUMPS),
     "paper1_slider_meniscus": ((200, 400), (1e-2, 1e-3), 15e-9, QUANT),
 }
 #: effectivity band every judged row must sit in (issue goal), and the estimate's cost limit

@@ -20,7 +20,7 @@ ORDER = 1.0
 #: order of the envelope of an oscillating convergence (the contact edge moving between
 #: nodes, a node at a time): the Fig 3 scene's banded family, spacings 175 -> 15.5 nm, shows
 #: local orders from 1.2 to 2.2 around a sign-changing mean; the smaller end is taken
-#: (validation/results/adaptive.md)
+#: (measured for the former validation/adaptive.py study, now validation/accuracy.py)
 ENVELOPE_ORDER = 1.5
 #: the largest order a monotone sequence of three members may claim: their coarsest member
 #: is often pre-asymptotic (Fig 3 banded, 175/87.5/43.75 nm: apparent order 3.4, while the
