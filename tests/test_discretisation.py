@@ -214,7 +214,7 @@ def test_a_tail_the_disk_cannot_hold_ends_the_run_not_the_budget():
     except ModuleNotFoundError:      # Python 3.10
         import tomli as tomllib
 
-    from femadh.runner.contact import run
+    from femadh.runner.run import run
     from femadh.scene import scene_from_dict
 
     text = (Path(__file__).resolve().parents[1] / "validation" / "scenes"

@@ -139,7 +139,7 @@ def test_vtk_output_opens_in_pyvista(tmp_path):
     import pyvista as pv
 
     from femadh.io.writers import read_fields_state
-    from femadh.runner.contact import run
+    from femadh.runner.run import run
     from femadh.scene import scene_from_dict
     from validation.paper1 import scene as load
 
@@ -166,7 +166,8 @@ def test_vtk_output_opens_in_pyvista(tmp_path):
 
 
 def test_coarse_nodes_warn_about_lj_stiffness(tmp_path):
-    from femadh.runner.contact import MeshResolutionWarning, run
+    from femadh.errors import MeshResolutionWarning
+    from femadh.runner.run import run
     from validation.paper1 import scene as load
 
     sc = load("paper1_fig3", 10, sigma="0.25 nm")

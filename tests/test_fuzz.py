@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import pytest
 
 from femadh.errors import DependencyError, FemadhError, SceneError
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.scene import scene_from_dict
 from femadh.scene.resources import check_resources
 

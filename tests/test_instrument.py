@@ -11,7 +11,7 @@ from femadh.errors import SceneError
 from femadh.instrument import bridge_stiffness, cantilever_stiffness, read_instrument
 from femadh.laws import LennardJones
 from femadh.reference.maugis import jkr_snap_off_with_spring, maugis_length_units
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.scene import load_scene, scene_from_dict
 
 try:

@@ -15,7 +15,7 @@ import femadh
 from femadh.elastic import RadialGrid
 from femadh.judges import HankelLayeredOperator
 from femadh.errors import MeshResolutionWarning, SceneError
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.runner.estimates import variant
 from femadh.studies.sweep import study_points
 

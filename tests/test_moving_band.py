@@ -14,7 +14,7 @@ from femadh.discretisation import plan as plan_mod
 from femadh.discretisation.moving import EdgeBand, carry_state, interpolate_state
 from femadh.elastic import GreenOperator
 from femadh.runner import adaptive
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.runner.estimates import variant
 from femadh.scene import build_problem
 

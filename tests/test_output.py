@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from femadh.io import progress
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from validation.paper1 import scene as paper1_scene
 
 from conftest import tiny_fe_text

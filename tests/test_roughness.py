@@ -178,7 +178,7 @@ def test_eq20_on_the_contact_set_is_the_smoothed_laws_limit_and_vanishes_with_th
     1.8e-3 mN at N = 100, 200, 400: order 1.0-1.3): a range-less pressure does no work."""
     import warnings
 
-    from femadh.runner.contact import run
+    from femadh.runner.run import run
     from validation.roughness import slider_scene
 
     from conftest import observed_order

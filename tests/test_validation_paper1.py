@@ -3,7 +3,7 @@ import numpy as np
 
 from femadh.contact.forces import state_forces
 from femadh.reference import max_rigid_lj_force
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from validation.paper1 import measure, scene
 
 from conftest import HAMAKER, Z0

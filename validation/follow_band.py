@@ -23,7 +23,7 @@ import numpy as np
 import femadh
 from femadh.discretisation import GridFamily
 from femadh.elastic import GreenOperator
-from femadh.runner.contact import run
+from femadh.runner.run import run
 from femadh.runner.estimates import variant
 from femadh.scene import build_problem
 

@@ -3,7 +3,7 @@ the complementarity model on the adaptive grid, run end to end (sweeps, error-es
 members, peak refinement) at their defaults and at tighter accuracies, with the work the
 correctors did counted beside the time - this checkout against an earlier one.
 
-Each row is one run in a fresh process of ``femadh.runner.contact.run`` (no output folder, no
+Each row is one run in a fresh process of ``femadh.runner.run.run`` (no output folder, no
 figures) with counters wrapped around the package's own functions:
 
 - solves: calls of ``solve_complementarity`` (continuation trial steps, landings, the peak's
@@ -63,7 +63,7 @@ def _child(scene_file, accuracy, time_limit):
         return st
     for mod in (cm, stepping, landing):
         mod.solve_complementarity = solve
-    from femadh.runner.contact import run
+    from femadh.runner.run import run
     from femadh.scene import apply_overrides, load_scene, scene_from_dict
 
     scene = load_scene(scene_file)

@@ -28,7 +28,7 @@ def _relative(res):
 
 def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwrite=False,
                     resume=False):
-    """Run ``scene`` (with ``run``, :func:`femadh.runner.contact.run`) on ever finer grids
+    """Run ``scene`` (with ``run``, :func:`femadh.runner.run.run`) on ever finer grids
     until its estimated error meets ``scene.accuracy``; see the module docstring."""
 
     from ..io.progress import phase

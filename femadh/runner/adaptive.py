@@ -82,7 +82,7 @@ def _capped(scene, family, spacing):
 def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=False,
                  resume=False, estimate=True):
     """Run ``scene`` on its adaptive grid (see the module docstring) with ``run``
-    (:func:`femadh.runner.contact.run`); with ``estimate`` not True, one run on the planned
+    (:func:`femadh.runner.run.run`); with ``estimate`` not True, one run on the planned
     member (its accuracy unjudged)."""
     from ..io.progress import phase
     from ..scene import scene_id

@@ -22,8 +22,6 @@ from .figures import draw_figures
 from .lifecycle import lifecycle
 from .result import ContactResult
 from ..io.progress import phase
-# run() of every kind: its own module; here too for the callers of femadh.runner.contact.run
-from .run import run  # noqa: F401
 from .checkpoint import CHECKPOINT, resume_point, save_checkpoint
 from .sink import Sink
 from .tracing import branch_plan, trace_arclength, trace_steps
@@ -32,12 +30,14 @@ from .tracing import branch_plan, trace_arclength, trace_steps
 STIFFNESS_WARNING = 0.5
 
 
-def run_contact(scene, out_dir=None, *, figures=True, progress=False, overwrite=False,
+def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overwrite=False,
                 resume=False, operator=None, estimate=True, folder_id=None, resume_from=None):
     """Solve a contact scene (called by :func:`femadh.runner.run.run`, which documents the
     arguments, inside the run's signal handling, time limit and progress display): an
     adaptive grid or an accuracy target is refined over several runs, else one run into its
-    claimed folder, then its figures."""
+    claimed folder, then its figures. ``run``: the run of every kind
+    (:func:`femadh.runner.run.run`), which the trials and the estimate's members go through
+    (handed in: this module does not import its caller)."""
     if getattr(scene, "adaptive", False):
         from .adaptive import run_adaptive
 
@@ -49,13 +49,14 @@ def run_contact(scene, out_dir=None, *, figures=True, progress=False, overwrite=
         return run_to_accuracy(scene, out_dir, run=run, figures=figures,
                                progress=progress, overwrite=overwrite, resume=resume)
     if out_dir is None:
-        return _run(scene, None, progress=progress, operator=operator, estimate=estimate)
+        return _run(scene, None, progress=progress, operator=operator, estimate=estimate,
+                    run=run)
     from ..io.run_folder import RunFolder
 
     mode = "resume" if resume else "overwrite" if overwrite else "new"
     with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
         res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
-                   resume_from=resume_from)
+                   resume_from=resume_from, run=run)
         if figures and res.status in ("converged", "failed") and any(
                 len(next(iter(b.values()))) for b in res.branches.values()):
             with phase("figures"):
@@ -94,7 +95,7 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=None):
+def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_from=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     from ..io.progress import note
@@ -186,7 +187,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
         if folder is not None and (folder.path / CHECKPOINT).exists():
             (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
         if res.status == "running":
-            _finish(scene, res, problem, sink, estimate)
+            _finish(scene, res, problem, sink, estimate, run)
             if folder is not None and res.instrument is not None:
                 from ..io.writers import write_instrument
 
@@ -194,7 +195,7 @@ def _run(scene, folder, *, progress, operator=None, estimate=True, resume_from=N
     return res
 
 
-def _finish(scene, res, problem, sink, estimate):
+def _finish(scene, res, problem, sink, estimate, run):
     """Headline numbers, their error estimates and the bound guard of a finished sweep."""
     from .estimates import estimate_errors, guard_bounds, refine_peak
     from .headline import headline

@@ -180,7 +180,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     """Fill ``res.headline`` with ``<quantity>_error`` entries and return the breakdown
     {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
     bracket (:func:`refine_peak`); ``run`` runs the coarser members
-    (:func:`femadh.runner.contact.run`)."""
+    (:func:`femadh.runner.run.run`)."""
     import warnings
 
     from ..errors import MeshResolutionWarning

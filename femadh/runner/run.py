@@ -91,7 +91,7 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
 
     # one display over the whole run: its trials, estimate members and figures
     with blas_threads(), interrupt.interruptible(limit), display(scene.name, progress):
-        return run_contact(scene, out_dir, figures=figures, progress=progress,
+        return run_contact(scene, out_dir, run=run, figures=figures, progress=progress,
                            overwrite=overwrite, resume=resume, estimate=estimate,
                            resume_from=resume_from, operator=operator, folder_id=folder_id)
 

@@ -27,7 +27,6 @@ import time
 
 import numpy as np
 
-from .operator import FEOperator
 
 #: bump when the condensation changes in a way the versions below do not capture
 #: (2: the surface load through a scikit-fem FacetBasis, which moves the compliance by
@@ -75,16 +74,15 @@ def operator_key(op):
     return hashlib.sha1(json.dumps(blob, sort_keys=True).encode()).hexdigest()[:20]
 
 
-def cached_operator(grid, body, settings=None, progress=None, *, mesh_path=None,
-                    cache_dir=None):
-    """The :class:`FEOperator` of ``body`` (an :class:`~.body.FEBody`) on ``grid``, its
-    condensed compliance read from the on-disk operator cache when an identical body was
-    condensed before, else built and stored there (keyed by content: the mesh file's bytes,
-    the grid, the materials, the settings). A cached operator builds its mesh, stiffness and
-    factorisation only when full fields are asked for. ``FEOperator.homogeneous(...,
-    cache=True)`` and ``FEOperator.layered(..., cache=True)`` call this."""
-    op = FEOperator.__new__(FEOperator)
-    op._prepare(grid, body, settings, mesh_path, progress)
+def cached_operator(op, progress=None, *, cache_dir=None):
+    """``op``, an :class:`~.operator.FEOperator` prepared but not built (its body, grid,
+    settings and mesh file set), with its condensed compliance read from the on-disk operator
+    cache when an identical body was condensed before, else built and stored there (keyed by
+    content: the mesh file's bytes, the grid, the materials, the settings). A cached operator
+    builds its mesh, stiffness and factorisation only when full fields are asked for.
+    ``FEOperator.homogeneous(..., cache=True)`` and ``FEOperator.layered(..., cache=True)``
+    call this (the operator hands itself in: the cache does not import it)."""
+    grid = op.grid
     t0 = time.perf_counter()
     key = operator_key(op)
     folder = cache_folder(cache_dir)

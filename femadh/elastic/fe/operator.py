@@ -120,8 +120,9 @@ class FEOperator(SurfaceOperator):
         if cache:
             from .cache import cached_operator
 
-            return cached_operator(grid, body, settings, progress, mesh_path=mesh_path,
-                                   cache_dir=cache_dir)
+            op = cls.__new__(cls)
+            op._prepare(grid, body, settings, mesh_path, progress)
+            return cached_operator(op, progress, cache_dir=cache_dir)
         return cls(grid, body, settings, mesh_path=mesh_path, progress=progress)
 
     def _prepare(self, grid, body, settings, mesh_path, progress):
