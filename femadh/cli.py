@@ -294,7 +294,8 @@ def _run(scene, args):
                f"`{shlex.join(again)}` continues the run")
         return res.exit_code
     if res.status != "converged":
-        _error(f"{res.error}; what was computed before it is kept in {res.out_dir}")
+        _error(f"{res.error}; " + (f"what was computed before it is kept in {res.out_dir}"
+                                   if res.out_dir else "nothing was computed"))
         return EXIT_SOLVE
     return 0
 
@@ -321,6 +322,8 @@ def _report(res):
     for line in headline_lines(res):
         print(line)
     figs = res.timings.get("figures_s")
+    if res.out_dir is None:
+        return                      # refused before its first grid: the error says why
     print(f"results in {res.out_dir} (run {res.wall_time:.2f} s"
           + (f", figures {figs:.2f} s)" if figs is not None else ")"))
 

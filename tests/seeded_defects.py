@@ -775,6 +775,16 @@ DEFECTS = [
       "largest force", "femadh/runner/result.py",
       (("float(np.asarray(c[\"force_error_N\"], float)[k])",
         "float(np.asarray(c[\"force_error_N\"], float)[k - 1])"),)),
+    # -- headline guards (a newcomer's trial on a fresh clone)
+    D("radius_unbounded", "scene: a sphere radius of metres or parsecs accepted",
+      "femadh/scene/parts/body.py", (("lo=0.0, hi=0.1, hi_closed=True),", "lo=0.0),"),)),
+    D("peak_end_silent", "run: a largest adhesion at an end of the sweep reported as a peak",
+      "femadh/runner/contact.py",
+      (("    if sink.peak is None or sink.peak[1] <= 0 or (sink.peak[2] is not None",
+        "    if True or sink.peak is None or sink.peak[1] <= 0 or (sink.peak[2] is not None"),)),
+    D("report_refused_radius", "report: an accuracy request refused before its first grid "
+      "prints an analysis radius of None (a crash)", "femadh/runner/report.py",
+      (('    if res.accuracy and res.accuracy.get("steps"):', "    if res.accuracy:"),)),
 ]
 
 

@@ -203,6 +203,7 @@ def _finish(scene, res, problem, sink, estimate, run):
     problem = sink.problem          # the last grid of a band that follows the edge
     t1 = time.perf_counter()
     res.headline = headline(res, problem)
+    res.warnings += _unbracketed_peak(sink)
     if estimate:
         with phase("peak search"):
             half = refine_peak(scene, res, problem, sink)
@@ -234,3 +235,16 @@ def _stiffness_warning(scene, problem):
     # (the caller of run(): _run <- run_contact <- runner.run.run <- the caller)
     warnings.warn(msg, MeshResolutionWarning, stacklevel=5)
     return [msg]
+
+
+def _unbracketed_peak(sink):
+    """A warning when the largest adhesion is a branch's first or last state: the sweep
+    stops where the force still grows, so the number is a lower bound of the peak (e.g. a
+    2-m sphere where 2 mm was meant: in contact from the sweep's first separation)."""
+    if sink.peak is None or sink.peak[1] <= 0 or (sink.peak[2] is not None
+                                                 and sink.peak[4] is not None):
+        return []
+    branch, _, _, best, _ = sink.peak
+    return [f"the largest adhesion is at an end of the {branch} sweep (d = {best.d * 1e9:.4g} "
+            "nm), not between computed separations: it is only a lower bound of the peak; "
+            "extend [sweep] past it"]

@@ -40,14 +40,16 @@ def headline_lines(res):
         out.append(f"F_ex(d = {hl['d_deepest_m'] * 1e9:.4g} nm) = "
                    f"{_force(hl['F_ex_deepest_N'], hl.get('F_ex_deepest_N_error'))}, F_LJ = "
                    f"{_force(hl['F_LJ_deepest_N'], hl.get('F_LJ_deepest_N_error'))}")
-    if res.accuracy:
+    if res.accuracy and res.accuracy.get("steps"):
         a = res.accuracy
         grid = (f"{a['nodes']} nodes, band spacing {a['spacing_m'] * 1e9:.3g} nm to "
                 f"{a['band_m'] * 1e6:.3g} µm" if a.get("adaptive") and a.get("spacing_m")
-                else f"N = {a['nodes']}")
-        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}, "
-                   f"analysis radius {a['analysis_radius_m'] * 1e6:.4g} µm after "
-                   f"{len(a['steps'])} run(s)")
+                and a.get("band_m") else f"N = {a.get('nodes')}")
+        # a request refused before any grid ran has no radius: say so, not crash on None
+        radius = (f", analysis radius {a['analysis_radius_m'] * 1e6:.4g} µm"
+                  if a.get("analysis_radius_m") is not None else "")
+        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}"
+                   f"{radius} after {len(a.get('steps', ()))} run(s)")
     for j in res.jumps:
         where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else
                  "traced fold, dd/ds = 0")

@@ -9,7 +9,9 @@ from ...schema import Key, Table
 from ..reader import BAD, any_bad
 
 SPHERE = Table("sphere", "The rigid sphere (slider, tip, asperity), paper 1 eq (4).", (
-    Key("radius", "length", "Sphere radius R (paper 1: 2 mm slider, 1 um in Fig 6).", lo=0.0),
+    Key("radius", "length", "Sphere radius R (paper 1: 2 mm slider, 1 um in Fig 6); at most "
+        "10 cm: MEMS/NEMS contacts (a larger R is a unit typo, e.g. '2 m' for '2 mm').",
+        lo=0.0, hi=0.1, hi_closed=True),
     Key("profile", "choice", "'paraboloid': b = d + r^2/2R (eq 4); 'sphere': the exact cap.",
         default="paraboloid", choices=PROFILES),
 ))
