@@ -63,7 +63,10 @@ def _child(scene_file, accuracy, time_limit):
         return st
     for mod in (cm, stepping, landing):
         mod.solve_complementarity = solve
-    from femadh.runner.run import run
+    try:
+        from femadh.runner.run import run
+    except ImportError:                 # an earlier femadh (--before): run() lived here
+        from femadh.runner.contact import run
     from femadh.scene import apply_overrides, load_scene, scene_from_dict
 
     scene = load_scene(scene_file)
