@@ -314,7 +314,7 @@ DEFECTS = [
     # -- what a user sees: progress width, the FE operator cache, the jump arrows, notes
     D("progress_zero_width", "progress: a terminal reporting 0 columns gets width 0",
       "femadh/io/progress.py",
-      (("    return cols if cols > 0 else FALLBACK_COLUMNS", "    return cols"),)),
+      (("    return n if n > 0 else fallback", "    return n"),)),
     D("fe_cache_ignores_materials", "FE operator cache key without the materials",
       "femadh/elastic/fe/cache.py",
       (('        "materials": [[repr(float(E)), repr(float(nu))] for E, nu in op.materials],\n',

@@ -33,36 +33,30 @@ def terminal():
     return sys.stderr.isatty()
 
 
-def width(stream=None):
-    """Columns of the terminal behind ``stream`` (default stderr); COLUMNS or 80 when it
-    reports 0 or none."""
+def _size(stream, field, env, fallback):
+    """One dimension of the terminal behind ``stream`` (default stderr): what it reports,
+    else the environment variable ``env``, else ``fallback`` (a pty of size 0x0 reports 0)."""
     stream = stream or sys.stderr
     try:
-        cols = os.get_terminal_size(stream.fileno()).columns
+        n = getattr(os.get_terminal_size(stream.fileno()), field)
     except (AttributeError, OSError, ValueError):
-        cols = 0
-    if cols <= 0:
+        n = 0
+    if n <= 0:
         try:
-            cols = int(os.environ.get("COLUMNS", "0"))
+            n = int(os.environ.get(env, "0"))
         except ValueError:
-            cols = 0
-    return cols if cols > 0 else FALLBACK_COLUMNS
+            n = 0
+    return n if n > 0 else fallback
+
+
+def width(stream=None):
+    """Columns of the terminal behind ``stream`` (default stderr); COLUMNS or 80."""
+    return _size(stream, "columns", "COLUMNS", FALLBACK_COLUMNS)
 
 
 def height(stream=None):
-    """Rows of the terminal behind ``stream`` (default stderr); LINES or 24 when it reports 0
-    or none."""
-    stream = stream or sys.stderr
-    try:
-        rows = os.get_terminal_size(stream.fileno()).lines
-    except (AttributeError, OSError, ValueError):
-        rows = 0
-    if rows <= 0:
-        try:
-            rows = int(os.environ.get("LINES", "0"))
-        except ValueError:
-            rows = 0
-    return rows if rows > 0 else FALLBACK_ROWS
+    """Rows of the terminal behind ``stream`` (default stderr); LINES or 24."""
+    return _size(stream, "lines", "LINES", FALLBACK_ROWS)
 
 
 class Display:
