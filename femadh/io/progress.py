@@ -90,12 +90,14 @@ class Display:
     def _redraw(self, total=None):
         cols = width(self.stream)
         self.bar.ncols = cols
-        self.bar.reset(total=total)
         # a phase without a count shows its name; the time is the whole run's so far
         self.bar.bar_format = ("{desc}: {n_fmt}/{total_fmt}{postfix}" if total
                                else "{desc}{postfix}")
         self.bar.set_postfix_str(self._elapsed(), refresh=False)
-        self.bar.set_description_str(self.label(room=cols - 22), refresh=True)
+        self.bar.set_description_str(self.label(room=cols - 22), refresh=False)
+        # reset last: it draws once, with the new label (reset first drew the finished
+        # phase's label at 0/n - "approach: 0/36" after "approach: 32/36")
+        self.bar.reset(total=total)
 
     def _elapsed(self):
         return f"{time.perf_counter() - self.t0:.1f} s"
