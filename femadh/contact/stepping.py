@@ -184,6 +184,9 @@ MAX_INDICATOR_TRIALS = 12
 #: an indicator trial must have at least halved the bracket over the last two trials, else the
 #: next one bisects (the safeguard of a regula falsi that keeps landing on one side)
 MIN_SHRINK_PER_TWO = 0.5
+#: False: the plain halving everywhere (the path the bracketed search replaced; the tests'
+#: reference for where the folds are)
+BRACKETED = True
 
 
 class _Bracket:
@@ -242,8 +245,12 @@ class _Bracket:
         return (self.far - state.d) * self.dir
 
     def located(self, state):
-        return (self.far is not None and self.decided
-                and self.width(state) <= self.min_step * (1 + 1e-9))
+        return self.far is not None and self.decided and self.steps(state) <= 1
+
+    def steps(self, state):
+        """The bracket's width in resolution steps (a whole number: its ends are lattice
+        points, up to the round-off of d, which can be 1e-8 of a step)."""
+        return int(round(self.width(state) / self.min_step))
 
     def estimate(self):
         """The indicator's estimate of the fold's d (m), or None."""
@@ -263,7 +270,7 @@ class _Bracket:
         trials (and the fold) lie on the lattice of the halving this replaced: the fold is
         the last point of that lattice the branch reaches, whichever trials found it."""
         a, h = state.d, self.min_step
-        n = int(round(self.width(state) / h))       # the bracket in resolution steps
+        n = self.steps(state)
         if n <= 1:
             return self.far                         # the decision solve
         est = None
@@ -387,7 +394,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         fold.see(state, t_state, problem)
         # the plain halving (no bracket): on a lattice-trapped grid, and as the fallback of a
         # grid step whose bracketed fold's landing did not polish (restarted from its start)
-        halving = trapped
+        halving = trapped or not BRACKETED
         start_here = (state, g_state, t_state)
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
