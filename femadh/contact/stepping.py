@@ -1,13 +1,23 @@
 """Continuation in the separation d: approach and retract branches, fold detection and jumps.
 
 Each grid step is taken with a predictor (the tangent dw/dd of the last state, its active set
-frozen) and the semismooth Newton corrector. A step is accepted only if the corrector
-converges to a *stable* state close to the prediction; otherwise the step is halved. When even
-the smallest step fails, the branch has folded (the stable equilibrium ceased to exist: jump-in
-on approach, jump-out on retract). The fold is reported at the last stable d, and the surface
-is then landed on the other branch by descending the total energy from the last state
-(Levenberg-Marquardt with the gap bound h >= sigma), which is where a quasi-static surface would
-snap to, and polished by Newton.
+frozen; computed once per state) and the semismooth Newton corrector. A step is accepted only
+if the corrector converges to a *stable* state close to the prediction. A step turned down
+because its stable state lies farther from the prediction than the corrector may go, on the
+same branch (no energy lost beyond one branch's bound), is halved. Any other turned-down step
+brackets a fold between the last accepted d and itself (:class:`_Bracket`): no trial goes past
+it again, and the fold is searched inside by a secant on the indicator 1/G'^2 (zero at a
+saddle-node fold), safeguarded by bisection and capped, on the lattice of resolution steps
+(MIN_STEP_FRACTION of the grid step) that the plain halving visited - so the fold is the one
+the halving found, in fewer solves. When the decision solve (the whole corrector budget) one
+resolution step past the last accepted state fails, the branch has folded (the stable
+equilibrium ceased to exist: jump-in on approach, jump-out on retract). The fold is reported
+at the last stable d, and the surface is then landed on the other branch by descending the
+total energy from the last state (Levenberg-Marquardt with the gap bound h >= sigma), which is
+where a quasi-static surface would snap to, and polished by Newton. The plain halving (step
+halved on any rejection, doubled on acceptance) is kept on lattice-trapped grids, where the
+states reached depend on the path, and is the fallback of a grid step whose landing does not
+polish.
 
 A corrector can also converge to a stable state of the *other* branch across a fold that lies
 inside the step (a small jump-in, whose gap change stays within MAX_CORRECTION_FRACTION). Such a
@@ -38,7 +48,8 @@ from .landing import land
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
 #: solves allowed between two requested separations before the branch counts as stalled
-#: (a fold needs ~log2(1/MIN_STEP_FRACTION) = 10 halvings; healthy steps need a handful)
+#: (a fold needs at most ~2 log2(1/MIN_STEP_FRACTION) = 20 bracketed trials, measured 4-8 on
+#: a jump-in; healthy steps need a handful)
 MAX_SOLVES_PER_STEP = 200
 #: folds in a row, each within CRAWL_STEPS smallest steps of the last landing, beyond which the
 #: branch counts as stalled (folds further apart are a contact unzipping node by node)
