@@ -812,6 +812,12 @@ DEFECTS = [
         "if False:"),)),
     D("landing_roundoff_loose", "landing: the descent stops at a 'round-off' of 1e12 ulps",
       "femadh/contact/landing.py", (("ROUNDOFF_ULPS = 64", "ROUNDOFF_ULPS = 1e12"),)),
+    D("landing_roundoff_on_trapped", "landing: the round-off stop also on a lattice-trapped grid",
+      "femadh/contact/landing.py",
+      (("roundoff=not trapped)", "roundoff=True)"),)),
+    D("landing_no_whole_descent", "landing: a polish that fails after the settled descent is "
+      "final (no whole descent)", "femadh/contact/landing.py",
+      (("if not trapped and not (st.converged and st.stable):", "if False:"),)),
 ]
 
 

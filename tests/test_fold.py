@@ -188,3 +188,25 @@ def test_the_energy_descent_stops_once_settled_at_round_off(monkeypatch):
     assert np.max(np.abs(landed.w - j.after.w)) <= 3 * TOL
     assert state_forces(p, landed)[2] == pytest.approx(state_forces(p, j.after)[2],
                                                        rel=1e-9, abs=0)
+
+
+def test_a_landing_whose_polish_fails_after_the_settled_descent_runs_the_whole_descent(
+        monkeypatch):
+    """The round-off stop is a shortcut, never a new failure: when the Newton polish from the
+    settled descent does not reach a stable state (forced here on the first polish), the
+    landing runs the whole descent to its cap as before and lands on the same state."""
+    p = _problem(150)
+    j = trace(p, D_VALUES, branch="approach", tol=TOL).jumps[0]
+    real = landing.solve_complementarity
+    calls = []
+
+    def first_fails(*a, **k):
+        st = real(*a, **k)
+        calls.append(st.n_iter)
+        if len(calls) <= 2:             # the polish and its larger-budget retry
+            st.converged = False
+        return st
+    monkeypatch.setattr(landing, "solve_complementarity", first_fails)
+    landed = landing.land(p, j.d_land, j.before.w, tol=TOL, max_iter=40)
+    assert len(calls) == 3 and landed.converged and landed.stable
+    assert np.max(np.abs(landed.w - j.after.w)) <= 3 * TOL
