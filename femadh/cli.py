@@ -302,16 +302,10 @@ def _run(scene, args):
 
 def _report(res):
     if res.kind == "meniscus":
-        for (liq, R, meth), c in res.curves.items():
-            import numpy as np
+        from .runner.meniscus import report_lines
 
-            ok = np.isfinite(c["force_over_4piRgamma"])
-            if ok.any():
-                k = int(np.nanargmax(c["force_over_4piRgamma"]))
-                print(f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: max F/4piRgamma = "
-                      f"{c['force_over_4piRgamma'][k]:.4f} at p/psat = {c['p_ratio'][k]:.3g}"
-                      + (f"  ({int((~ok).sum())} p/psat without meniscus)" if (~ok).any()
-                         else ""))
+        for line in report_lines(res):
+            print(line)
         for e in res.errors[:5]:
             print(f"femadh: note: no meniscus for {e['liquid']} R = {e['tip_radius_m']:g} m "
                   f"{e['method']} at p/psat = {e['p_ratio']:g}: {e['error']}", file=sys.stderr)

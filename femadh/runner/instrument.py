@@ -212,7 +212,8 @@ def _pull_off_at_the_peak(res, problem):
     if ret is None or "instrument_pull_off_N" not in hl or "d_at_max_adhesion_m" not in hl:
         return
     d = hl["d_at_max_adhesion_m"]
-    F = hl["max_adhesion_N"] + tail_force(problem, d)
+    tail = tail_force(problem, d)
+    F = hl["max_adhesion_N"] + tail
     held = [dk for dk, kind in zip(ret["d_m"], ret["kind"]) if kind == "point"]
     # the readout's largest tension is an interior state of the path (not a jump's fold),
     # and the peak lies where the path holds the contact: the same maximum, sampled
@@ -224,6 +225,30 @@ def _pull_off_at_the_peak(res, problem):
         hl["instrument_pull_off_N"] = float(F)
         ins["resolution"]["pull_off_N"] = max(abs(F - sampled),
                                               ins["resolution"].get("pull_off_N", 0.0))
+        ins["pull_off_tail"] = _tail_share(problem, d, tail, hl["max_adhesion_N"], sampled)
+    else:
+        # read elsewhere on the path (a jump's fold): the tail there, no identity with the
+        # max adhesion (another state)
+        d_p = float(ret["d_m"][i])
+        ins["pull_off_tail"] = _tail_share(problem, d_p, tail_force(problem, d_p))
+
+
+def _tail_share(problem, d, tail, max_adhesion=None, sampled=None):
+    """summary.json "instrument" "pull_off_tail": what the pull-off holds beyond the headline's
+    max adhesion. The spring holds the whole sphere, so its force is F_ex (the analysis disk,
+    r <= a, the max adhesion's basis) plus F_tail = -2 pi R U(b(a; d)) beyond a (exact for
+    the undeformed paraboloid; the deformation there is ~F / (pi E* a), 4e-12 m on the AFM
+    tip's 5-nm gap at a). With the pull-off at the max adhesion's state (``max_adhesion``
+    given): pull-off - max adhesion = F_tail(d_at_max_adhesion), the identity the terminal
+    prints; ``sampled`` is the path's own reading of that maximum (fresh states, F_ex + F_tail
+    each), an independent check of it."""
+    out = {"d_m": float(d), "F_tail_N": float(tail),
+           "analysis_radius_m": float(problem.grid.radius),
+           "at_max_adhesion": max_adhesion is not None}
+    if max_adhesion is not None:
+        out["max_adhesion_N"] = float(max_adhesion)
+        out["sampled_pull_off_N"] = float(sampled)
+    return out
 
 
 def _resolved(hl, target, step):
