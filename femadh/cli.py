@@ -31,7 +31,8 @@ def _parser():
                     "examples and `femadh keys` for every key.",
         epilog="exit codes: 0 done, 2 bad scene/arguments, 3 solve failed (states kept), "
                "4 output not writable or folder holds a previous run, 5 missing dependency, "
-               "6 time limit reached (states kept), 130/143 interrupted.")
+               "6 time limit reached (states kept), 130/143 interrupted, 1 an internal "
+               "error (a bug in femadh: please report it).")
     p.add_argument("--version", action="version", version=f"femadh {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     r = sub.add_parser("run", help="solve a scene and write its results and figures",
