@@ -101,3 +101,15 @@ def test_help_lists_every_exit_code_the_readme_does():
                  "5 missing dependency", "6 time limit", "130/143 interrupted",
                  "1 an internal error"):
         assert code in epilog, code
+
+
+def test_a_celsius_temperature_written_c_names_the_coulomb(tmp_path, capsys):
+    """'25 C' is 25 coulomb to pint: the line says so and how Celsius is written."""
+    text = (ROOT / "validation/scenes/paper2_ethanol_100nm.toml").read_text()
+    assert text.count('temperature = "298.15 K"') == 1
+    code, err, path = _check(tmp_path, capsys, text.replace('temperature = "298.15 K"',
+                                                            'temperature = "25 C"'))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [meniscus.temperature] = '25 C': expected a "
+                   "temperature such as '298.15 K', but it has units of C (C is the coulomb: "
+                   "Celsius is 'degC')"]
