@@ -796,6 +796,17 @@ DEFECTS = [
       "pull-off, not to the max adhesion", "femadh/runner/report.py",
       (("f\"{t['max_adhesion_N'] * s:.5g} {unit} (analysis disk) + F_tail \"",
         "f\"{t['sampled_pull_off_N'] * s:.5g} {unit} (analysis disk) + F_tail \""),)),
+    D("newcomer_refine_mixed_pair", "instrument readout: a bracket's ends taken as the first "
+      "states at its separations (a fold's landing for the fold)", "femadh/runner/instrument.py",
+      (("        best = min(pairs, key=apart)\n", "        best = pairs[0]\n"),)),
+    D("newcomer_lj_invalid_silenced", "LJ law: a NaN made in the law silenced with its limits "
+      "at contact", "femadh/laws/lj.py",
+      (('AT_CONTACT = {"over": "ignore", "divide": "ignore", "under": "ignore"}',
+        'AT_CONTACT = {"all": "ignore"}'),)),
+    D("newcomer_reader_missing_silent", "scene reader: a missing required key not reported "
+      "unless its table is missing", "femadh/scene/reader.py",
+      (("            elif key.required and (absent or full in self.suggested):",
+        "            elif key.required and (absent or True):"),)),
     D("newcomer_meniscus_shooting_exact", "meniscus report: shooting's 0 printed as an "
       "estimated error (± 0)", "femadh/runner/meniscus.py",
       (('estimated = meth in ("fe", "no-film") and np.isfinite(err)',

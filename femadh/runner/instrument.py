@@ -1,6 +1,8 @@
 """The instrument's numbers of a run: read off the computed states
 (:mod:`femadh.instrument.readout`), then sharpened by fresh states where the readout
 interpolates (z's turning points, the landings, the largest tension)."""
+import math
+
 import numpy as np
 
 #: rounds of fresh states in each interval the readout interpolates in
@@ -144,8 +146,27 @@ def refine_instrument(scene, res, problem, sink):
             out[b] = {k: np.asarray(v, float)[order] for k, v in c.items()}
         return out
 
-    def at(branch, d):
-        return next((st for st in pool.get(branch, ()) if st.d == d), None)
+    def ends(branch, lo, hi):
+        """The computed states at a bracket's ends on one piece of the branch. At a fold the
+        branch's last state and its landing can share a separation (a traced fold lands at
+        d_fold): of the candidates, the pair whose displacements differ least (a landing
+        differs from its fold by the jump, ~ the gap). A fresh state solved between a fold and
+        its landing lands on either branch, and one from the other piece in the branch's rows
+        reads as a turn of z that is not there (a pull-off of 468 nN on a curve whose largest
+        tension is 363 nN: the smooth sphere at mu = 2 on a 3e4 N/m spring)."""
+        A = [st for st in pool.get(branch, ()) if st.d == lo]
+        B = [st for st in pool.get(branch, ()) if st.d == hi]
+
+        def apart(ab):
+            a, b = ab
+            if np.shape(a.w) != np.shape(b.w):
+                return math.inf          # a band that moved between them: no interpolation
+            return float(np.max(np.abs(np.asarray(a.w) - np.asarray(b.w))))
+        pairs = [(a, b) for a in A for b in B]
+        if not pairs:
+            return None, None
+        best = min(pairs, key=apart)
+        return best if math.isfinite(apart(best)) else (None, None)
 
     for _ in range(REFINE_ROUNDS):
         try:
@@ -162,7 +183,7 @@ def refine_instrument(scene, res, problem, sink):
             if (branch, lo, hi) in done or hi - lo <= REFINE_MIN_FRACTION * step:
                 continue
             done.add((branch, lo, hi))
-            a, b = at(branch, lo), at(branch, hi)
+            a, b = ends(branch, lo, hi)
             if a is None or b is None:
                 continue
             have = np.asarray(rows[branch]["d_m"], float)
