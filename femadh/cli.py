@@ -252,8 +252,11 @@ def _check(scene, path):
 
     mem, _ = memory_estimate(scene)
     t, what = time_estimate(scene)
+    # an adaptive scene's node count is femadh's to choose: its default 'nodes' is not run
+    grid = (f"adaptive grid to accuracy {scene.target_accuracy:g}" if scene.adaptive else
+            "banded grid" if scene.grid is not None else f"{scene.nodes} nodes")
     print(f"{path}: ok ({len(scene.d_values)} separations, {', '.join(scene.directions)}, "
-          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB, "
+          f"{grid}, {scene.method}, ~{mem / 2**20:.0f} MiB, "
           f"{'' if t < 1 else '~'}{_hms(t)} with "
           f"its error estimate: {what}, at rates measured on a 2-core machine; folds and "
           "jumps can take up to ~10x more)")

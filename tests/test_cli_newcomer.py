@@ -113,3 +113,14 @@ def test_a_celsius_temperature_written_c_names_the_coulomb(tmp_path, capsys):
     assert err == [f"femadh: error: {path}: [meniscus.temperature] = '25 C': expected a "
                    "temperature such as '298.15 K', but it has units of C (C is the coulomb: "
                    "Celsius is 'degC')"]
+
+
+def test_check_names_the_grid_the_run_will_use(capsys):
+    """An adaptive scene (no [solver] nodes) is not run on the default node count: `femadh
+    check` says 'adaptive grid to accuracy 0.001' (the run then chose 181 nodes for Fig 3),
+    not '200 nodes'; an explicit count is printed as given."""
+    assert main(["check", str(ROOT / "validation/scenes/paper1_fig3.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "adaptive grid to accuracy 0.001" in out and "200 nodes" not in out
+    assert main(["check", str(ROOT / "validation/scenes/afm_tip_cantilever.toml")]) == 0
+    assert ", 150 nodes, green" in capsys.readouterr().out
