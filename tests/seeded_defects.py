@@ -785,6 +785,39 @@ DEFECTS = [
     D("report_refused_radius", "report: an accuracy request refused before its first grid "
       "prints an analysis radius of None (a crash)", "femadh/runner/report.py",
       (('    if res.accuracy and res.accuracy.get("steps"):', "    if res.accuracy:"),)),
+    # -- a newcomer's second trial: the instrument's whole-sphere pull-off, the meniscus lines
+    D("newcomer_pull_off_no_tail", "instrument: the pull-off at the peak without the tail "
+      "beyond the analysis radius (the disk's max adhesion)", "femadh/runner/instrument.py",
+      (('    F = hl["max_adhesion_N"] + tail\n', '    F = hl["max_adhesion_N"]\n'),)),
+    D("newcomer_tail_wrong_state", "instrument: the pull-off's tail taken at d = 0, not at "
+      "the max adhesion's state", "femadh/runner/instrument.py",
+      (("    tail = tail_force(problem, d)\n", "    tail = tail_force(problem, 0.0)\n"),)),
+    D("newcomer_tail_line_basis", "report: the tail line adds F_tail to the path's sampled "
+      "pull-off, not to the max adhesion", "femadh/runner/report.py",
+      (("f\"{t['max_adhesion_N'] * s:.5g} {unit} (analysis disk) + F_tail \"",
+        "f\"{t['sampled_pull_off_N'] * s:.5g} {unit} (analysis disk) + F_tail \""),)),
+    D("newcomer_refine_mixed_pair", "instrument readout: a bracket's ends taken as the first "
+      "states at its separations (a fold's landing for the fold)", "femadh/runner/instrument.py",
+      (("        best = min(pairs, key=apart)\n", "        best = pairs[0]\n"),)),
+    D("newcomer_lj_invalid_silenced", "LJ law: a NaN made in the law silenced with its limits "
+      "at contact", "femadh/laws/lj.py",
+      (('AT_CONTACT = {"over": "ignore", "divide": "ignore", "under": "ignore"}',
+        'AT_CONTACT = {"all": "ignore"}'),)),
+    D("newcomer_reader_missing_silent", "scene reader: a missing required key not reported "
+      "unless its table is missing", "femadh/scene/reader.py",
+      (("            elif key.required and (absent or full in self.suggested):",
+        "            elif key.required and (absent or True):"),)),
+    D("newcomer_meniscus_shooting_exact", "meniscus report: shooting's 0 printed as an "
+      "estimated error (± 0)", "femadh/runner/meniscus.py",
+      (('estimated = meth in ("fe", "no-film") and np.isfinite(err)',
+        'estimated = meth in ("fe", "no-film", "shooting") and np.isfinite(err)'),)),
+    D("newcomer_meniscus_few_elements", "meniscus: an FE meridian too short to halve reports "
+      "error 0", "femadh/runner/meniscus.py",
+      (("    if scene.elements < 4:\n        return math.nan\n",
+        "    if scene.elements < 4:\n        return 0.0\n"),)),
+    D("newcomer_meniscus_error_scale", "meniscus report: the F/4πRγ error not divided by "
+      "4πRγ (by 4πR)", "femadh/runner/meniscus.py",
+      (('f" ± {err / unit4:.1g}"', 'f" ± {err / (4 * math.pi * R):.1g}"'),)),
 ]
 
 
