@@ -54,7 +54,8 @@ from ..reference.maugis import lj_dugdale_lambda, maugis_fixed_grip_pull_off, ma
 # the smooth-sphere problem of one point (re-exported: the map's public names)
 from .smooth_sphere import (ANALYSIS_RADIUS, BAND, BAND_MU, DS_MAX,  # noqa: F401
                             EDGE_GAP, GRADING, SPACING, TRACE_CORRECTION, PointSetup,  # noqa
-                            Resolution, e_star_length, lateral_length, lj_force, trace_point)
+                            Resolution, e_star_length, lateral_length, lj_force, trace_edge_point,
+                            trace_point)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
@@ -259,11 +260,41 @@ def solve_point(mu, radius, law, res, tol, progress):
     progress : callable or None
     """
     setup = PointSetup(mu, radius, law, res)
+    if setup.follows_edge:
+        return _read_edge(setup, trace_edge_point(setup, tol))
     curve = trace_point(setup, tol, progress)
     q = _read(setup, curve)
     q.update(setup=setup, n_points=len(curve.points), n_solves=curve.n_solves,
              n_folds=len(curve.folds), n_grids=len(curve.tracers))
     return q
+
+
+def _read_edge(setup, e):
+    """The map's readout (units of the map) of a point traced with the grid following the
+    edge (:func:`~femadh.studies.smooth_sphere.trace_edge_point`): two grids (the approach
+    branch's and the contact branch's), the edge on a node of the latter at every state
+    (band offset 0), two folds traced (jump-in and jump-out; the unstable branch between
+    them, with its two further folds at mu >= 5, is not traced)."""
+    z0 = setup.z0
+    scale = math.pi * setup.radius * setup.dg
+    (da, fa), (dr, fr) = e["approach"], e["retract"]
+    return {
+        "pull_off": float(e["pull_off"] / scale),
+        "pull_off_displacement": float(e["pull_off_displacement"] / scale),
+        "jump_in": float(e["jump_in"] / z0), "jump_out": float(e["jump_out"] / z0),
+        "hysteresis": float(e["hysteresis"] / (scale * z0)),
+        "hysteresis_trapezoid": float(e["loop_work"] / (scale * z0)),
+        "trapping": float(e["trapping"]), "edge_ratio": float(e["edge_ratio"]),
+        "band_offset": 0.0, "nodes": int(e["nodes"]),
+        "curves": {"curve_d": e["curve_d"] / z0, "curve_F": e["curve_F"] / scale,
+                   "curve_stable": e["curve_stable"],
+                   "approach_d": da / z0, "approach_F": fa / scale,
+                   "retract_d": dr / z0, "retract_F": fr / scale,
+                   "n_factor": e["n_factor"], "n_krylov": e["n_krylov"],
+                   "n_newton": e["n_newton"]},
+        "setup": setup, "n_points": e["n_points"], "n_solves": e["n_solves"],
+        "n_folds": e["n_folds"], "n_grids": 2,
+    }
 
 
 def _coarse_member(mu, radius, law, res, tol):
@@ -337,8 +368,13 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
             raise ValueError(f"judged must name some of {', '.join(QUANTITIES)}, got "
                              f"{', '.join(sorted(unknown)) or 'none'}")
         if "spacing" not in over and not res.legacy:
-            cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged
-                   else None)
+            if PointSetup(mu, radius, law, res).follows_edge:
+                # the grid follows the edge: no lattice wiggles to cap the spacing for
+                cap = MAX_SPACING_EDGE / COARSE_RATIO
+            elif "pull_off_displacement" in judged:
+                cap = lattice_cap(mu, radius, law)
+            else:
+                cap = None
             res = replace(res, spacing=initial_spacing(accuracy, cap))
     member = {}
     member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
@@ -433,6 +469,13 @@ MAX_SPACING = 0.2
 LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
+#: largest spacing of the coarser member where the grid follows the edge (JKR side,
+#: :func:`~femadh.studies.smooth_sphere.trace_edge_point`; units of ell): the lattice cap
+#: does not apply (the edge sits on a node at every state) and the error follows
+#: C spacing^2 with C = 0.015-0.02 (measured at mu = 3, 8, 20 against spacing 0.025-0.05,
+#: validation/results/accuracy_regime.md); at 0.3 the error ratios of the 0.3/0.2 pair are
+#: 1.7-2.3 for a spacing ratio 1.5 (2.25 at order 2): Richardson effectivity 0.85-1.0
+MAX_SPACING_EDGE = 0.3
 
 
 def regime_map(mus, progress=None, **kw):
