@@ -30,10 +30,11 @@ the jump-out fold is the root of dd/dc (from the linearised system), the load-co
 pull-off the largest tension, the landing after the jump-in the root of d(c) = d_in.
 """
 from dataclasses import dataclass
+import copy
 import math
 
 import numpy as np
-from scipy import integrate, optimize
+from scipy import optimize
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
@@ -51,9 +52,12 @@ STEP_MAX = 0.08
 STEP_MIN = 1e-5
 #: Newton iterations a step aims at (the step grows below, shrinks above)
 TARGET_ITER = 4
-#: relative accuracy in c of the fold and of the landing (root finding) and of the largest
-#: tension's location (the value at a smooth maximum is then exact to ~1e-10)
-C_XTOL = 1e-9
+#: relative accuracy in c of the fold and of the landing (root finding: the fold's tension and
+#: the landing's work move by ~this relative to themselves)
+C_XTOL = 1e-8
+#: relative accuracy in c of the largest tension's location: the value at a smooth maximum
+#: is off by ~(this)^2 relative
+MAX_XTOL = 1e-4
 #: the branch ends after this many states (a cap: a healthy branch takes 30-80)
 MAX_STATES = 2000
 
@@ -112,11 +116,20 @@ class EdgeBranch:
         self.n = base.grid.n
         self.n_solves = 0
         self.n_iter = 0
+        self._base = ContactProblem(base, sphere, effects, check_laws=False)
 
     def problem(self, c):
-        """The problem on the grid whose node k sits at c (m)."""
-        return ContactProblem(ScaledOperator(self.base, c / self.r0), self.sphere, self.effects,
-                              check_laws=False)
+        """The problem on the grid whose node k sits at c (m): the reference problem with its
+        operator scaled (its energy stiffness diag(area) K scales like lambda too)."""
+        lam = c / self.r0
+        op = ScaledOperator(self.base, lam)
+        pb = copy.copy(self._base)
+        pb.operator, pb.grid = op, op.grid
+        pb.shape = self.sphere.shape(op.grid.nodes)
+        pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
+        pb.S_sym = lam * self._base.S_sym
+        pb._finest = None
+        return pb
 
     def _jacobian(self, pb, D):
         n, k = self.n, self.k
@@ -181,14 +194,16 @@ class EdgeBranch:
         return float(lapack.dgetrs(lu, piv, rhs)[0][n])
 
 
-def tail_energy(law, radius, a, d):
-    """Interaction energy (J) beyond the analysis radius a of a rigid paraboloid at
-    separation d: 2 pi int_a^inf U(d + r^2/2R) r dr = 2 pi R int_b^inf U(h) dh, b = d + a^2/2R
-    (the surface is undeformed there)."""
-    b = d + a * a / (2 * radius)
-    val, _ = integrate.quad(lambda h: float(law.energy(np.array([h]))[0]), b, np.inf,
-                            epsabs=0.0, epsrel=1e-10, limit=200)
-    return 2 * math.pi * radius * val
+def tail_energy_change(law, radius, a, d1, d2):
+    """E_tail(d1) - E_tail(d2) (J): the change of the interaction energy beyond the analysis
+    radius a of a rigid paraboloid, E_tail(d) = 2 pi int_a^inf U(d + r^2/2R) r dr
+    = 2 pi R int_b^inf U(h) dh with b = d + a^2/2R (the surface is undeformed there), i.e.
+    2 pi R int_b1^b2 U(h) dh: 16-point Gauss-Legendre (U is smooth at these gaps, b >= 20 z0
+    at the smallest analysis radius)."""
+    b1, b2 = d1 + a * a / (2 * radius), d2 + a * a / (2 * radius)
+    x, wq = np.polynomial.legendre.leggauss(16)
+    h = 0.5 * (b1 + b2) + 0.5 * (b2 - b1) * x
+    return 2 * math.pi * radius * 0.5 * (b2 - b1) * float(wq @ law.energy(h))
 
 
 class BranchTrace:
@@ -283,5 +298,5 @@ class BranchTrace:
                 best[:] = [v, st]
             return -v
         optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
-                                 options={"xatol": C_XTOL * hi})
+                                 options={"xatol": MAX_XTOL * hi})
         return best[0], best[1]

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..contact import ContactProblem
 from ..contact.arclength import trace_curve
+from ..contact.complementarity import solve_complementarity
 from ..contact.stability import is_positive_definite
 from ..errors import ConvergenceError
 from ..discretisation.moving import MovingBand
@@ -213,6 +214,8 @@ class PointSetup:
         fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
         d_out = z0 - (fg[1] * d_unit if fg else 0.0)
         self.d_start = max(12 * z0, 1.5 * d_out)
+        self.d_out_md = d_out
+        self.bistable = fg is not None
         self.ds_max = res.ds_max if res.ds_max else max(DS_MAX, 0.02 * self.d_start / z0)
         self.sphere = Sphere(radius)
 
@@ -227,9 +230,10 @@ class PointSetup:
     @property
     def follows_edge(self):
         """True where the point is traced with the grid following the contact edge
-        (:func:`trace_edge_point`): the JKR side (the elastocohesive length sets ell), the
-        moving band requested and no legacy grid."""
-        return self.res.follow_edge and not self.res.legacy and self.fixed_band is None
+        (:func:`trace_edge_point`): where the curve has a jump-in and a jump-out
+        (Maugis-Dugdale's fixed-grip pull-off exists: lambda > 0.938, mu > 0.81), unless
+        ``follow_edge`` is off or the grid is the legacy one."""
+        return self.res.follow_edge and not self.res.legacy and self.bistable
 
     def problem(self, center=0.0):
         """The problem on a grid fine around the contact edge at ``center`` (m)."""
@@ -298,8 +302,13 @@ EDGE_GRADING = 2.0
 #: the reference grid's analysis radius relative to the point's (the grid shrinks with the
 #: edge down to the jump-out fold, ~0.5 of the zero-load JKR radius)
 EDGE_RADIUS_MARGIN = 4.0
+#: the approach branch is traced from this multiple of Maugis-Dugdale's jump-out separation
+#: (at least one z0 beyond it), with steps up to APPROACH_DS of the start separation: far out
+#: the surface barely deforms and the predictor is near exact
+APPROACH_START = 1.2
+APPROACH_DS = 0.05
 #: Gauss-Legendre nodes of the contact branch's work between the landing and the fold
-HYSTERESIS_NODES = 12
+HYSTERESIS_NODES = 8
 
 
 def _jkr_guess(branch, setup, c):
@@ -337,7 +346,7 @@ def trace_edge_point(setup, tol):
         The headline quantities in SI (pull_off, pull_off_displacement (N), jump_in,
         jump_out (m), hysteresis, loop_work (J)) and the states and counts the map reports.
     """
-    from ..contact.edge_branch import BranchTrace, EdgeBranch, tail_energy
+    from ..contact.edge_branch import BranchTrace, EdgeBranch, tail_energy_change
     from ..discretisation.family import GridFamily
 
     law, z0, R = setup.law, setup.z0, setup.radius
@@ -346,13 +355,14 @@ def trace_edge_point(setup, tol):
     def force(pb, d, w):
         return lj_force(pb, law, d, w)
 
-    def energy(pb, d, w):
-        return pb.energy(w, d) + tail_energy(law, R, pb.grid.radius, d)
-
     # approach branch: the centre band of the point's family, up to the jump-in fold
     app = setup.problem(0.0)
-    curve = trace_curve(app, setup.d_start, setup.d_end, tol=tol, scale=z0, ds=0.2,
-                        ds_max=setup.ds_max, stop=lambda cv: bool(cv.folds), max_points=20000,
+    # (from beyond Maugis-Dugdale's jump-out: the approach state at the traced jump-out is
+    # found there, or solved on its own if the traced one lies further out)
+    d_app = min(setup.d_start, max(APPROACH_START * setup.d_out_md, setup.d_out_md + z0))
+    curve = trace_curve(app, d_app, setup.d_end, tol=tol, scale=z0, ds=0.2,
+                        ds_max=max(DS_MAX, APPROACH_DS * d_app / z0),
+                        stop=lambda cv: bool(cv.folds), max_points=20000,
                         target_correction=TRACE_CORRECTION)
     if not curve.folds:
         raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
@@ -360,7 +370,9 @@ def trace_edge_point(setup, tol):
     fin = curve.folds[0]
     apts = curve.points[:fin.index + 1]
     # contact branch: reference grid fine around its node k at the zero-load JKR radius
-    c0 = jkr_contact_radius(0.0, R, setup.e_star, setup.dg)
+    # (started at JKR's load-controlled pull-off radius, (9 pi dg R^2 / 8 E*)^(1/3): the
+    # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
+    c0 = jkr_contact_radius(-1.5 * math.pi * R * setup.dg, R, setup.e_star, setup.dg)
     a_ref = EDGE_RADIUS_MARGIN * setup.a
     half = EDGE_BAND * ell
     fam = GridFamily(a_ref, min(a_ref, c0 + half), EDGE_GRADING * ell, inner=c0 - half)
@@ -383,17 +395,23 @@ def trace_edge_point(setup, tol):
         return st.force
 
     # down in c to the jump-out fold (d(c) has its largest value there)
-    down = tr.march(start, -1, lambda run: len(run) >= 3 and run[-1].d < run[-2].d)
-    fout = tr.fold(down[-1].c, down[-3].c)
+    # down in c past the jump-out fold (d(c) has its largest value there) and past the
+    # largest tension (the load-controlled pull-off is the largest tension anywhere on the
+    # curve: beyond the fold, on the unstable side, it would be missed)
+    down = tr.march(start, -1, lambda run: len(run) >= 3 and run[-1].d < run[-2].d
+                    and F(run[-1]) < F(run[-2]))
+    i_fold = next(i for i in range(2, len(down)) if down[i].d < down[i - 1].d)
+    fout = tr.fold(down[i_fold].c, down[i_fold - 2].c)
     # up in c past the jump-in landing (d below the jump-in fold's) and the largest tension
     up = tr.march(start, +1, lambda run: run[-1].d < fin.d and (
         len(run) >= 2 and F(run[-1]) < F(run[-2])))
+    traced = tr.states
+    i = int(np.argmax([F(s) for s in traced]))
+    if i in (0, len(traced) - 1):
+        raise ConvergenceError("edge trace: the largest tension lies at an end of the traced "
+                               f"contact branch (c = {traced[i].c:.4g} m)", d=traced[i].d)
+    pull_c, pull_state = tr.maximize(F, traced[i - 1].c, traced[i + 1].c)
     stable = [s for s in tr.states if s.c > fout.c]
-    fs = [F(s) for s in stable]
-    i = int(np.argmax(fs))
-    lo = fout.c if i == 0 else stable[i - 1].c
-    hi = stable[min(i + 1, len(stable) - 1)].c
-    pull_c, pull_state = tr.maximize(F, lo, hi)
     j = next(j for j in range(len(stable)) if stable[j].d < fin.d)
     land = tr.where_d(fin.d, stable[j - 1].c if j else fout.c, stable[j].c)
     if not is_positive_definite(land.problem.energy_hessian(land.problem.contour(land.d)
@@ -402,13 +420,19 @@ def trace_edge_point(setup, tol):
                                "is not stable", d=fin.d)
     # the retract path leaves the contact at the fold and lands on the approach branch
     d_out = fout.d
+    pba = curve.problem_of(0)
     ia = next((i for i in range(len(apts) - 1)
                if (apts[i].d - d_out) * (apts[i + 1].d - d_out) <= 0), None)
-    if ia is None:
-        raise ConvergenceError(f"edge trace: the approach branch does not reach the jump-out "
-                               f"separation {d_out / z0:.4g} z0", d=d_out)
-    w_out = curve.point_at(ia, d_out)
-    pba = curve.problem_of(0)
+    if ia is not None:
+        w_out = curve.point_at(ia, d_out)
+    else:   # beyond the traced approach branch: Newton from the undeformed surface
+        out = solve_complementarity(pba, d_out, np.zeros(pba.grid.n), tol=tol, max_iter=60)
+        if not (out.converged and out.stable
+                and np.min(pba.contour(d_out) - out.w) > EDGE_GAP * z0):
+            raise ConvergenceError(f"edge trace: no approach state (without contact) at the "
+                                   f"jump-out separation {d_out / z0:.4g} z0", d=d_out,
+                                   residual=out.residual, n_iter=out.n_iter)
+        w_out = out.w
     # the work of the cycle (the energy its jumps release): int F dd along the contact
     # branch from the landing to the fold (Gauss-Legendre in c, where F d'(c) is smooth)
     # less the same along the approach branch (its energy difference on one grid: F = dE/dd
@@ -420,7 +444,8 @@ def trace_edge_point(setup, tol):
     for xi, wi in zip(x, wq):
         st = tr.at(mid_c + half_c * xi)
         contact_work += wi * half_c * F(st) * branch.slope(st)
-    approach_work = energy(pba, fin.d, fin.w) - energy(pba, d_out, w_out)
+    approach_work = (pba.energy(fin.w, fin.d) - pba.energy(w_out, d_out)
+                     + tail_energy_change(law, R, pba.grid.radius, fin.d, d_out))
     released = approach_work - contact_work
     # the paths (for the loop integral and the figures)
     fa = np.array([force(pba, p.d, p.w) for p in apts])
@@ -444,7 +469,8 @@ def trace_edge_point(setup, tol):
         "trapping": trapping,
         "edge_ratio": max(s.c / s.problem.grid.radius for s in all_c),
         "nodes": max(app.grid.n, grid.n), "nodes_approach": app.grid.n, "nodes_contact": grid.n,
-        "n_points": len(apts) + len(all_c), "n_solves": curve.n_solves + branch.n_solves,
+        "n_points": len(apts) + len(all_c), "n_approach": len(apts), "n_branch_solves": branch.n_solves,
+        "n_solves": curve.n_solves + branch.n_solves,
         "n_newton": branch.n_iter,
         "n_folds": len(curve.folds) + 1,
         "curve_d": np.r_[da, fin.d, [s.d for s in all_c]],
