@@ -62,6 +62,47 @@ MAX_XTOL = 1e-4
 MAX_STATES = 2000
 
 
+def edge_grid(radius, edge, spacing, half, grading, max_nodes=4000):
+    """A radial grid with a node exactly at ``edge`` (m), uniform spacing h within ``half`` of
+    it on both sides and coarsening linearly beyond, Delta = h (1 + (|r - edge| - half) /
+    grading) (the banded family of :class:`~femadh.discretisation.family.GridFamily`, laid
+    out from the edge node instead of from r = 0): its members at every h are refinements of
+    one mesh density around the edge node, whatever h, which a Richardson estimate of the
+    edge-following trace needs (a band laid out from r = 0 puts its node nearest the edge up
+    to h/2 off the band's centre, differently for each h). Towards r = 0 the last step is
+    cut to land on 0 (the contact's interior, where the solution is smooth)."""
+    def delta(x):
+        return spacing * (1.0 + max(x - half, 0.0) / grading)
+
+    def walk(limit):
+        out, x = [], 0.0
+        while True:
+            step = delta(x + 0.5 * delta(x))
+            if x + step >= limit:
+                return out, x
+            x += step
+            out.append(x)
+            if len(out) > max_nodes:
+                raise ValueError(f"edge grid needs more than {max_nodes} nodes (spacing "
+                                 f"{spacing:.3g} m on a radius of {radius:.3g} m)")
+    inner, _ = walk(edge)
+    # outside: stop where the last annulus (half-way edge to a) would be narrower than a step
+    outer, x = [], 0.0
+    while True:
+        step = delta(x + 0.5 * delta(x))
+        if edge + x + 1.5 * step > radius:
+            break
+        x += step
+        outer.append(x)
+        if len(outer) > max_nodes:
+            raise ValueError(f"edge grid needs more than {max_nodes} nodes")
+    if inner and edge - inner[-1] < 0.5 * delta(inner[-1]):
+        inner = inner[:-1]          # no sliver of a last step before r = 0
+    nodes = np.r_[0.0, edge - np.array(inner[::-1]), edge, edge + np.array(outer)]
+    from ..elastic.grid import RadialGrid
+    return RadialGrid.from_nodes(nodes, radius, fine_radius=edge + half), len(inner) + 1
+
+
 class ScaledOperator:
     """The half-space operator of a grid scaled by lambda from a reference grid: C = lambda
     C^0, K = K^0 / lambda (the compliance is homogeneous of degree one in length)."""

@@ -469,13 +469,14 @@ MAX_SPACING = 0.2
 LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
-#: largest spacing of the coarser member where the grid follows the edge (JKR side,
-#: :func:`~femadh.studies.smooth_sphere.trace_edge_point`; units of ell): the lattice cap
-#: does not apply (the edge sits on a node at every state) and the error follows
-#: C spacing^2 with C = 0.015-0.02 (measured at mu = 3, 8, 20 against spacing 0.025-0.05,
-#: validation/results/accuracy_regime.md); at 0.3 the error ratios of the 0.3/0.2 pair are
-#: 1.7-2.3 for a spacing ratio 1.5 (2.25 at order 2): Richardson effectivity 0.85-1.0
-MAX_SPACING_EDGE = 0.3
+#: largest spacing of the coarser member where the grid follows the edge (units of ell;
+#: :func:`~femadh.studies.smooth_sphere.trace_edge_point`): the lattice cap does not apply
+#: (the edge sits on a node at every state); the error follows C spacing^2 with
+#: C = 0.01-0.02 up to 0.2 (measured: LJ mu = 3, 8, 20 and the peer's Lj82 at mu = 1, 3,
+#: against spacing 0.025-0.05, validation/results/accuracy_regime.md), beyond it not: the
+#: peer's mu = 3 pull-off is 1.3e-3 off at 0.25 and 4.8e-3 at 0.3, where nodes soften to
+#: 0.38-0.46 of their stiffness (C = 0.021 and 0.053, against 0.0097 at 0.1-0.125)
+MAX_SPACING_EDGE = 0.2
 
 
 def regime_map(mus, progress=None, **kw):
