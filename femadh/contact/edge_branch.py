@@ -172,6 +172,13 @@ class EdgeBranch:
         pb._finest = None
         return pb
 
+    def softening_ratio(self):
+        """The largest softening stiffness of the laws against the edge node's own stiffness
+        K_kk on the reference grid (:meth:`ContactProblem.surface_force_stiffness`'s law
+        side): near 1 a node snaps on its own."""
+        _, _, soft, _ = self._base.surface_force_stiffness()
+        return soft / float(self._base.K[self.k, self.k])
+
     def _jacobian(self, pb, D):
         n, k = self.n, self.k
         J = np.zeros((n + 1, n + 1))

@@ -299,15 +299,20 @@ def _read_edge(setup, e):
 
 def _coarse_member(mu, radius, law, res, tol):
     """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
-    traced). Returns (result, ratio)."""
-    for ratio in (COARSE_RATIO, 2.0):
+    traced; where the grid follows the edge x COARSE_RATIO_EDGE, else x COARSE_RATIO).
+    Returns (result, ratio)."""
+    ratios = ((COARSE_RATIO_EDGE, COARSE_RATIO) if PointSetup(mu, radius, law, res).follows_edge
+              else (COARSE_RATIO, 2.0))
+    why = None
+    for ratio in ratios:
         try:
             return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio
-        except (ConvergenceError, ValueError):
+        except (ConvergenceError, ValueError) as exc:
+            why = str(exc)
             continue
-    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x 1.5, x 2 of "
-                          f"{res.spacing:g} ell) cannot be traced: no error estimate; lower "
-                          f"spacing")
+    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x {ratios[0]:g}, "
+                          f"x {ratios[1]:g} of {res.spacing:g} ell) cannot be traced ({why}): "
+                          f"no error estimate; lower spacing")
 
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
@@ -370,7 +375,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         if "spacing" not in over and not res.legacy:
             if PointSetup(mu, radius, law, res).follows_edge:
                 # the grid follows the edge: no lattice wiggles to cap the spacing for
-                cap = MAX_SPACING_EDGE / COARSE_RATIO
+                cap = MAX_SPACING_EDGE / COARSE_RATIO_EDGE
             elif "pull_off_displacement" in judged:
                 cap = lattice_cap(mu, radius, law)
             else:
@@ -469,14 +474,17 @@ MAX_SPACING = 0.2
 LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
-#: largest spacing of the coarser member where the grid follows the edge (units of ell;
-#: :func:`~femadh.studies.smooth_sphere.trace_edge_point`): the lattice cap does not apply
-#: (the edge sits on a node at every state); the error follows C spacing^2 with
-#: C = 0.01-0.02 up to 0.2 (measured: LJ mu = 3, 8, 20 and the peer's Lj82 at mu = 1, 3,
-#: against spacing 0.025-0.05, validation/results/accuracy_regime.md), beyond it not: the
-#: peer's mu = 3 pull-off is 1.3e-3 off at 0.25 and 4.8e-3 at 0.3, where nodes soften to
-#: 0.38-0.46 of their stiffness (C = 0.021 and 0.053, against 0.0097 at 0.1-0.125)
-MAX_SPACING_EDGE = 0.2
+#: where the grid follows the edge (:func:`~femadh.studies.smooth_sphere.trace_edge_point`;
+#: units of ell) the lattice cap does not apply (the edge sits on a node at every state), but
+#: the pull-off leaves the spacing^2 line above ~0.15 ell, where nodes soften to more than
+#: ~0.25 of their stiffness (measured, errors against spacing 0.025: LJ mu = 2: 4.4e-4 at
+#: 0.2, 3.7e-4 at 0.133 (ratio 1.2 for order-2's 2.25), 1.9e-4 at 0.1; mu = 3: 5.8e-4 at
+#: 0.167, 2.8e-4 at 0.133, 1.5e-4 at 0.1; the peer's Lj82 at mu = 3: 1.3e-3 at 0.25, 4.8e-3
+#: at 0.3). The coarser member is at most MAX_SPACING_EDGE, COARSE_RATIO_EDGE times the fine
+#: one: the pair (0.167, 0.133) estimates the mu = 2 and 3 pull-offs 1.8-1.9x high (the 0.2
+#: member would put the mu = 2 estimate 7x low)
+MAX_SPACING_EDGE = 1.0 / 6.0
+COARSE_RATIO_EDGE = 1.25
 
 
 def regime_map(mus, progress=None, **kw):

@@ -29,9 +29,10 @@ from ..contact import ContactProblem
 from ..contact.arclength import trace_curve
 from ..contact.complementarity import solve_complementarity
 from ..contact.stability import is_positive_definite
-from ..errors import ConvergenceError
 from ..discretisation.moving import MovingBand
 from ..elastic import GreenOperator, RadialGrid
+from ..errors import ConvergenceError
+from ..estimate.guards import TRAPPING_LIMIT, trapping_message
 from ..indenter import Sphere
 from ..laws import LennardJones
 from ..reference.adhesion import dmt_contact_radius, jkr_contact_radius
@@ -313,7 +314,7 @@ APPROACH_DS = 0.05
 HYSTERESIS_NODES = 8
 
 
-def _jkr_guess(branch, setup, c):
+def jkr_start(branch, setup, c):
     """A start for Newton at edge radius c: the JKR pressure of contact radius c (Johnson
     1985 eq 5.31: Hertz plus the flat punch of the adhesive tension), its displacements
     through the scaled operator, gaps inside the contact held at z0 (where the LJ pressure
@@ -379,9 +380,15 @@ def trace_edge_point(setup, tol):
     grid, k = edge_grid(a_ref, c0, h, half, EDGE_GRADING * ell)
     base = GreenOperator(grid, setup.e_star)
     branch = EdgeBranch(base, k, setup.sphere, {"law": law}, EDGE_GAP * z0, tol)
+    # a grid whose nodes snap on their own cannot carry the edge (a priori, at the law's
+    # steepest softening against the edge node's stiffness)
+    trapped = trapping_message(branch.softening_ratio(), TRAPPING_LIMIT)
+    if trapped:
+        raise ConvergenceError(f"edge trace at spacing {setup.res.spacing:g} ell: {trapped}; "
+                               "lower spacing")
     tr = BranchTrace(branch)
     c0 = float(grid.nodes[k])
-    w0, d0 = _jkr_guess(branch, setup, c0)
+    w0, d0 = jkr_start(branch, setup, c0)
     start = branch.solve(c0, w0, d0)
     if start is None:
         raise ConvergenceError(f"edge trace: Newton from the JKR state at c = {c0:.4g} m "
