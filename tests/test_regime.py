@@ -114,6 +114,25 @@ def test_unresolved_grid_is_refused_with_the_setting_to_change():
     assert "-P'(h)/K_kk" in msg and "spacing" in msg
     pts = regime_map([2.0], spacing=3.0)
     assert pts[0].failed and math.isnan(pts[0].pull_off)
+    # the arclength trace on the moving band refuses it after tracing (its own guard)
+    from femadh.studies.regime import Resolution
+    with pytest.raises(ResolutionError) as e:
+        lj_sphere(2.0, spacing=3.0, resolution=Resolution(follow_edge=False))
+    assert "-P'(h)/K_kk" in str(e.value) and "spacing" in str(e.value)
+
+
+def test_lattice_cap_bounds_the_moving_band_where_the_fixed_grip_pull_off_is_judged():
+    """On the moving band (follow_edge=False) the jump-out fold's lattice wiggles cap the
+    starting spacing when the fixed-grip pull-off is judged (mu = 2: 0.05 ell, measured), and
+    do not when only the pull-off is; the edge-following trace has no such cap (0.133)."""
+    from femadh.studies.regime import R_DEFAULT, Resolution, lattice_cap, lj_sphere
+
+    band = Resolution(follow_edge=False)
+    cap = lattice_cap(2.0, R_DEFAULT, LennardJones(HAMAKER, Z0))
+    p = lj_sphere(2.0, accuracy=3e-3, resolution=band)
+    assert p.resolution.spacing <= cap * (1 + 1e-12) and p.failed is None
+    q = lj_sphere(2.0, accuracy=3e-3, resolution=band, judged=("pull_off",))
+    assert q.resolution.spacing > 2 * cap
 
 
 def _trace_only(mu, **res):
