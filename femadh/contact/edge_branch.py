@@ -111,8 +111,13 @@ class ScaledOperator:
 
     def __init__(self, base, lam):
         g = base.grid
-        self.grid = type(g)(g.nodes * lam, g.edges * lam,
-                            None if g.fine_radius is None else g.fine_radius * lam)
+        # a scaled valid grid is valid: its checks (monotone edges, nodes inside their
+        # annuli) are not repeated at every state
+        self.grid = object.__new__(type(g))
+        for name, value in (("nodes", g.nodes * lam), ("edges", g.edges * lam),
+                            ("fine_radius", None if g.fine_radius is None
+                             else g.fine_radius * lam)):
+            object.__setattr__(self.grid, name, value)
         self.compliance = lam * base.compliance
         self.stiffness = base.stiffness / lam
         self.lam = lam

@@ -297,12 +297,11 @@ def _read_edge(setup, e):
     }
 
 
-def _coarse_member(mu, radius, law, res, tol):
+def _coarse_member(mu, radius, law, res, tol, edge):
     """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
-    traced; where the grid follows the edge x COARSE_RATIO_EDGE, else x COARSE_RATIO).
-    Returns (result, ratio)."""
-    ratios = ((COARSE_RATIO_EDGE, COARSE_RATIO) if PointSetup(mu, radius, law, res).follows_edge
-              else (COARSE_RATIO, 2.0))
+    traced; where the grid follows the edge (``edge``) x COARSE_RATIO_EDGE, else x
+    COARSE_RATIO). Returns (result, ratio)."""
+    ratios = (COARSE_RATIO_EDGE, COARSE_RATIO) if edge else (COARSE_RATIO, 2.0)
     why = None
     for ratio in ratios:
         try:
@@ -365,6 +364,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     over = {k: v for k, v in (("spacing", spacing), ("stiffness_target", stiffness_target),
                               ("min_nodes", min_nodes), ("ds_max", ds_max)) if v is not None}
     res = replace(res, **over)
+    edge = PointSetup(mu, radius, law, res).follows_edge
     if accuracy is not None:
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
@@ -373,7 +373,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
             raise ValueError(f"judged must name some of {', '.join(QUANTITIES)}, got "
                              f"{', '.join(sorted(unknown)) or 'none'}")
         if "spacing" not in over and not res.legacy:
-            if PointSetup(mu, radius, law, res).follows_edge:
+            if edge:
                 # the grid follows the edge: no lattice wiggles to cap the spacing for
                 cap = MAX_SPACING_EDGE / COARSE_RATIO_EDGE
             elif "pull_off_displacement" in judged:
@@ -382,7 +382,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                 cap = None
             res = replace(res, spacing=initial_spacing(accuracy, cap))
     member = {}
-    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
+    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol, edge)
 
     def attempt(res):
         fine = solve_point(mu, radius, law, res, tol, progress)
