@@ -336,8 +336,9 @@ EDGE_RADIUS_MARGIN = 3.0
 #: the surface barely deforms and the predictor is near exact
 APPROACH_START = 1.2
 APPROACH_DS = 0.05
-#: Gauss-Legendre nodes of the contact branch's work between the landing and the fold
-HYSTERESIS_NODES = 8
+#: Gauss-Legendre nodes of the contact branch's work between the landing and the fold (F d'(c)
+#: is smooth in c: 6, 8 and 12 nodes agree to 1e-9 relative at mu = 1, 3, 20, measured)
+HYSTERESIS_NODES = 6
 
 
 def jkr_start(branch, setup, c):
