@@ -14,11 +14,10 @@ def _branch(mu=3.0, spacing=0.133):
     """The edge branch of one map point at its start radius, and the point's setup."""
     from femadh.contact.edge_branch import EdgeBranch, edge_grid
     from femadh.elastic import GreenOperator
-    from femadh.reference.adhesion import jkr_contact_radius
     from femadh.studies.smooth_sphere import PointSetup, Resolution
 
     st = PointSetup(mu, R, LennardJones(HAMAKER, Z0), Resolution(spacing=spacing))
-    c0 = jkr_contact_radius(-1.5 * math.pi * R * st.dg, R, st.e_star, st.dg)
+    c0 = (9 * math.pi * st.dg * R * R / (8 * st.e_star)) ** (1 / 3)   # JKR's pull-off radius
     grid, k = edge_grid(3 * st.a, c0, st.spacing, 2 * st.ell, 2 * st.ell)
     return EdgeBranch(GreenOperator(grid, st.e_star), k, st.sphere, {"law": st.law},
                       1.5 * Z0, 1e-19), st, c0

@@ -71,6 +71,10 @@ def edge_grid(radius, edge, spacing, half, grading, max_nodes=4000):
     edge-following trace needs (a band laid out from r = 0 puts its node nearest the edge up
     to h/2 off the band's centre, differently for each h). Towards r = 0 the last step is
     cut to land on 0 (the contact's interior, where the solution is smooth)."""
+    if not (0.0 < edge < radius and spacing > 0 and half >= 0 and grading > 0):
+        raise ValueError(f"edge grid needs 0 < edge ({edge:.4g} m) < radius ({radius:.4g} m), "
+                         f"spacing > 0 ({spacing:.4g} m), grading > 0 ({grading:.4g} m)")
+
     def delta(x):
         return spacing * (1.0 + max(x - half, 0.0) / grading)
 

@@ -401,7 +401,7 @@ def trace_edge_point(setup, tol):
     # contact branch: reference grid fine around its node k at the zero-load JKR radius
     # (started at JKR's load-controlled pull-off radius, (9 pi dg R^2 / 8 E*)^(1/3): the
     # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
-    c0 = jkr_contact_radius(-1.5 * math.pi * R * setup.dg, R, setup.e_star, setup.dg)
+    c0 = (9 * math.pi * setup.dg * R * R / (8 * setup.e_star)) ** (1 / 3)
     a_ref = EDGE_RADIUS_MARGIN * setup.a
     half = EDGE_BAND * ell
     grid, k = edge_grid(a_ref, c0, h, half, EDGE_GRADING * ell)
