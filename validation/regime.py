@@ -154,8 +154,8 @@ on the static band (`trace_point`). "grids": grids of the trace.
 {len(pts)} points, mu = {mus[0]:.3g} ... {mus[-1]:.3g}: {wall:.1f} s wall time on a shared 2-core
 machine, one BLAS thread, load average {load0:.1f} at the start and {load1:.1f} at the end
 (the times are indicative at a load above 2; the nodes, grids and folds are the counts).
-{len([p for p in pts if p.failed])} points failed. Before the edge-following trace (the whole curve by arclength on a
-band re-centred in steps): 1088 s on the same kind of machine, N 80 -> 852, 84 grids and
+{len([p for p in pts if p.failed])} points failed. Before the edge-following trace (the whole curve by
+arclength on a band re-centred in steps): 1088 s on the same kind of machine, N 80 -> 852, 84 grids and
 843 s at μ = 20 (validation/results/regime_cost.md: where the time went).
 """
     (RESULTS / "regime_map.md").write_text(text)

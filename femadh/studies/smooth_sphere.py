@@ -361,12 +361,12 @@ def jkr_start(branch, setup, c):
 
 
 def trace_edge_point(setup, tol):
-    """One JKR-side map point traced with the grid following the contact edge.
+    """One bistable map point traced with the grid following the contact edge.
 
     The approach branch (no contact yet) is traced by arclength
     (:func:`~femadh.contact.arclength.trace_curve`) on a band at the centre up to the jump-in
     fold; the contact branch by Newton in its edge radius c on a grid that moves with the edge
-    (:mod:`femadh.contact.edge_branch`), from the zero-load JKR radius down through the largest
+    (:mod:`femadh.contact.edge_branch`), from JKR's pull-off radius down through the largest
     tension to the jump-out fold and up past the landing of the jump-in. The unstable branch
     between the folds is not traced: no headline quantity is read off it.
 
@@ -398,8 +398,8 @@ def trace_edge_point(setup, tol):
                                f"d = {curve.points[-1].d / z0:.4g} z0", d=curve.points[-1].d)
     fin = curve.folds[0]
     apts = curve.points[:fin.index + 1]
-    # contact branch: reference grid fine around its node k at the zero-load JKR radius
-    # (started at JKR's load-controlled pull-off radius, (9 pi dg R^2 / 8 E*)^(1/3): the
+    # contact branch: reference grid fine around its node k at JKR's load-controlled
+    # pull-off radius (9 pi dg R^2 / 8 E*)^(1/3), where it starts (the
     # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
     c0 = (9 * math.pi * setup.dg * R * R / (8 * setup.e_star)) ** (1 / 3)
     a_ref = EDGE_RADIUS_MARGIN * setup.a
@@ -427,7 +427,6 @@ def trace_edge_point(setup, tol):
             st.force = force(st.problem, st.d, st.w)
         return st.force
 
-    # down in c to the jump-out fold (d(c) has its largest value there)
     # down in c past the jump-out fold (d(c) has its largest value there) and past the
     # largest tension (the load-controlled pull-off is the largest tension anywhere on the
     # curve: beyond the fold, on the unstable side, it would be missed)
@@ -436,14 +435,14 @@ def trace_edge_point(setup, tol):
     i_fold = next(i for i in range(2, len(down)) if down[i].d < down[i - 1].d)
     fout = tr.fold(down[i_fold].c, down[i_fold - 2].c)
     # up in c past the jump-in landing (d below the jump-in fold's) and the largest tension
-    up = tr.march(start, +1, lambda run: run[-1].d < fin.d and (
+    tr.march(start, +1, lambda run: run[-1].d < fin.d and (
         len(run) >= 2 and F(run[-1]) < F(run[-2])))
     traced = tr.states
     i = int(np.argmax([F(s) for s in traced]))
     if i in (0, len(traced) - 1):
         raise ConvergenceError("edge trace: the largest tension lies at an end of the traced "
                                f"contact branch (c = {traced[i].c:.4g} m)", d=traced[i].d)
-    pull_c, pull_state = tr.maximize(F, traced[i - 1].c, traced[i + 1].c)
+    pull_c, _ = tr.maximize(F, traced[i - 1].c, traced[i + 1].c)
     stable = [s for s in tr.states if s.c > fout.c]
     j = next(j for j in range(len(stable)) if stable[j].d < fin.d)
     land = tr.where_d(fin.d, stable[j - 1].c if j else fout.c, stable[j].c)
@@ -502,7 +501,8 @@ def trace_edge_point(setup, tol):
         "trapping": trapping,
         "edge_ratio": max(s.c / s.problem.grid.radius for s in all_c),
         "nodes": max(app.grid.n, grid.n), "nodes_approach": app.grid.n, "nodes_contact": grid.n,
-        "n_points": len(apts) + len(all_c), "n_approach": len(apts), "n_branch_solves": branch.n_solves,
+        "n_points": len(apts) + len(all_c), "n_approach": len(apts),
+        "n_branch_solves": branch.n_solves,
         "n_solves": curve.n_solves + branch.n_solves,
         "n_newton": branch.n_iter,
         "n_folds": len(curve.folds) + 1,
