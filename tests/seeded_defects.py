@@ -570,12 +570,37 @@ DEFECTS = [
         "return (value - error < lower * (1 - math.copysign(rel, lower))"),)),
     D("regime_judged_cap_off", "regime: the lattice cap dropped though the fixed-grip "
       "pull-off is judged", "femadh/studies/regime.py",
-      (('cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged',
-        'cap = (lattice_cap(mu, radius, law) if False'),)),
+      (('            elif "pull_off_displacement" in judged:',
+        '            elif False:'),)),
     D("regime_judged_ignored", "regime: the accuracy judged on every quantity whatever is asked",
       "femadh/studies/regime.py",
       (('fine["errors"], fine["worst"] = errors, _worst(fine, errors, judged)',
         'fine["errors"], fine["worst"] = errors, _worst(fine, errors)'),)),
+    # -- the regime map's contact branch traced in its edge radius (edge-following grid)
+    D("edge_scaled_compliance", "edge branch: the scaled grid keeps the reference compliance "
+      "(C not scaled by lambda)", "femadh/contact/edge_branch.py",
+      (("self.compliance = lam * base.compliance", "self.compliance = base.compliance"),)),
+    D("edge_slope_moving_nodes", "edge branch: dd/dc without the nodes' motion (shape "
+      "derivative dropped)", "femadh/contact/edge_branch.py",
+      (("dshape = self.sphere.slope(r) * r / st.c", "dshape = 0.0 * r"),)),
+    D("edge_hysteresis_tail", "edge trace: the approach work without the tail beyond the "
+      "analysis radius", "femadh/studies/smooth_sphere.py",
+      (("+ tail_energy_change(law, R, pba.grid.radius, fin.d, d_out))", ")"),)),
+    D("edge_gauss_jacobian", "edge trace: the contact branch's work without the Gauss "
+      "interval's half-length", "femadh/studies/smooth_sphere.py",
+      (("contact_work += wi * half_c * F(st) * branch.slope(st)",
+        "contact_work += wi * F(st) * branch.slope(st)"),)),
+    D("edge_grid_band", "edge grid: coarsening from the edge node (no uniform band)",
+      "femadh/contact/edge_branch.py",
+      (("return spacing * (1.0 + max(x - half, 0.0) / grading)",
+        "return spacing * (1.0 + x / grading)"),)),
+    D("edge_coarse_ratio", "regime: the coarser member's spacing ratio reported as 1.5 "
+      "whatever it was", "femadh/studies/regime.py",
+      (("return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio",
+        "return solve_point(mu, radius, law, res.coarser(ratio), tol, None), 1.5"),)),
+    D("edge_radius_margin", "edge trace: the reference grid's radius equal to the point's "
+      "(the grid shrinks below it at the fold)", "femadh/studies/smooth_sphere.py",
+      (("EDGE_RADIUS_MARGIN = 3.0", "EDGE_RADIUS_MARGIN = 1.0"),)),
     # -- fold accounting
     D("closure_jump_resolution", "closure: a fold's resolution reported as the grid step",
       "femadh/contact/closure/trace.py",
