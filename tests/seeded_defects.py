@@ -258,7 +258,8 @@ DEFECTS = [
         "return float(np.sum(problem.K @ state.w))"),)),
     D("fold_landing_restart", "stepping: a stalled landing no longer restarts on the branch "
       "the corrector found", "femadh/contact/stepping.py",
-      (("                    beyond = new\n", "                    pass\n"),)),
+      (("                    beyond, why = new, \"rejected_energy\"\n",
+        "                    why = \"rejected_energy\"\n"),)),
     # -- studies: the operator cache, the done/redo bookkeeping, exit codes, units, workers
     # the operator's key is the content hash of (body, discretisation): femadh/scene/parts
     D("study_key_wrong_part", "a study's operator key of the laws instead of the body (the "
@@ -810,6 +811,38 @@ DEFECTS = [
     D("report_refused_radius", "report: an accuracy request refused before its first grid "
       "prints an analysis radius of None (a crash)", "femadh/runner/report.py",
       (('    if res.accuracy and res.accuracy.get("steps"):', "    if res.accuracy:"),)),
+    # -- stepping: a fold bracketed and located by the indicator's secant (test_fold.py)
+    D("fold_secant_sign", "fold search: the indicator's secant extrapolated backwards",
+      "femadh/contact/stepping.py",
+      (("return d2 + q2 * (d2 - d1) / (q1 - q2)", "return d2 - q2 * (d2 - d1) / (q1 - q2)"),)),
+    D("fold_located_coarse", "fold search: a fold located (and decided) to 4 resolution "
+      "steps, not 1", "femadh/contact/stepping.py",
+      (("return self.far is not None and self.decided and self.steps(state) <= 1",
+        "return self.far is not None and self.decided and self.steps(state) <= 4"),
+       ("        if n <= 1:\n            return self.far",
+        "        if n <= 4:\n            return self.far"),
+       ("smallest = abs(d_try - state.d) <= min_step * 1.5",
+        "smallest = abs(d_try - state.d) <= min_step * 4.5"))),
+    D("fold_off_lattice", "fold search: the indicator's trials off the halving's lattice",
+      "femadh/contact/stepping.py",
+      (("            return a + self.dir * min(k, n - 1) * h\n",
+        "            return a + self.dir * min(max((est - a) * self.dir - 0.5 * h, h),\n"
+        "                                      (n - 1) * h)\n"),)),
+    D("fold_predictor_brackets", "fold search: a step turned down for the predictor's reach "
+      "brackets a fold", "femadh/contact/stepping.py",
+      (('if why == "rejected_predictor" and k > 1:', "if False:"),)),
+    D("fold_no_halving_fallback", "fold search: a landing that does not polish is an error, "
+      "no halving fallback", "femadh/contact/stepping.py",
+      (("if not (landed.converged and landed.stable) and not halving and jumps_here == 0:",
+        "if False:"),)),
+    D("landing_roundoff_loose", "landing: the descent stops at a 'round-off' of 1e12 ulps",
+      "femadh/contact/landing.py", (("ROUNDOFF_ULPS = 64", "ROUNDOFF_ULPS = 1e12"),)),
+    D("landing_roundoff_on_trapped", "landing: the round-off stop also on a lattice-trapped grid",
+      "femadh/contact/landing.py",
+      (("roundoff=not trapped)", "roundoff=True)"),)),
+    D("landing_no_whole_descent", "landing: a polish that fails after the settled descent is "
+      "final (no whole descent)", "femadh/contact/landing.py",
+      (("if not trapped and not (st.converged and st.stable):", "if False:"),)),
     # -- a newcomer's second trial: the instrument's whole-sphere pull-off, the meniscus lines
     D("newcomer_pull_off_no_tail", "instrument: the pull-off at the peak without the tail "
       "beyond the analysis radius (the disk's max adhesion)", "femadh/runner/instrument.py",

@@ -1,13 +1,24 @@
 """Continuation in the separation d: approach and retract branches, fold detection and jumps.
 
 Each grid step is taken with a predictor (the tangent dw/dd of the last state, its active set
-frozen) and the semismooth Newton corrector. A step is accepted only if the corrector
-converges to a *stable* state close to the prediction; otherwise the step is halved. When even
-the smallest step fails, the branch has folded (the stable equilibrium ceased to exist: jump-in
-on approach, jump-out on retract). The fold is reported at the last stable d, and the surface
-is then landed on the other branch by descending the total energy from the last state
-(Levenberg-Marquardt with the gap bound h >= sigma), which is where a quasi-static surface would
-snap to, and polished by Newton.
+frozen; computed once per state) and the semismooth Newton corrector. A step is accepted only
+if the corrector converges to a *stable* state close to the prediction. A step turned down
+because its stable state lies farther from the prediction than the corrector may go, with no
+energy lost beyond one branch's bound (most likely the same branch: the predictor's reach), is
+halved. Any other turned-down step
+brackets a fold between the last accepted d and itself (:class:`_Bracket`): no trial goes past
+it again, and the fold is searched inside by a secant on the indicator 1/G'^2 (zero at a
+saddle-node fold), safeguarded by bisection and capped, on the lattice of resolution steps
+(MIN_STEP_FRACTION of the grid step) that the plain halving visited - so the fold is the one
+the halving found, in fewer solves. When the decision solve (the whole corrector budget) one
+resolution step past the last accepted state fails, the branch has folded (the stable
+equilibrium ceased to exist: jump-in on approach, jump-out on retract). The fold is reported
+at the last stable d, and the surface is then landed on the other branch by descending the
+total energy from the last state (Levenberg-Marquardt with the gap bound h >= sigma), which is
+where a quasi-static surface would snap to, and polished by Newton. The plain halving (step
+halved on any rejection, doubled on acceptance) is kept on lattice-trapped grids, where the
+states reached depend on the path, and is the fallback of a grid step whose landing does not
+polish.
 
 A corrector can also converge to a stable state of the *other* branch across a fold that lies
 inside the step (a small jump-in, whose gap change stays within MAX_CORRECTION_FRACTION). Such a
@@ -38,7 +49,8 @@ from .landing import land
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
 #: solves allowed between two requested separations before the branch counts as stalled
-#: (a fold needs ~log2(1/MIN_STEP_FRACTION) = 10 halvings; healthy steps need a handful)
+#: (a fold needs at most ~2 log2(1/MIN_STEP_FRACTION) = 20 bracketed trials, measured 4-8 on
+#: a jump-in; healthy steps need a handful)
 MAX_SOLVES_PER_STEP = 200
 #: folds in a row, each within CRAWL_STEPS smallest steps of the last landing, beyond which the
 #: branch counts as stalled (folds further apart are a contact unzipping node by node)
@@ -178,7 +190,124 @@ def lattice_snap(problem, old, landed, g_old, g_landed):
     return bool(released <= FOLD_ENERGY_SHARE_MIN_STEP * work + noise)
 
 
-def _predict(problem, state, d):
+#: trials inside a fold's bracket allowed to follow the fold indicator before every further
+#: trial bisects (the cap that makes a fold cost at most ~2 log2(1/MIN_STEP_FRACTION) solves)
+MAX_INDICATOR_TRIALS = 12
+#: an indicator trial must have at least halved the bracket over the last two trials, else the
+#: next one bisects (the safeguard of a regula falsi that keeps landing on one side)
+MIN_SHRINK_PER_TWO = 0.5
+#: False: the plain halving everywhere (the path the bracketed search replaced; the tests'
+#: reference for where the folds are)
+BRACKETED = True
+
+
+class _Bracket:
+    """A fold bracketed between the current state's d and the nearest turned-down separation.
+
+    Once a continuation step is turned down at ``far`` (no stable state of the branch close
+    to the prediction, or one across a fold) the fold lies between the last accepted d and
+    ``far`` - or ``far`` was only too far for the predictor, which the next trials find out.
+    No trial goes beyond ``far`` again while it stands. Each trial inside the bracket aims
+    half a resolution step short of the fold's estimate from the indicator (below); once the
+    last accepted state lies within a resolution step of the estimate it probes one
+    resolution step past it - the decision solve (full corrector budget) that locates the
+    fold when it is turned down. Without an estimate, after MAX_INDICATOR_TRIALS, or when
+    the bracket has not halved over the last two trials (MIN_SHRINK_PER_TWO), a trial
+    bisects. The fold is located when the decision solve from the current state turns down
+    ``far`` at most one resolution step away (MIN_STEP_FRACTION of the grid step: the
+    resolution of the halving this replaced, never coarser).
+
+    The indicator: near a saddle-node fold at d* the branch's total force G(d) goes as
+    G* - c sqrt(|d* - d|), so its tangent G' = sum S dw/dd (N/m) diverges as |d* - d|^-1/2
+    and q = 1/G'^2 falls linearly to zero at d*. The two last accepted states give the
+    secant estimate d* = d2 + q2 (d2 - d1) / (q1 - q2), used when q falls toward the
+    bracket and the estimate lies inside it. (A fold of a contact set - a node released or
+    added - has no such divergence: q then does not fall, and the bracket is bisected.)
+    """
+
+    def __init__(self, grid_step, min_step):
+        self.dir = math.copysign(1.0, grid_step)
+        self.min_step = min_step
+        self.points = []        # (d, q) of the accepted states since the last landing
+        self.clear()
+
+    def clear(self):
+        """No bracket (a landing, or a far end that turned out to be no fold)."""
+        self.far, self.decided = None, False
+        self.widths, self.trials = [], 0
+
+    def restart(self, state, t, problem):
+        """A new branch piece from ``state`` (a landing): its indicator starts afresh."""
+        self.points = []
+        self.clear()
+        self.see(state, t, problem)
+
+    def see(self, state, t, problem):
+        """An accepted state and its tangent t = dw/dd (or None)."""
+        self.decided = False
+        gp = float(np.sum(problem.S_sym @ t)) if t is not None else 0.0
+        q = 1.0 / (gp * gp) if gp != 0.0 and math.isfinite(gp) else math.inf
+        self.points = (self.points + [(state.d, q)])[-2:]
+
+    def reject(self, d, decided):
+        """The trial at d was turned down; ``decided``: by a decision solve (whole budget)."""
+        self.far, self.decided = d, decided
+
+    def width(self, state):
+        return (self.far - state.d) * self.dir
+
+    def located(self, state):
+        return self.far is not None and self.decided and self.steps(state) <= 1
+
+    def steps(self, state):
+        """The bracket's width in resolution steps (a whole number: its ends are lattice
+        points, up to the round-off of d, which can be 1e-8 of a step)."""
+        return int(round(self.width(state) / self.min_step))
+
+    def estimate(self):
+        """The indicator's estimate of the fold's d (m), or None."""
+        if len(self.points) < 2:
+            return None
+        (d1, q1), (d2, q2) = self.points
+        if not (math.isfinite(q1) and math.isfinite(q2)) or (d2 - d1) * self.dir <= 0 \
+                or not q2 < q1:
+            return None
+        return d2 + q2 * (d2 - d1) / (q1 - q2)
+
+    def trial(self, state, work):
+        """The next separation to try inside the bracket (m); counts the bisections (the
+        fallback) in ``work["fold_bisections"]``.
+
+        Every trial is the current d plus a whole number of resolution steps, so that the
+        trials (and the fold) lie on the lattice of the halving this replaced: the fold is
+        the last point of that lattice the branch reaches, whichever trials found it."""
+        a, h = state.d, self.min_step
+        n = self.steps(state)
+        if n <= 1:
+            return self.far                         # the decision solve
+        est = None
+        stuck = len(self.widths) >= 2 and n > MIN_SHRINK_PER_TWO * self.widths[-2]
+        if self.trials < MAX_INDICATOR_TRIALS and not stuck:
+            est = self.estimate()
+        self.widths.append(n)
+        self.trials += 1
+        if est is not None and 0 < (est - a) * self.dir < n * h:
+            # half a resolution step short of the estimate; at it: one step past (a decision)
+            k = max(1, int(round((est - a) * self.dir / h - 0.5)))
+            return a + self.dir * min(k, n - 1) * h
+        work["fold_bisections"] = work.get("fold_bisections", 0) + 1
+        return a + self.dir * (n // 2) * h
+
+
+def _tangent(problem, state, sweep):
+    """dw/dd (m/m) of ``state`` with its active set frozen, or None without a factorisation
+    (the predictor then takes the state itself); computed once per state, not per trial."""
+    if state.lu is None:
+        return None
+    return tangent(problem, state)
+
+
+def _predict(problem, state, d, t=None):
     """Predicted displacements at d (tangent of the last state) and the active set they imply.
 
     (A release of the contact ring predicted from the tangent of the contact pressure,
@@ -186,8 +315,10 @@ def _predict(problem, state, d):
     retract, but near the pull-off its decision solve at the smallest step missed a stable
     state the gap-only prediction finds, and moved the fold by one resolution step; the
     fold's decision must not depend on the predictor, so the set only grows here.)"""
-    if state.lu is not None:
-        w = state.w + tangent(problem, state) * (d - state.d)
+    if t is None and state.lu is not None:
+        t = tangent(problem, state)
+    if t is not None:
+        w = state.w + t * (d - state.d)
     else:
         w = state.w.copy()
     if problem.sigma is None:
@@ -264,12 +395,19 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # a law that softens beyond a node's stiffness somewhere the surfaces can reach: nodes
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
+    t_state = _tangent(problem, state, sweep)
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
         min_step = abs(grid_step) * MIN_STEP_FRACTION
         solves_here, jumps_here, crawl_run = 0, 0, 0
         beyond = None       # a stable state past a fold that the energy check turned down
+        fold = _Bracket(grid_step, min_step)
+        fold.see(state, t_state, problem)
+        # the plain halving (no bracket): on a lattice-trapped grid, and as the fallback of a
+        # grid step whose bracketed fold's landing did not polish (restarted from its start)
+        halving = trapped or not BRACKETED
+        start_here = (state, g_state, t_state)
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
             # edge) brings its own budget; a crawl is cut by crawl_run below
@@ -289,38 +427,89 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 exc.sweep = sweep
                 raise exc
             solves_here += 1
-            d_try = state.d + step
-            if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
-                    abs(d_next - d_try) < 0.5 * min_step:
-                d_try = d_next
+            if fold.far is None or halving:
+                d_try = state.d + step
+                if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
+                        abs(d_next - d_try) < 0.5 * min_step:
+                    d_try = d_next
+            elif fold.located(state):
+                # the fold is bracketed to the resolution and the far end was turned down by
+                # a decision solve from this very state: no stable state continues the branch
+                d_try = fold.far
+            else:
+                d_try = fold.trial(state, sweep.work)
+                if abs(d_try - state.d) > abs(step):
+                    # the predictor reaches only this far (a step turned down above for the
+                    # corrector's distance from it, not for a fold)
+                    d_try = state.d + step
             sweep.d_current = d_try
-            w_pred, act = _predict(problem, state, d_try)
+            w_pred, act = _predict(problem, state, d_try, t_state)
             # the smallest step decides a fold: its corrector gets the whole budget; a larger
             # step that stagnates is only halved - unless a node softens beyond its own
             # stiffness (it snaps on its own: a slow corrector there is the lattice, and a
             # different path of halvings lands on other lattice states)
-            smallest = abs(step) <= min_step * 1.5
-            stall = None if smallest or trapped else STALL_ITER
-            new = solve_complementarity(problem, d_try, w_pred, tol=tol, max_iter=max_iter,
-                                        active0=act, factor=state.lu, stall_iter=stall,
-                                        stats=sweep.work)
-            sweep.n_solves += 1
-            if _accept(new, w_pred, d_try):
+            smallest = abs(d_try - state.d) <= min_step * 1.5
+            if fold.far is not None and fold.located(state):
+                new = None          # decided already: straight to the landing
+            else:
+                stall = None if smallest or trapped else STALL_ITER
+                new = solve_complementarity(problem, d_try, w_pred, tol=tol,
+                                            max_iter=max_iter, active0=act, factor=state.lu,
+                                            stall_iter=stall, stats=sweep.work)
+                sweep.n_solves += 1
+                if fold.far is not None:
+                    sweep.work["fold_solves"] = sweep.work.get("fold_solves", 0) + 1
+            accepted, why = False, None
+            if new is not None and _accept(new, w_pred, d_try):
                 g_new = total_force(problem, new)
-                share = (FOLD_ENERGY_SHARE_MIN_STEP if abs(step) <= min_step * 1.5
-                         else FOLD_ENERGY_SHARE)
+                share = FOLD_ENERGY_SHARE_MIN_STEP if smallest else FOLD_ENERGY_SHARE
                 accepted = not crossed_fold(problem, state, new, g_state, g_new, share)
                 if not accepted:
-                    beyond = new
-            else:
-                accepted = False
+                    beyond, why = new, "rejected_energy"
+            elif new is not None:
+                why = ("rejected_correction" if new.converged and new.stable
+                       else "rejected_unconverged")
+                if why == "rejected_correction" and not crossed_fold(
+                        problem, state, new, g_state, total_force(problem, new)):
+                    # a stable state that released no more energy than one branch can: most
+                    # likely the same branch, farther from the prediction than the corrector
+                    # may go (the predictor's frozen contact set): halved, no bracket. Only
+                    # the search's path hangs on this, never an acceptance: a step across a
+                    # fold can pass the energy test too (measured: Fig 4's jump-in, 1.2 ->
+                    # 1.1 nm on 632 nodes, converges in contact within the bound), and the
+                    # halved trials bracket that fold at their next turned-down step
+                    why = "rejected_predictor"
+            if why:
+                sweep.work[why] = sweep.work.get(why, 0) + 1
             if accepted:
+                last = abs(step if halving else d_try - state.d)
                 state, g_state = new, g_new
-                step = math.copysign(min(abs(2 * step), abs(grid_step)), grid_step)
+                t_state = _tangent(problem, state, sweep)
+                fold.see(state, t_state, problem)
+                step = math.copysign(min(2 * last, abs(grid_step)), grid_step)
+                if fold.far is not None and state.d == fold.far:
+                    # the far end was no fold (a predictor too far from the branch): on with
+                    # the whole step
+                    fold.clear()
+                    step = grid_step
                 continue
-            if abs(step) > min_step * 1.5:
-                step *= 0.5
-                continue
+            if halving:
+                # a lattice-trapped grid (nodes snap on their own): the states reached depend
+                # on the path of the steps, and the plain halving's path is kept - no bracket
+                if abs(step) > min_step * 1.5:
+                    step *= 0.5
+                    continue
+            else:
+                k = int(round(abs(d_try - state.d) / min_step))
+                if why == "rejected_predictor" and k > 1:
+                    # half the distance, in whole resolution steps (the trials' lattice)
+                    step = math.copysign(max(1, k // 2) * min_step, grid_step)
+                    continue
+                if new is not None:
+                    fold.reject(d_try, decided=smallest)
+                    if not fold.located(state):
+                        continue
+                d_try = fold.far
             # Fold: no stable state continues the branch beyond state.d.
             landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
             sweep.n_solves += 1
@@ -331,11 +520,27 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                                                max_iter=max_iter, active0=beyond.active)
                 sweep.n_solves += 1
                 beyond = None
+            if not (landed.converged and landed.stable) and not halving and jumps_here == 0:
+                # the fallback: the landing from this fold did not polish (a near-trapped grid
+                # where the states reached depend on the path): the grid step once more from
+                # its start by plain halving, the path this search replaced (nothing of the
+                # step was passed on yet: no jump, no state)
+                sweep.work["fold_fallbacks"] = sweep.work.get("fold_fallbacks", 0) + 1
+                halving, beyond = True, None
+                state, g_state, t_state = start_here
+                fold.restart(state, t_state, problem)
+                step = grid_step
+                continue
             _check(landed, f"landing after the fold at d = {state.d * 1e9:.6g} nm", tol, sweep)
             g_landed = total_force(problem, landed)
+            fold.clear()
+            if not halving:
+                step = math.copysign(min_step, grid_step)
             if lattice_snap(problem, state, landed, g_state, g_landed):
                 sweep.work["lattice_snaps"] = sweep.work.get("lattice_snaps", 0) + 1
                 state, g_state, beyond = landed, g_landed, None
+                t_state = _tangent(problem, state, sweep)
+                fold.restart(state, t_state, problem)
                 continue
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
             if on_jump:
@@ -349,6 +554,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
                 solves_here = MAX_SOLVES_PER_STEP * (1 + jumps_here)
             state, g_state = landed, g_landed
+            t_state = _tangent(problem, state, sweep)
+            fold.restart(state, t_state, problem)
         sweep.states.append(state)
         if on_state:
             on_state(state)
