@@ -37,6 +37,7 @@ import numpy as np
 from scipy import optimize
 
 from ..contact.forces import tail_force
+from .members import reduced_member
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError,  # noqa: F401
                                TrappingError, check_state, outside_bounds)
@@ -50,6 +51,10 @@ FE_ORDER = 3
 MAX_NODES = 3200
 #: refinements accuracy mode may make
 MAX_REFINEMENTS = 5
+#: the coarser members solve only the states the headline numbers are read at, from the fine
+#: run's (femadh.runner.members); False traces every member whole (the reference the reduced
+#: members are tested against)
+REDUCED_MEMBERS = True
 
 
 def tolerance_force(problem, state, tol):
@@ -229,16 +234,27 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 "estimated: the stated errors lack it")
     levels = []
     ratio, members = coarser_members(scene, problem, green)
+    solved = []
     for i, (label, member) in enumerate(members):
         with _phase(f"estimate: {label}"):
+            # the member solved only where the headline numbers are read, from the fine
+            # run's states (femadh.runner.members); traced whole where it cannot stand in
+            hl_m, how = (reduced_member(scene, member, problem, sink, res) if REDUCED_MEMBERS
+                         else (None, "reduced members off"))
+            if hl_m is not None:
+                levels.append(hl_m)
+                solved.append({"member": label, "reduced": True, "solves": how})
+                continue
             r = run(member, progress=False, estimate="peak")
         _stop_if_stopped(r)
+        solved.append({"member": label, "reduced": False, "why": how})
         if r.status != "converged":
             res.warnings.append(member_note(label, r.error, _fine_label(scene, problem),
                                             [lb for lb, _ in members[:i]]))
             res.grid["failed_member"] = {"member": label, "error": r.error}
             break
         levels.append(dict(r.headline))
+    res.grid["member_solves"] = solved
     res.grid["member_ratio"] = ratio
     res.grid["members"] = [lb for lb, _ in members][:len(levels)]
     if scene.grid is not None:
