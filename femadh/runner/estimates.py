@@ -83,17 +83,22 @@ def state_between(problem, a, b, d, scene):
     return st
 
 
-def peak_adhesion(problem, prev, best, nxt, scene):
+def peak_adhesion(problem, prev, best, nxt, scene, within=None):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). The states may be
     :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
-    hold them. Returns (F, d, half-width of the final d bracket)."""
+    hold them. ``within`` = (lo, hi) narrows the search to that part of the bracket (an
+    estimate's member near the fine run's peak: fewer fresh states, the same absolute
+    tolerance in d). Returns (F, d, half-width of the final d bracket)."""
     from ..contact.forces import state_forces
 
     f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
+    xatol = 1e-4 * (hi - lo)
+    if within is not None:
+        lo, hi = max(lo, within[0]), min(hi, within[1])
     found = {}
 
     def neg(d):
@@ -103,7 +108,6 @@ def peak_adhesion(problem, prev, best, nxt, scene):
             return -f_best
         found[d] = state_forces(problem, st)[2]
         return -found[d]
-    xatol = 1e-4 * (hi - lo)
     optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
                              options={"xatol": xatol, "maxiter": 40})
     F, d = max([(f_best, best.d)] + [(v, x) for x, v in found.items()])

@@ -28,8 +28,18 @@ import math
 
 import numpy as np
 
+from ..contact.stepping import MIN_STEP_FRACTION
+
 #: grid states the member may walk past the fine run's peak looking for its own grid maximum
 PEAK_WALK = 3
+#: half-width of a member's peak search around the fine run's peak, in grid steps (the Fig 3
+#: and Fig 4 members' peaks lie within 0.02 grid steps of the fine run's)
+PEAK_WINDOW = 0.125
+#: a member's fold is searched on the fine run's lattice from the fine run's fold states
+#: (False: the fine run's grid step that holds it is traced, halvings and all)
+BRACKETED_FOLDS = True
+#: corrector solves a member's fold search may take (a healthy one: 10-20)
+MAX_FOLD_SOLVES = 80
 
 
 class _NotReduced(Exception):
@@ -90,13 +100,38 @@ class _Member:
         self.cache[key] = st
         return st
 
+    def near(self, snap, d, branch=True):
+        """The member's stable equilibrium at separation d by Newton from the fine run's state
+        ``snap`` (at a nearby separation) carried to the member's grid, or None where Newton
+        does not end on a stable state (or, with ``branch``, ends further than a quarter of a
+        gap from the start: another branch)."""
+        from ..contact import solve_state
+        from ..discretisation.moving import interpolate_state
+
+        w0, active0 = interpolate_state(self.fine, self.problem, d, snap.w)
+        kw = {} if active0 is None else {"active0": active0}
+        st = solve_state(self.problem, d, w0, tol=self.scene.tolerance,
+                         max_iter=self.scene.max_iter, **kw)
+        self.solves += 1
+        if not (st.converged and st.stable):
+            return None
+        if branch and np.any(np.abs(st.w - w0) > 0.25 * np.maximum(
+                self.problem.contour(d) - w0, 0) + 1e-15):
+            return None
+        return st
+
+    def released(self, before, after, d_land):
+        """Energy (J) a snap from ``before`` to ``after`` releases at the landing's d."""
+        return float(self.problem.energy(before.w, d_land)
+                     - self.problem.energy(after.w, d_land))
+
     def f_ex(self, st):
         from ..contact.forces import state_forces
 
         return state_forces(self.problem, st)[2]
 
 
-def _peak(m, sink, snaps):
+def _peak(m, sink, snaps, d_fine=None):
     """(F, d) of the member's largest adhesion: its grid maximum near the fine run's, then
     the bounded search between the grid states around it."""
     from .estimates import peak_adhesion
@@ -120,8 +155,17 @@ def _peak(m, sink, snaps):
     if prev is None or nxt is None or k == 0 or k == n - 1:
         # the fine run's peak is at a branch end (no bracket): the grid value, as there
         return float(m.f_ex(st)), float(st.d)
-    F, d, _ = peak_adhesion(m.problem, m.state(branch, states, k - 1), st,
-                            m.state(branch, states, k + 1), m.scene)
+    around = (m.state(branch, states, k - 1), st, m.state(branch, states, k + 1))
+    if k == i and d_fine is not None:
+        # the member's peak lies within its grid difference of the fine run's: the search
+        # on PEAK_WINDOW of the grid step around it (the same tolerance in d), the whole
+        # bracket where the member's optimum ends at the window's edge
+        half = PEAK_WINDOW * abs(states[i + 1].d - states[i].d)
+        F, d, tol = peak_adhesion(m.problem, *around, m.scene,
+                                  within=(d_fine - half, d_fine + half))
+        if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:
+            return F, d
+    F, d, _ = peak_adhesion(m.problem, *around, m.scene)
     return F, d
 
 
@@ -142,30 +186,121 @@ def _fold_steps(res, snaps):
     return out
 
 
-def _folds(m, res, snaps):
-    """The member's folds in the grid steps of the fine run's, in the same order: a list of
-    (branch, d_fold, energy released)."""
+def _step_folds(m, branch, states, k, count):
+    """The member's folds in the fine run's grid step k -> k+1 of ``branch``, traced from
+    the member's state at its start (the halvings of a whole trace): [(d_fold, released)]."""
     from ..contact import trace
     from ..errors import ConvergenceError
 
+    start = m.state(branch, states, k)
+    try:
+        sw = trace(m.problem, [states[k].d, states[k + 1].d], branch=branch,
+                   tol=m.scene.tolerance, start=start, max_iter=m.scene.max_iter)
+    except ConvergenceError as exc:
+        raise _NotReduced(f"the fold's step did not trace ({exc})") from None
+    m.solves += sw.n_solves
+    if len(sw.jumps) != count:
+        raise _NotReduced(f"{len(sw.jumps)} folds in the member's step at d = "
+                          f"{states[k].d * 1e9:.6g} nm, {count} in the fine run's")
+    return [(j.d_fold, m.released(j.before, j.after, j.d_land)) for j in sw.jumps]
+
+
+def _lattice_fold(m, d_fold, d_land, before, after):
+    """(d_fold, released) of the member's fold on the fine run's lattice d_fold + j r
+    (r = d_land - d_fold, the fine run's smallest step: the stepping's own lattice in that
+    grid step), continued from near the fine run's fold instead of halving the grid step
+    down to it.
+
+    The start: Newton from the fine run's last state before its fold (``before``), carried
+    to the member's grid, at j = -1, -2, -4, ... until it ends on a stable state within a
+    quarter of every gap of the start (near a fold Newton's basin is narrow: the Fig 4
+    scene's members reach it 18-31 lattice steps back). From there the stepping's rules on
+    the lattice: a tangent predictor, the corrector, a step accepted if it converged to a
+    stable state within MAX_CORRECTION_FRACTION of the predicted gaps and released no more
+    energy than one branch can (:func:`~femadh.contact.stepping.crossed_fold`), doubled after
+    an acceptance and halved after a rejection; the fold is where a one-step move fails. The
+    landing one step beyond: the energy descent from the last state
+    (:func:`~femadh.contact.landing.land`), Newton from the fine run's landing where that
+    stalls; a landing that releases no more than the step's work is a node snapping across
+    the lattice and is stepped over (:func:`~femadh.contact.stepping.lattice_snap`), as in a
+    whole trace."""
+    from ..contact.complementarity import STALL_ITER, solve_complementarity, tangent
+    from ..contact.landing import land
+    from ..contact.stepping import (FOLD_ENERGY_SHARE, FOLD_ENERGY_SHARE_MIN_STEP,
+                                    MAX_CORRECTION_FRACTION, crossed_fold, lattice_snap,
+                                    total_force)
+
+    p, sc = m.problem, m.scene
+    r = d_land - d_fold
+    cap = int(round(1.0 / MIN_STEP_FRACTION))
+    j, state = -1, None
+    while state is None:
+        if -j > cap:
+            raise _NotReduced("no member state near the fine run's fold")
+        state = m.near(before, d_fold + j * r)
+        j = j if state is not None else 2 * j
+    g, step, solves = total_force(p, state), 1, 0
+    while True:
+        if solves > MAX_FOLD_SOLVES or j > cap:
+            raise _NotReduced("the member's fold is not within a grid step of the fine run's")
+        d = d_fold + (j + step) * r
+        w = state.w + tangent(p, state) * (d - state.d) if state.lu is not None else state.w
+        act = None if p.sigma is None else state.active | (p.contour(d) - w < p.sigma)
+        kw = {} if act is None else {"active0": act}
+        new = solve_complementarity(p, d, w, tol=sc.tolerance, max_iter=sc.max_iter,
+                                    factor=state.lu, stall_iter=None if step == 1 else STALL_ITER,
+                                    **kw)
+        solves += 1
+        ok = new.converged and new.stable and bool(np.all(
+            np.abs(new.w - w) <= MAX_CORRECTION_FRACTION * np.maximum(new.h + (new.w - w), 0)
+            + 1e-15))
+        if ok:
+            g_new = total_force(p, new)
+            ok = not crossed_fold(p, state, new, g, g_new, FOLD_ENERGY_SHARE_MIN_STEP
+                                  if step == 1 else FOLD_ENERGY_SHARE)
+        if ok:
+            state, g, j, step = new, g_new, j + step, 2 * step
+            continue
+        if step > 1:
+            step //= 2
+            continue
+        landed = land(p, d, state.w, tol=sc.tolerance, max_iter=sc.max_iter)
+        solves += 1
+        if not (landed.converged and landed.stable):
+            landed = m.near(after, d, branch=False)
+        if landed is None or not (landed.converged and landed.stable):
+            raise _NotReduced(f"the landing after the member's fold at d = "
+                              f"{state.d * 1e9:.6g} nm did not converge")
+        g_landed = total_force(p, landed)
+        if lattice_snap(p, state, landed, g, g_landed):
+            # a node snapping across the lattice: the branch goes on (as in a whole trace)
+            state, g, j, step = landed, g_landed, j + 1, 1
+            continue
+        m.solves += solves
+        return state.d, m.released(state, landed, d)
+
+
+def _folds(m, res, sink, snaps):
+    """The member's folds where the fine run's are, in the same order: a list of
+    (branch, d_fold, energy released). Each by :func:`_lattice_fold` from the fine run's
+    fold states, or - where that finds none - by tracing the fine run's grid step that holds
+    it (:func:`_step_folds`)."""
     out = []
+    fine = {(b, d): (before, after) for b, d, _, before, after in getattr(sink, "folds", [])}
     for (branch, k), fine_jumps in sorted(_fold_steps(res, snaps).items(),
                                           key=lambda kv: (kv[0][0] != "approach", kv[0][1])):
         states = snaps[branch]
-        start = m.state(branch, states, k)
         try:
-            sw = trace(m.problem, [states[k].d, states[k + 1].d], branch=branch,
-                       tol=m.scene.tolerance, start=start, max_iter=m.scene.max_iter)
-        except ConvergenceError as exc:
-            raise _NotReduced(f"the fold's step did not trace ({exc})") from None
-        m.solves += sw.n_solves
-        if len(sw.jumps) != len(fine_jumps):
-            raise _NotReduced(f"{len(sw.jumps)} folds in the member's step at d = "
-                              f"{states[k].d * 1e9:.6g} nm, {len(fine_jumps)} in the fine run's")
-        for jump in sw.jumps:
-            released = float(m.problem.energy(jump.before.w, jump.d_land)
-                             - m.problem.energy(jump.after.w, jump.d_land))
-            out.append((branch, jump.d_fold, released))
+            if BRACKETED_FOLDS and all((branch, j["d_fold_m"]) in fine for j in fine_jumps):
+                got = [_lattice_fold(m, j["d_fold_m"], j["d_land_m"],
+                                       *fine[(branch, j["d_fold_m"])]) for j in fine_jumps]
+            else:
+                got = None
+        except _NotReduced:
+            got = None
+        if got is None:
+            got = _step_folds(m, branch, states, k, len(fine_jumps))
+        out += [(branch, d, e) for d, e in got]
     return out
 
 
@@ -229,9 +364,10 @@ def reduced_member(scene, member, problem, sink, res):
             hl.update(d_deepest_m=float(st.d), F_LJ_deepest_N=float(f_lj),
                       F_ex_deepest_N=float(f_ex))
         if "max_adhesion_N" in fine and sink.peak is not None:
-            hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = _peak(m, sink, snaps)
+            hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = _peak(
+                m, sink, snaps, fine.get("d_at_max_adhesion_m"))
         if res.jumps:
-            folds = _folds(m, res, snaps)
+            folds = _folds(m, res, sink, snaps)
             ins = [d for b, d, _ in folds if b == "approach"]
             outs = [d for b, d, _ in folds if b == "retract"]
             if ins:
