@@ -37,7 +37,7 @@ import numpy as np
 from scipy import optimize
 
 from ..contact.forces import tail_force
-from .members import reduced_member
+from .members import deepest_locked, reduced_member
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError,  # noqa: F401
                                TrappingError, check_state, outside_bounds)
@@ -225,10 +225,12 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                 g = run(other, progress=False, estimate="peak")
         _stop_if_stopped(g)
         if g is not None and g.status == "converged":
-            for k, v in g.headline.items():
-                if isinstance(v, float) and isinstance(hl.get(k), float):
-                    parts.setdefault(k, {})["fe_mesh"] = (
-                        (hl[k] - v) / (ratio**FE_ORDER - 1) if layered else v - hl[k])
+            # layered: Richardson at the P2 body's order over the meshes' size ratio (the
+            # error machinery's one Richardson); else the exact Green function's difference
+            mesh = (discretisation(hl, g.headline, ratio=ratio, order=FE_ORDER) if layered
+                    else fe_against_green(hl, g.headline))
+            for k, v in mesh.items():
+                parts.setdefault(k, {})["fe_mesh"] = v
             if not layered:
                 fine_hl = dict(g.headline)       # the grid part: the Green function's in N
         elif g is not None:
@@ -267,6 +269,17 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
                                    ratio=ratio).items():
             parts.setdefault(k, {})["grid"] = v
+    # the forces at the deepest separation: members placed by its contact edge (the same
+    # fraction of a spacing as the fine grid's), where they can be
+    locked = deepest_locked(scene, problem, sink, ratio, variant) if REDUCED_MEMBERS and \
+        levels else None
+    if locked is not None:
+        (h1, h2), (lv1, lv2) = locked
+        h0 = float(problem.grid.nodes[1])
+        for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
+                                   ratio=h1 / h0, ratio2=h2 / h1).items():
+            parts.setdefault(k, {})["grid"] = v
+        res.grid["deepest_member_spacings_m"] = [h1, h2]
     # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
         js = [j for j in res.jumps if j["branch"] == branch]
@@ -295,6 +308,17 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         comp["total"] = float(sum(abs(v) for v in comp.values()))
         hl[f"{k}_error"] = comp["total"]
     return parts
+
+
+def fe_against_green(fe, green):
+    """{name: Q_Green - Q_FE}: the FE body's error of each number where the exact Green
+    function on the same nodes gives the body without its mesh (finite floats only)."""
+    return {k: green[k] - v for k, v in fe.items()
+            if _finite(v) and _finite(green.get(k))}
+
+
+def _finite(x):
+    return isinstance(x, float) and math.isfinite(x)
 
 
 def _stop_if_stopped(member):

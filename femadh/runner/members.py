@@ -58,7 +58,14 @@ def eligible(scene, problem, sink):
         return "the Hertz closure"
     if getattr(scene, "instrument", None) is not None:
         return "an instrument"
-    if (getattr(scene, "grid", None) or {}).get("follow"):
+    if getattr(scene, "grid", None) is None:
+        # an explicit uniform grid's members (N/2, N/4) may resolve the contact so coarsely
+        # that their branches differ from the fine one's - the Fig 8 scene's N = 100 and 50
+        # members unzip in 3 and 4 folds where N = 200 has one, and a member state solved
+        # from the fine run's misses the folds the fine run does not have; the banded
+        # families femadh plans keep their members below the trapping limit
+        return "a uniform grid (its members are traced whole)"
+    if scene.grid.get("follow"):
         return "a band following the edge"
     committed = getattr(sink, "committed", None) or {}
     for branch, rows in sink.rows.items():
@@ -119,6 +126,12 @@ class _Member:
                 self.problem.contour(d) - w0, 0) + 1e-15):
             return None
         return st
+
+    def carried(self, snap, d):
+        """The fine run's displacements of ``snap`` on the member's grid at separation d."""
+        from ..discretisation.moving import interpolate_state
+
+        return interpolate_state(self.fine, self.problem, d, snap.w)[0]
 
     def released(self, before, after, d_land):
         """Energy (J) a snap from ``before`` to ``after`` releases at the landing's d."""
@@ -276,6 +289,13 @@ def _lattice_fold(m, d_fold, d_land, before, after):
             # a node snapping across the lattice: the branch goes on (as in a whole trace)
             state, g, j, step = landed, g_landed, j + 1, 1
             continue
+        # the member must land where the fine run did (on the branch of its landing, within
+        # a quarter of every gap): a member that lands elsewhere - a contact unzipping in
+        # several folds on a coarse grid - is not the fine run's picture and is traced whole
+        w0 = m.carried(after, d)
+        if np.any(np.abs(landed.w - w0) > 0.25 * np.maximum(p.contour(d) - w0, 0) + 1e-15):
+            raise _NotReduced(f"the member lands elsewhere than the fine run after its fold at "
+                              f"d = {state.d * 1e9:.6g} nm")
         m.solves += solves
         return state.d, m.released(state, landed, d)
 
@@ -383,3 +403,85 @@ def reduced_member(scene, member, problem, sink, res):
     except (_NotReduced, FemadhError) as exc:
         return None, str(exc)
     return hl, m.solves
+
+
+#: fewest band spacings between the centre and the contact edge of a member placed by the
+#: edge (coarser members are pre-asymptotic: the Fig 3 scene's F_LJ at the deepest state is
+#: 7e-3 off at 15 spacings, 1.3e-3 at 21)
+MIN_EDGE_SPACINGS = 12
+
+
+def contact_edge(problem, snap):
+    """Radius (m) of the contact edge of a sigma-gap state between its grid nodes: the gap
+    opens beyond the edge like (r - r_e)^(3/2) (an adhesive edge without a stress
+    singularity), so the gaps above sigma at the first two free nodes place it; None
+    without a contact or where they do not bracket it (the outermost contact node and the
+    next)."""
+    if problem.sigma is None or snap.active is None or not np.any(snap.active):
+        return None
+    r = problem.grid.nodes
+    a = int(np.flatnonzero(snap.active)[-1])
+    if a + 2 >= r.size:
+        return None
+    gap = problem.contour(snap.d) - snap.w - problem.sigma
+    g1, g2 = float(gap[a + 1]), float(gap[a + 2])
+    if not (0 < g1 < g2):
+        return None
+    q = (g2 / g1) ** (2.0 / 3.0)
+    r_e = (r[a + 2] - q * r[a + 1]) / (1.0 - q)
+    return float(min(max(r_e, r[a]), r[a + 1]))
+
+
+def locked_spacings(problem, r_e, band, ratio, count=2):
+    """Band spacings h_k ~ ratio^k h (k = 1..count) of members whose lattice puts the edge
+    at radius ``r_e`` at the same fraction of a spacing as the fine grid's (h_k = r_e /
+    (n_k + f), r_e / h = n + f): the discretisation error of a number read at that edge
+    changes sign as the edge crosses a node (the Fig 3 scene's F_LJ at the deepest state:
+    +1.3e-3, -2.1e-4, +6.7e-4 on members at 170, 120, 85 nm), and is smooth, of order ~2,
+    among members at one fraction (-1.6e-3, -8.9e-4, -4.7e-4 at 153, 110, 78.5 nm): the
+    members' differences then measure the fine grid's own error. None where the edge is not
+    inside the band's uniform part, or a member would have fewer than MIN_EDGE_SPACINGS
+    spacings to it."""
+    h = float(problem.grid.nodes[1])
+    if r_e is None or band is None or r_e + 2 * ratio**count * h > band:
+        return None
+    x = r_e / h
+    f = x - math.floor(x)
+    out = []
+    for k in range(1, count + 1):
+        n_k = round(x / ratio**k - f)
+        if n_k < MIN_EDGE_SPACINGS:
+            return None
+        out.append(r_e / (n_k + f))
+    return out
+
+
+def deepest_locked(scene, problem, sink, ratio, variant):
+    """(spacings, [member headlines]) of the members placed by the contact edge of the
+    deepest state (:func:`locked_spacings`), each solved at the deepest separation only, by
+    Newton from the fine run's state there; None where they cannot be placed or solved
+    (the family's own members stand)."""
+    from ..contact.forces import state_forces
+    from ..errors import FemadhError
+    from ..scene import build_problem
+
+    g = getattr(scene, "grid", None)
+    if g is None or g.get("follow") or scene.method != "green" or \
+            eligible(scene, problem, sink):
+        return None
+    snap = sink.committed["approach"][-1]
+    spacings = locked_spacings(problem, contact_edge(problem, snap), g.get("band"), ratio)
+    if spacings is None:
+        return None
+    levels = []
+    for h in spacings:
+        member = variant(scene, grid={**g, "spacing": h})
+        try:
+            m = _Member(member, problem, member, build_problem(member))
+            st = m.state("approach", sink.committed["approach"],
+                         len(sink.committed["approach"]) - 1)
+        except (_NotReduced, FemadhError, ValueError):
+            return None
+        f_lj, _, f_ex = state_forces(m.problem, st)
+        levels.append({"F_LJ_deepest_N": float(f_lj), "F_ex_deepest_N": float(f_ex)})
+    return spacings, levels
