@@ -62,15 +62,20 @@ def tolerance_force(problem, state, tol):
     return float(problem.areas @ np.abs(problem.dpressure(state.h)) * tol)
 
 
-def state_between(problem, a, b, d, scene):
+def state_between(problem, a, b, d, scene, reuse=False):
     """A fresh equilibrium at separation d between two states a and b of one branch, solved
     from the displacements interpolated between them, or None unless it converged, is stable
-    and stayed on that branch (every gap within a quarter of the interpolation's)."""
+    and stayed on that branch (every gap within a quarter of the interpolation's). With
+    ``reuse``, the nearer state's factorisation (if it has one) serves the corrector's chord
+    steps, as in a sweep's step (an estimate's member: a third of the fresh factorisations;
+    the fine run's own search keeps its fresh Newton, its bits unchanged)."""
     from ..contact import solve_state
 
     t = (d - a.d) / (b.d - a.d)
     w0, near = (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
     kw = {}
+    if reuse and getattr(near, "lu", None) is not None:
+        kw["factor"] = near.lu
     if problem.contact_model == "hertz-closure":
         kw["r_c0"] = near.r_c or None
     elif problem.sigma is not None:
@@ -83,7 +88,7 @@ def state_between(problem, a, b, d, scene):
     return st
 
 
-def peak_adhesion(problem, prev, best, nxt, scene, within=None):
+def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
@@ -91,7 +96,8 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None):
     :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
     hold them. ``within`` = (lo, hi) narrows the search to that part of the bracket (an
     estimate's member near the fine run's peak: fewer fresh states, the same absolute
-    tolerance in d). Returns (F, d, half-width of the final d bracket)."""
+    tolerance in d); ``reuse``: see :func:`state_between`. Returns (F, d, half-width of the
+    final d bracket)."""
     from ..contact.forces import state_forces
 
     f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
@@ -103,7 +109,7 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None):
 
     def neg(d):
         a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
-        st = state_between(problem, a, b, d, scene)
+        st = state_between(problem, a, b, d, scene, reuse)
         if st is None:
             return -f_best
         found[d] = state_forces(problem, st)[2]

@@ -97,6 +97,11 @@ class _Member:
         c = snaps[k]
         w0, active0 = interpolate_state(self.fine, self.problem, c.d, c.w)
         kw = {} if active0 is None else {"active0": active0}
+        # the factorisation of the member's nearest state on the branch serves the chord
+        # steps (as a sweep's previous step does)
+        near = [j for b, j in self.cache if b == branch]
+        if near:
+            kw["factor"] = self.cache[(branch, min(near, key=lambda j: abs(j - k)))].lu
         st = solve_state(self.problem, c.d, w0, tol=self.scene.tolerance,
                          max_iter=self.scene.max_iter, **kw)
         self.solves += 1
@@ -175,10 +180,10 @@ def _peak(m, sink, snaps, d_fine=None):
         # bracket where the member's optimum ends at the window's edge
         half = PEAK_WINDOW * abs(states[i + 1].d - states[i].d)
         F, d, tol = peak_adhesion(m.problem, *around, m.scene,
-                                  within=(d_fine - half, d_fine + half))
+                                  within=(d_fine - half, d_fine + half), reuse=True)
         if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:
             return F, d
-    F, d, _ = peak_adhesion(m.problem, *around, m.scene)
+    F, d, _ = peak_adhesion(m.problem, *around, m.scene, reuse=True)
     return F, d
 
 
