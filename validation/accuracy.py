@@ -38,7 +38,11 @@ JUMPS = ("jump_in_d_m", "jump_out_d_m")
 
 #: scene -> (uniform node counts, requested accuracies, reference band spacing (m), quantities)
 CASES = {
-    "paper1_fig3": ((200, 400, 800), (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), 7.5e-9, QUANT),
+    # the reference at 3.75 nm: the 1e-4 request's grid is at 9.4 nm, and against a 7.5-nm
+    # reference its "achieved" error was the reference's own (F_LJ at the deepest state:
+    # 7.3e-6 of the 7.5-nm grid against 6e-7 of the 9.4-nm one, both measured against 2.5 nm
+    # by single-state solves)
+    "paper1_fig3": ((200, 400, 800), (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), 3.75e-9, QUANT),
     # 1e-4 on Fig 4 is not in the table: its second trial plans 2904 nodes on the static band
     # (> 190 s; its first, 871 nodes, reaches 6.1e-4 in 27 s), beyond the reference itself
     "paper1_fig4": ((200, 400, 800), (1e-2, 3e-3, 1e-3), 5e-9, QUANT + JUMPS),
