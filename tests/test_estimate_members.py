@@ -132,6 +132,11 @@ def test_locked_deepest_estimate_effectivity_against_a_fine_reference():
     assert sr.converged and sr.stable
     true = state_forces(ref, sr)[0] - res.headline["F_LJ_deepest_N"]
     est = res.estimates["F_LJ_deepest_N"]["grid"]
+    # the grid part is the uneven Richardson of the placed members at their own ratios
+    (h1, h2), (lv1, lv2) = g["deepest_member_spacings_m"], g["deepest_members"]
+    assert est == discretisation(
+        {"F_LJ_deepest_N": res.headline["F_LJ_deepest_N"]}, lv1, lv2,
+        ratio=h1 / g["spacing_m"], ratio2=h2 / h1)["F_LJ_deepest_N"]
     assert est * true > 0                       # the side the error is on
     assert 0.5 <= est / true <= 5.0, est / true
 

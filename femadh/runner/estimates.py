@@ -288,6 +288,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                    ratio=h1 / h0, ratio2=h2 / h1).items():
             parts.setdefault(k, {})["grid"] = v
         res.grid["deepest_member_spacings_m"] = [h1, h2]
+        res.grid["deepest_members"] = [lv1, lv2]
     # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
         js = [j for j in res.jumps if j["branch"] == branch]
