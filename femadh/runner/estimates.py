@@ -3,11 +3,16 @@ and accuracy on demand.
 
 Each headline number gets an a-posteriori estimate made of
 - **discretisation**: the same scene on the coarser members of its grid family (N/2 and N/4
-  nodes of a uniform grid, spacings r h and r^2 h of a banded one; FE runs: also the FE body against the exact Green function on the same nodes, or
-  for a layered body, which has none, against the next coarser mesh of its family with
+  nodes of a uniform grid, spacings r h and r^2 h of a banded one; FE runs: also the FE body
+  against the exact Green function on the same nodes, or for a layered body, which has
+  none, against the next coarser mesh of its family with
   Richardson at the P2 body's order 3 and the size ratio the two meshes actually have), the
   fine grid's error estimated by Richardson with the order observed over the three levels
-  (clamped to [1, 2]), or by the envelope of both differences where they oscillate;
+  (clamped to [1, 1.5]), or by the envelope of both differences where they oscillate. A
+  banded member is solved only at the states its numbers are read at, from the fine run's
+  (:mod:`femadh.runner.members`); the forces at the deepest separation take members placed
+  so that the contact edge sits at the fine grid's fraction of a spacing (Richardson over
+  their uneven ratios);
 - **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
   the grid separations by a bounded scalar search on fresh states (its bracket is its error);
   a fold is located to 2^-10 of the grid step (the jump's resolution);

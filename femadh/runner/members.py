@@ -12,17 +12,26 @@ only, each by Newton from the fine run's committed state there carried to the me
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
   the fine run's (:func:`femadh.runner.estimates.peak_adhesion`);
-- each fold: the one grid step that holds the fine run's fold, traced from the member's
-  state at its start with the stepping continuation (the same halvings, the same resolution:
-  the fold located and landed on exactly as a whole trace would in that step);
+- each fold: continued on the fine run's lattice of smallest steps (the stepping's own in
+  that grid step) from a few lattice steps before the fine run's fold, with the stepping's
+  acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
+  point and landing as a whole trace, in ~10-20 solves where halving the grid step down to
+  the fold and landing takes ~40; the grid step traced whole where that finds none;
 - the contact radius at zero force: the grid states around the fine run's sign change.
 
 A member state is the member's equilibrium on the fine run's branch at that separation; a
 whole trace reaches the same state where its branch is the same (measured on the Fig 3 scene's
-family, spacings 15-240 nm: F_LJ at the deepest separation identical to the last digit).
-Anything the reduced member cannot reproduce - a state that does not converge, is unstable or
-refused by a guard, a fold that is not in the fine run's step, a sign change that moved - is
-not guessed: :func:`reduced_member` returns None and the member is traced whole, as before.
+family, spacings 15-240 nm: F_LJ at the deepest separation identical to the last digit; Fig 3
+and Fig 4 at their defaults: every grid part within 1.4e-6 of its number of the whole
+trace's, folds and hysteresis identical). Anything the reduced member cannot reproduce - a
+state that does not converge, is unstable or refused by a guard, a fold that is not near the
+fine run's, a landing elsewhere than the fine run's, a sign change that moved - is not
+guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
+uniform grid's members (N/2, N/4 may resolve the contact so coarsely that their branches
+differ from the fine one's: folds the fine run does not have, which no state of it shows).
+
+The forces at the deepest separation also get members placed by the contact edge
+(:func:`deepest_locked`): one state each.
 """
 import math
 
@@ -32,12 +41,13 @@ from ..contact.stepping import MIN_STEP_FRACTION
 
 #: grid states the member may walk past the fine run's peak looking for its own grid maximum
 PEAK_WALK = 3
-#: half-width of a member's peak search around the fine run's peak, in grid steps (the Fig 3
-#: and Fig 4 members' peaks lie within 0.02 grid steps of the fine run's)
+#: half-width of a member's peak search around the fine run's peak, in grid steps (the Fig 4
+#: members' peaks lie 0.02 grid steps from the fine run's, Fig 3's 0.06); an optimum at the
+#: window's edge is searched again over the whole bracket
 PEAK_WINDOW = 0.125
-#: a member's fold is searched on the fine run's lattice from the fine run's fold states
+#: a member's fold is continued on the fine run's lattice from near the fine run's fold
 #: (False: the fine run's grid step that holds it is traced, halvings and all)
-BRACKETED_FOLDS = True
+LATTICE_FOLDS = True
 #: corrector solves a member's fold search may take (a healthy one: 10-20)
 MAX_FOLD_SOLVES = 80
 
@@ -156,7 +166,9 @@ def _peak(m, sink, snaps, d_fine=None):
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]
-    i = next(j for j, s in enumerate(states) if s is best)
+    i = next((j for j, s in enumerate(states) if s is best), None)
+    if i is None:
+        raise _NotReduced("the fine run's peak state is not among its committed states")
     n = len(states)
     k = i
     for _ in range(PEAK_WALK + 1):
@@ -316,7 +328,7 @@ def _folds(m, res, sink, snaps):
                                           key=lambda kv: (kv[0][0] != "approach", kv[0][1])):
         states = snaps[branch]
         try:
-            if BRACKETED_FOLDS and all((branch, j["d_fold_m"]) in fine for j in fine_jumps):
+            if LATTICE_FOLDS and all((branch, j["d_fold_m"]) in fine for j in fine_jumps):
                 got = [_lattice_fold(m, j["d_fold_m"], j["d_land_m"],
                                        *fine[(branch, j["d_fold_m"])]) for j in fine_jumps]
             else:
