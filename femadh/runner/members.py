@@ -38,6 +38,7 @@ import math
 import numpy as np
 
 from ..contact.stepping import MIN_STEP_FRACTION
+from ..estimate.guards import TRAPPING_LIMIT
 
 #: grid states the member may walk past the fine run's peak looking for its own grid maximum
 PEAK_WALK = 3
@@ -250,9 +251,9 @@ def _lattice_fold(m, d_fold, d_land, before, after):
     energy than one branch can (:func:`~femadh.contact.stepping.crossed_fold`), doubled after
     an acceptance and halved after a rejection; the fold is where a one-step move fails. The
     landing one step beyond: the energy descent from the last state
-    (:func:`~femadh.contact.landing.land`), Newton from the fine run's landing where that
-    stalls; a landing that releases no more than the step's work is a node snapping across
-    the lattice and is stepped over (:func:`~femadh.contact.stepping.lattice_snap`), as in a
+    (:func:`~femadh.contact.landing.land`; where it does not converge the member is traced
+    whole, whose trace fails there too); a landing that releases no more than the step's
+    work is a node snapping across the lattice and is stepped over (:func:`~femadh.contact.stepping.lattice_snap`), as in a
     whole trace."""
     from ..contact.complementarity import STALL_ITER, solve_complementarity, tangent
     from ..contact.landing import land
@@ -297,8 +298,8 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         landed = land(p, d, state.w, tol=sc.tolerance, max_iter=sc.max_iter)
         solves += 1
         if not (landed.converged and landed.stable):
-            landed = m.near(after, d, branch=False)
-        if landed is None or not (landed.converged and landed.stable):
+            # as in a whole trace, whose failure there is the member's (a lattice-trapped
+            # member's landing that does not polish: the adaptive run refines): traced whole
             raise _NotReduced(f"the landing after the member's fold at d = "
                               f"{state.d * 1e9:.6g} nm did not converge")
         g_landed = total_force(p, landed)
@@ -391,6 +392,10 @@ def reduced_member(scene, member, problem, sink, res):
     snaps = sink.committed
     try:
         m = _Member(member, problem, member, build_problem(member))
+        if m.problem.surface_force_stiffness()[0] >= TRAPPING_LIMIT:
+            # a law softening beyond a node's own stiffness: nodes snap on their own and the
+            # member's states depend on its path, which no state of the fine run shows
+            return None, "a lattice-trapped member (traced whole)"
         hl = {}
         fine = res.headline
         if "F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine:
