@@ -31,7 +31,8 @@ def _parser():
                     "examples and `femadh keys` for every key.",
         epilog="exit codes: 0 done, 2 bad scene/arguments, 3 solve failed (states kept), "
                "4 output not writable or folder holds a previous run, 5 missing dependency, "
-               "6 time limit reached (states kept), 130/143 interrupted.")
+               "6 time limit reached (states kept), 130/143 interrupted, 1 an internal "
+               "error (a bug in femadh: please report it).")
     p.add_argument("--version", action="version", version=f"femadh {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     r = sub.add_parser("run", help="solve a scene and write its results and figures",
@@ -251,8 +252,11 @@ def _check(scene, path):
 
     mem, _ = memory_estimate(scene)
     t, what = time_estimate(scene)
+    # an adaptive scene's node count is femadh's to choose: its default 'nodes' is not run
+    grid = (f"adaptive grid to accuracy {scene.target_accuracy:g}" if scene.adaptive else
+            "banded grid" if scene.grid is not None else f"{scene.nodes} nodes")
     print(f"{path}: ok ({len(scene.d_values)} separations, {', '.join(scene.directions)}, "
-          f"{scene.nodes} nodes, {scene.method}, ~{mem / 2**20:.0f} MiB, "
+          f"{grid}, {scene.method}, ~{mem / 2**20:.0f} MiB, "
           f"{'' if t < 1 else '~'}{_hms(t)} with "
           f"its error estimate: {what}, at rates measured on a 2-core machine; folds and "
           "jumps can take up to ~10x more)")
@@ -302,16 +306,10 @@ def _run(scene, args):
 
 def _report(res):
     if res.kind == "meniscus":
-        for (liq, R, meth), c in res.curves.items():
-            import numpy as np
+        from .runner.meniscus import report_lines
 
-            ok = np.isfinite(c["force_over_4piRgamma"])
-            if ok.any():
-                k = int(np.nanargmax(c["force_over_4piRgamma"]))
-                print(f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: max F/4piRgamma = "
-                      f"{c['force_over_4piRgamma'][k]:.4f} at p/psat = {c['p_ratio'][k]:.3g}"
-                      + (f"  ({int((~ok).sum())} p/psat without meniscus)" if (~ok).any()
-                         else ""))
+        for line in report_lines(res):
+            print(line)
         for e in res.errors[:5]:
             print(f"femadh: note: no meniscus for {e['liquid']} R = {e['tip_radius_m']:g} m "
                   f"{e['method']} at p/psat = {e['p_ratio']:g}: {e['error']}", file=sys.stderr)

@@ -15,8 +15,23 @@ class SceneError(FemadhError, ValueError):
     def __init__(self, file, key, value, expected):
         self.file, self.key, self.value, self.expected = file, key, value, expected
         where = f"{file}: " if file else ""
-        shown = "(missing)" if value is _MISSING else repr(value)
-        super().__init__(f"{where}[{key}] = {shown}: expected {expected}")
+        if key == "(file)":
+            # the file itself (unreadable, not TOML): no key to name, its value is the file
+            super().__init__(f"{where}expected {expected}")
+            return
+        super().__init__(f"{where}[{key}] = {_shown(value)}: expected {expected}")
+
+
+def _shown(value):
+    """A scene value as the error line shows it: TOML's true/false, a table by its keys (a
+    misspelt table's whole content would bury the line)."""
+    if value is _MISSING:
+        return "(missing)"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, dict):
+        return "(a table of " + (", ".join(map(str, value)) or "no keys") + ")"
+    return repr(value)
 
 
 class SceneErrors(SceneError):

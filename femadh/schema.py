@@ -76,14 +76,22 @@ class Key:
         return base + self.range_words()
 
     def range_words(self):
+        from .units import DIMENSIONS
+
+        # bounds are SI: a nonzero one names its unit ("a length in (0, 0.1 m]": a bare 0.1
+        # reads as the scene's own unit, e.g. mm)
+        unit = DIMENSIONS[self.kind][1] if self.kind in DIMENSIONS else ""
+
+        def b(x):
+            return f"{x:g} {unit}" if unit and x != 0 else f"{x:g}"
         lo, hi = self.lo, self.hi
         if lo is not None and hi is not None:
-            return (f" in {'[' if self.lo_closed else '('}{lo:g}, {hi:g}"
+            return (f" in {'[' if self.lo_closed else '('}{b(lo)}, {b(hi)}"
                     f"{']' if self.hi_closed else ')'}")
         if lo is not None:
-            return f" {'>=' if self.lo_closed else '>'} {lo:g}"
+            return f" {'>=' if self.lo_closed else '>'} {b(lo)}"
         if hi is not None:
-            return f" {'<=' if self.hi_closed else '<'} {hi:g}"
+            return f" {'<=' if self.hi_closed else '<'} {b(hi)}"
         return ""
 
     def in_range(self, x):

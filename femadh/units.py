@@ -34,6 +34,11 @@ DIMENSIONS = {
 
 _NUMBER_UNIT = None
 
+#: a temperature written with a letter pint reads as another unit ('25 C' is 25 coulomb)
+_TEMPERATURE_HINTS = {"C": " (C is the coulomb: Celsius is 'degC')",
+                      "F": " (F is the farad: Fahrenheit is 'degF')",
+                      "k": " (k is the Boltzmann constant: kelvin is 'K')"}
+
 _PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "T": 1e12, "m": 1e-3, "u": 1e-6, "µ": 1e-6,
            "n": 1e-9, "p": 1e-12, "f": 1e-15, "a": 1e-18, "z": 1e-21, "c": 1e-2}
 
@@ -138,5 +143,7 @@ def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     if q.dimensionless:
         raise SceneError(file, key, value, f"{words}; a bare number in a string has no unit")
     if not q.check(dim):
-        raise SceneError(file, key, value, f"{words}, but it has units of {q.units:~}")
+        unit = f"{q.units:~}"
+        hint = _TEMPERATURE_HINTS.get(unit, "") if dimension == "temperature" else ""
+        raise SceneError(file, key, value, f"{words}, but it has units of {unit}{hint}")
     return float(q.to(si.replace("^", "**")).magnitude)

@@ -570,12 +570,37 @@ DEFECTS = [
         "return (value - error < lower * (1 - math.copysign(rel, lower))"),)),
     D("regime_judged_cap_off", "regime: the lattice cap dropped though the fixed-grip "
       "pull-off is judged", "femadh/studies/regime.py",
-      (('cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged',
-        'cap = (lattice_cap(mu, radius, law) if False'),)),
+      (('            elif "pull_off_displacement" in judged:',
+        '            elif False:'),)),
     D("regime_judged_ignored", "regime: the accuracy judged on every quantity whatever is asked",
       "femadh/studies/regime.py",
       (('fine["errors"], fine["worst"] = errors, _worst(fine, errors, judged)',
         'fine["errors"], fine["worst"] = errors, _worst(fine, errors)'),)),
+    # -- the regime map's contact branch traced in its edge radius (edge-following grid)
+    D("edge_scaled_compliance", "edge branch: the scaled grid keeps the reference compliance "
+      "(C not scaled by lambda)", "femadh/contact/edge_branch.py",
+      (("self.compliance = lam * base.compliance", "self.compliance = base.compliance"),)),
+    D("edge_slope_moving_nodes", "edge branch: dd/dc without the nodes' motion (shape "
+      "derivative dropped)", "femadh/contact/edge_branch.py",
+      (("dshape = self.sphere.slope(r) * r / st.c", "dshape = 0.0 * r"),)),
+    D("edge_hysteresis_tail", "edge trace: the approach work without the tail beyond the "
+      "analysis radius", "femadh/studies/smooth_sphere.py",
+      (("+ tail_energy_change(law, R, pba.grid.radius, fin.d, d_out))", ")"),)),
+    D("edge_gauss_jacobian", "edge trace: the contact branch's work without the Gauss "
+      "interval's half-length", "femadh/studies/smooth_sphere.py",
+      (("contact_work += wi * half_c * F(st) * branch.slope(st)",
+        "contact_work += wi * F(st) * branch.slope(st)"),)),
+    D("edge_grid_band", "edge grid: coarsening from the edge node (no uniform band)",
+      "femadh/contact/edge_branch.py",
+      (("return spacing * (1.0 + max(x - half, 0.0) / grading)",
+        "return spacing * (1.0 + x / grading)"),)),
+    D("edge_coarse_ratio", "regime: the coarser member's spacing ratio reported as 1.5 "
+      "whatever it was", "femadh/studies/regime.py",
+      (("return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio",
+        "return solve_point(mu, radius, law, res.coarser(ratio), tol, None), 1.5"),)),
+    D("edge_radius_margin", "edge trace: the reference grid's radius equal to the point's "
+      "(the grid shrinks below it at the fold)", "femadh/studies/smooth_sphere.py",
+      (("EDGE_RADIUS_MARGIN = 3.0", "EDGE_RADIUS_MARGIN = 1.0"),)),
     # -- fold accounting
     D("closure_jump_resolution", "closure: a fold's resolution reported as the grid step",
       "femadh/contact/closure/trace.py",
@@ -815,6 +840,39 @@ DEFECTS = [
       "femadh/runner/estimates.py",
       (("    return {k: green[k] - v for k, v in fe.items()",
         "    return {k: v - green[k] for k, v in fe.items()"),)),
+    # -- a newcomer's second trial: the instrument's whole-sphere pull-off, the meniscus lines
+    D("newcomer_pull_off_no_tail", "instrument: the pull-off at the peak without the tail "
+      "beyond the analysis radius (the disk's max adhesion)", "femadh/runner/instrument.py",
+      (('    F = hl["max_adhesion_N"] + tail\n', '    F = hl["max_adhesion_N"]\n'),)),
+    D("newcomer_tail_wrong_state", "instrument: the pull-off's tail taken at d = 0, not at "
+      "the max adhesion's state", "femadh/runner/instrument.py",
+      (("    tail = tail_force(problem, d)\n", "    tail = tail_force(problem, 0.0)\n"),)),
+    D("newcomer_tail_line_basis", "report: the tail line adds F_tail to the path's sampled "
+      "pull-off, not to the max adhesion", "femadh/runner/report.py",
+      (("f\"{t['max_adhesion_N'] * s:.5g} {unit} (analysis disk) + F_tail \"",
+        "f\"{t['sampled_pull_off_N'] * s:.5g} {unit} (analysis disk) + F_tail \""),)),
+    D("newcomer_refine_mixed_pair", "instrument readout: a bracket's ends taken as the first "
+      "states at its separations (a fold's landing for the fold)", "femadh/runner/instrument.py",
+      (("        best = min(pairs, key=apart)\n", "        best = pairs[0]\n"),)),
+    D("newcomer_lj_invalid_silenced", "LJ law: a NaN made in the law silenced with its limits "
+      "at contact", "femadh/laws/lj.py",
+      (('AT_CONTACT = {"over": "ignore", "divide": "ignore", "under": "ignore"}',
+        'AT_CONTACT = {"all": "ignore"}'),)),
+    D("newcomer_reader_missing_silent", "scene reader: a missing required key not reported "
+      "unless its table is missing", "femadh/scene/reader.py",
+      (("            elif key.required and (absent or full in self.suggested):",
+        "            elif key.required and (absent or True):"),)),
+    D("newcomer_meniscus_shooting_exact", "meniscus report: shooting's 0 printed as an "
+      "estimated error (± 0)", "femadh/runner/meniscus.py",
+      (('estimated = meth in ("fe", "no-film") and np.isfinite(err)',
+        'estimated = meth in ("fe", "no-film", "shooting") and np.isfinite(err)'),)),
+    D("newcomer_meniscus_few_elements", "meniscus: an FE meridian too short to halve reports "
+      "error 0", "femadh/runner/meniscus.py",
+      (("    if scene.elements < 4:\n        return math.nan\n",
+        "    if scene.elements < 4:\n        return 0.0\n"),)),
+    D("newcomer_meniscus_error_scale", "meniscus report: the F/4πRγ error not divided by "
+      "4πRγ (by 4πR)", "femadh/runner/meniscus.py",
+      (('f" ± {err / unit4:.1g}"', 'f" ± {err / (4 * math.pi * R):.1g}"'),)),
 ]
 
 

@@ -1,6 +1,8 @@
 """The instrument's numbers of a run: read off the computed states
 (:mod:`femadh.instrument.readout`), then sharpened by fresh states where the readout
 interpolates (z's turning points, the landings, the largest tension)."""
+import math
+
 import numpy as np
 
 #: rounds of fresh states in each interval the readout interpolates in
@@ -144,8 +146,27 @@ def refine_instrument(scene, res, problem, sink):
             out[b] = {k: np.asarray(v, float)[order] for k, v in c.items()}
         return out
 
-    def at(branch, d):
-        return next((st for st in pool.get(branch, ()) if st.d == d), None)
+    def ends(branch, lo, hi):
+        """The computed states at a bracket's ends on one piece of the branch. At a fold the
+        branch's last state and its landing can share a separation (a traced fold lands at
+        d_fold): of the candidates, the pair whose displacements differ least (a landing
+        differs from its fold by the jump, ~ the gap). A fresh state solved between a fold and
+        its landing lands on either branch, and one from the other piece in the branch's rows
+        reads as a turn of z that is not there (a pull-off of 468 nN on a curve whose largest
+        tension is 363 nN: the smooth sphere at mu = 2 on a 3e4 N/m spring)."""
+        A = [st for st in pool.get(branch, ()) if st.d == lo]
+        B = [st for st in pool.get(branch, ()) if st.d == hi]
+
+        def apart(ab):
+            a, b = ab
+            if np.shape(a.w) != np.shape(b.w):
+                return math.inf          # a band that moved between them: no interpolation
+            return float(np.max(np.abs(np.asarray(a.w) - np.asarray(b.w))))
+        pairs = [(a, b) for a in A for b in B]
+        if not pairs:
+            return None, None
+        best = min(pairs, key=apart)
+        return best if math.isfinite(apart(best)) else (None, None)
 
     for _ in range(REFINE_ROUNDS):
         try:
@@ -162,7 +183,7 @@ def refine_instrument(scene, res, problem, sink):
             if (branch, lo, hi) in done or hi - lo <= REFINE_MIN_FRACTION * step:
                 continue
             done.add((branch, lo, hi))
-            a, b = at(branch, lo), at(branch, hi)
+            a, b = ends(branch, lo, hi)
             if a is None or b is None:
                 continue
             have = np.asarray(rows[branch]["d_m"], float)
@@ -212,7 +233,8 @@ def _pull_off_at_the_peak(res, problem):
     if ret is None or "instrument_pull_off_N" not in hl or "d_at_max_adhesion_m" not in hl:
         return
     d = hl["d_at_max_adhesion_m"]
-    F = hl["max_adhesion_N"] + tail_force(problem, d)
+    tail = tail_force(problem, d)
+    F = hl["max_adhesion_N"] + tail
     held = [dk for dk, kind in zip(ret["d_m"], ret["kind"]) if kind == "point"]
     # the readout's largest tension is an interior state of the path (not a jump's fold),
     # and the peak lies where the path holds the contact: the same maximum, sampled
@@ -224,6 +246,30 @@ def _pull_off_at_the_peak(res, problem):
         hl["instrument_pull_off_N"] = float(F)
         ins["resolution"]["pull_off_N"] = max(abs(F - sampled),
                                               ins["resolution"].get("pull_off_N", 0.0))
+        ins["pull_off_tail"] = _tail_share(problem, d, tail, hl["max_adhesion_N"], sampled)
+    else:
+        # read elsewhere on the path (a jump's fold): the tail there, no identity with the
+        # max adhesion (another state)
+        d_p = float(ret["d_m"][i])
+        ins["pull_off_tail"] = _tail_share(problem, d_p, tail_force(problem, d_p))
+
+
+def _tail_share(problem, d, tail, max_adhesion=None, sampled=None):
+    """summary.json "instrument" "pull_off_tail": what the pull-off holds beyond the headline's
+    max adhesion. The spring holds the whole sphere, so its force is F_ex (the analysis disk,
+    r <= a, the max adhesion's basis) plus F_tail = -2 pi R U(b(a; d)) beyond a (exact for
+    the undeformed paraboloid; the deformation there is ~F / (pi E* a), 4e-12 m on the AFM
+    tip's 5-nm gap at a). With the pull-off at the max adhesion's state (``max_adhesion``
+    given): pull-off - max adhesion = F_tail(d_at_max_adhesion), the identity the terminal
+    prints; ``sampled`` is the path's own reading of that maximum (fresh states, F_ex + F_tail
+    each), an independent check of it."""
+    out = {"d_m": float(d), "F_tail_N": float(tail),
+           "analysis_radius_m": float(problem.grid.radius),
+           "at_max_adhesion": max_adhesion is not None}
+    if max_adhesion is not None:
+        out["max_adhesion_N"] = float(max_adhesion)
+        out["sampled_pull_off_N"] = float(sampled)
+    return out
 
 
 def _resolved(hl, target, step):

@@ -115,15 +115,18 @@ def _run(scene, folder, progress):
 
 def _error_estimate(scene, meth, R, lq, r):
     """Estimated error (N) of an FE meniscus force: the same meniscus on half the elements,
-    |F_n - F_n/2| / (2^4 - 1) (order 4). Exact methods report 0 (shooting: its ODE tolerance
-    1e-12), the circular approximation nan (its error is the approximation's, see
-    validation)."""
+    |F_n - F_n/2| / (2^4 - 1) (order 4). Shooting reports 0 (its ODE tolerance 1e-12: exact
+    next to the FE's error; :func:`report_lines` says it is not an estimate), the circular
+    approximation nan (its error is the approximation's, see validation), and so does an FE
+    meridian of fewer than 4 elements (half of them is too few to solve: no estimate)."""
     if isinstance(r, Exception):
         return math.nan
     if meth == "circular":
         return math.nan
-    if meth == "shooting" or scene.elements < 4:
+    if meth == "shooting":
         return 0.0
+    if scene.elements < 4:
+        return math.nan
     from ..errors import ConvergenceError, DomainError
     from ..meniscus.solve import meniscus
 
@@ -184,3 +187,70 @@ def _write_vtk(out, liquid, R, p_ratios, res, n_theta=48):
         save_atomic(vdir / name, lambda p, mesh=mesh: meshio.write(p, mesh, file_format="vtu"))
         entries.append((x, f"vtk/{name}", 0))
     write_pvd(Path(out) / f"meniscus_{tag}.pvd", entries)
+
+
+#: what each method's printed error is (the terminal says it beside every number)
+ERROR_BASIS = {
+    "fe": f"± the meridian on half the elements, order {FE_ORDER:g}",
+    "no-film": f"± the meridian on half the elements, order {FE_ORDER:g}",
+    "shooting": "no error estimate: the ODE is solved to 1e-12 relative",
+    "circular": "no error estimate: the toroidal approximation",
+}
+
+
+def report_lines(res):
+    """The lines a meniscus run prints: what F and F/4πRγ are, then per liquid, tip radius
+    and method the largest force over the computed p/psat, each number with its estimated
+    error (:func:`_error_estimate`) or a plain "no error estimate" with the reason; the
+    circular approximation also with its difference from the exact meniscus (fe, else
+    shooting) at the same p/psat when the scene computes one."""
+    from ..io.plots import force_unit
+
+    scene = res.scene
+    where = ("in contact (D = -2h with the films)" if scene.separation is None else
+             f"at solid-solid separation {scene.separation * 1e9:.4g} nm")
+    n = len(scene.p_ratios)
+    out = [f"F: capillary force on the tip {where}, attractive positive; F/4πRγ: F over "
+           "4πRγ (R the solid tip radius, γ the liquid's surface tension); each line the "
+           f"largest of its {n} computed p/psat (not located between them)"]
+    gamma = {lq.name: lq.surface_tension for lq in scene.liquids}
+    for (liq, R, meth), c in res.curves.items():
+        f = np.asarray(c["force_N"], float)
+        ok = np.isfinite(f)
+        if not ok.any():
+            continue
+        k = int(np.nanargmax(f))
+        unit4 = 4 * math.pi * R * gamma[liq]
+        s, unit = force_unit([f[k]])
+        err = float(np.asarray(c["force_error_N"], float)[k])
+        estimated = meth in ("fe", "no-film") and np.isfinite(err)
+        F = f"F = {f[k] * s:.5g}" + (f" ± {err * s:.1g}" if estimated else "") + f" {unit}"
+        x = f"F/4πRγ = {c['force_over_4piRgamma'][k]:.5g}" + (
+            f" ± {err / unit4:.1g}" if estimated else "")
+        if estimated:
+            basis = ERROR_BASIS[meth]
+        elif meth in ("fe", "no-film"):
+            basis = ("no error estimate: the half-element meridian failed" if
+                     scene.elements >= 4 else "no error estimate: fewer than 4 elements")
+        else:
+            basis = ERROR_BASIS[meth]
+        if meth == "circular":
+            basis += _against_exact(res, liq, R, k, unit4)
+        line = (f"{liq:10s} R = {R * 1e9:7g} nm {meth:9s}: {x}, {F} (4πRγ = "
+                f"{unit4 * s:.4g} {unit}) at p/psat = {c['p_ratio'][k]:.3g}; {basis}")
+        if (~ok).any():
+            line += f" ({int((~ok).sum())} p/psat without meniscus)"
+        out.append(line)
+    return out
+
+
+def _against_exact(res, liq, R, k, unit4):
+    """The circular approximation's difference from the exact meniscus at its p/psat point k
+    (F/4πRγ), when the run computed one: a measured model error, not an estimate."""
+    for exact in ("fe", "shooting"):
+        c = res.curves.get((liq, R, exact))
+        a = res.curves.get((liq, R, "circular"))
+        if c is not None and np.isfinite(c["force_N"][k]):
+            dx = (a["force_N"][k] - c["force_N"][k]) / unit4
+            return f", {dx:+.2g} from {exact} here"
+    return ""

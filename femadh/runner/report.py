@@ -81,6 +81,8 @@ def _instrument_lines(res):
     if "instrument_snap_off_N" in hl:
         line += (f", snaps off at {_force(hl['instrument_snap_off_N'], hl.get('instrument_snap_off_N_error'))}")
     out = [line]
+    if "instrument_pull_off_N" in hl:
+        out.append(_tail_line(res))
     if "instrument_jump_in_z_m" in hl:
         out.append(f"instrument jumps in at z = {nm('instrument_jump_in_z_m')} (d = "
                    f"{nm('instrument_jump_in_d_m')})")
@@ -99,3 +101,28 @@ def _instrument_lines(res):
         out.append(f"instrument hysteresis {hl['instrument_hysteresis_J']:.4g}"
                    + (f" ± {e:.1g}" if e is not None else "") + " J")
     return out
+
+
+def _tail_line(res):
+    """Why the instrument's pull-off differs from the max adhesion: the spring holds the whole
+    sphere (F_ex + F_tail), the max adhesion is F_ex over the analysis disk alone."""
+    t = res.instrument.get("pull_off_tail")
+    if t is None:
+        return ("instrument forces are the whole sphere's: F_ex plus F_tail, the laws' force "
+                "beyond the analysis radius; the max adhesion above is the analysis disk's")
+    from ..io.plots import force_unit
+
+    s, unit = force_unit([res.headline["instrument_pull_off_N"]])
+    a = f"r > {t['analysis_radius_m'] * 1e9:.4g} nm"
+    if t["at_max_adhesion"]:
+        # the max adhesion's error estimate counts this tail as its "tail" part: say so when
+        # it is most of the printed ± (else the two numbers look inconsistent)
+        est = res.estimates.get("max_adhesion_N", {})
+        most = est.get("total") and abs(est.get("tail", 0.0)) > 0.5 * est["total"]
+        return (f"instrument forces are the whole sphere's: pull-off = max adhesion "
+                f"{t['max_adhesion_N'] * s:.5g} {unit} (analysis disk) + F_tail "
+                f"{t['F_tail_N'] * s:.3g} {unit} ({a}) at d = {t['d_m'] * 1e9:.4g} nm"
+                + (" (most of the max adhesion's ±)" if most else ""))
+    return (f"instrument forces are the whole sphere's: its pull-off includes F_tail "
+            f"{t['F_tail_N'] * s:.3g} {unit} ({a}) at d = {t['d_m'] * 1e9:.4g} nm; the max "
+            "adhesion above is the analysis disk's alone")

@@ -295,4 +295,7 @@ def instrument_summary(res):
     out["jumps"] = [{k: v for k, v in j.items() if k != "turn"}
                     for j in res.instrument["jumps"]]
     out["incomplete"] = res.instrument["incomplete"]
+    if "pull_off_tail" in res.instrument:
+        # the spring holds the whole sphere: the pull-off's share beyond the analysis radius
+        out["pull_off_tail"] = res.instrument["pull_off_tail"]
     return out

@@ -222,9 +222,8 @@ def parse_contact(reader, data, file):
 
     so = reader.read(SOLVER, data.get("solver"), "solver")
     a = analysis_radius_m(reader, so, sphere)
-    sw = reader.read(SWEEP, data.get("sweep"), "sweep")
-    if "sweep" not in data:
-        reader.fail("sweep", None, "a [sweep] table (it is required)")
+    sw = reader.read(SWEEP, data.get("sweep"), "sweep",
+                     missing="a [sweep] table (it is required)")
     d_values = separations(reader, sw, data.get("sweep") or {})
     ou = reader.read(OUTPUT, data.get("output"), "output")
     study = reader.read(STUDY, data["study"], "study") if "study" in data else None

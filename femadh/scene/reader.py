@@ -46,6 +46,9 @@ class Reader:
         # caller so that this base reader imports no table of its own
         self.kinds = dict(kinds or {})
         self.errors = []
+        # keys an unknown key was taken for (dotted paths): a typo's "did you mean" line
+        # stands for their "missing" line too
+        self.suggested = set()
 
     def bare_ok(self, path):
         """Whether a bare number is SI (not an error) at the dotted ``path``."""
@@ -64,12 +67,17 @@ class Reader:
         if self.errors:
             raise SceneErrors(self.errors)
 
-    def read(self, table, data, path=None):
+    def read(self, table, data, path=None, *, missing=None):
         """Values (SI) of the keys of ``table`` from the dict ``data`` (None: all defaults).
 
         Unknown keys are errors; missing required keys are errors; a key that fails is BAD.
+        ``missing``: the table is required (what to expect, in words): without it that is the
+        one error, its required keys BAD without a line each (one typo, one line).
         """
         path = table.path if path is None else path
+        absent = data is None and missing is not None
+        if absent and path not in self.suggested:
+            self.fail(path, _MISSING, missing)
         if data is None:
             data = {}
         if not isinstance(data, dict):
@@ -84,6 +92,8 @@ class Reader:
             full = f"{path}.{key.name}" if path else key.name
             if key.name in data:
                 out[key.name] = self.value(key, data[key.name], full)
+            elif key.required and (absent or full in self.suggested):
+                out[key.name] = BAD
             elif key.required:
                 out[key.name] = self.fail(full, _MISSING, f"{key.expected(_words(key))} "
                                           "(this key is required)")
@@ -97,6 +107,8 @@ class Reader:
         full = f"{path}.{name}" if path else str(name)
         self.fail(full, value, f"no such key here; {hint}allowed keys are "
                   + ", ".join(sorted(allowed)))
+        if close:
+            self.suggested.add(f"{path}.{close[0]}" if path else close[0])
 
     def value(self, key, raw, path, default=False):
         """One key's value in SI (or BAD, with its error recorded)."""
@@ -132,7 +144,12 @@ class Reader:
                 self.errors.append(exc)
                 return BAD
             if not math.isfinite(x) or not key.in_range(x):
-                return self.fail(path, raw, key.expected(_words(key)))
+                # a unit string out of range: say what it came to in the bounds' SI unit
+                # ('2 furlongs' is 402.3 m, not a length in (0, 0.1 m])
+                bounded = any(v not in (None, 0) for v in (key.lo, key.hi))
+                si = (f"; it is {x:.4g} {DIMENSIONS[key.kind][1]}" if isinstance(raw, str)
+                      and math.isfinite(x) and DIMENSIONS[key.kind][1] and bounded else "")
+                return self.fail(path, raw, key.expected(_words(key)) + si)
             return x
         raise ValueError(f"unknown key kind {key.kind!r} of {path}")
 

@@ -16,10 +16,17 @@ displacement-controlled experiment follow from it. Read off the curve:
 Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277; Feng 2000,
 J. Colloid Interface Sci. 238, 318.
 
-Grid: a band of uniform fine spacing that follows the contact edge, graded beyond it
-(:class:`~femadh.studies.smooth_sphere.PointSetup`, :class:`Resolution`); ``band_offset``
-reports how far the edge strayed from the band's centre, the guards refuse a point whose edge
-left it, whose nodes snap alone or whose contact reaches the analysis radius.
+Grid: where the curve is bistable (mu > 0.81) the contact branch is traced in its edge
+radius on a grid whose nodes move with the edge, the edge on a node at every state
+(:func:`~femadh.studies.smooth_sphere.trace_edge_point`, :mod:`femadh.contact.edge_branch`):
+no lattice wiggles, a fine band of +-2 ell around the edge only, nodes growing like ln mu
+(mu = 20 at 1e-3: 247 nodes, against 852 on the moving band); the approach branch by
+arclength to the jump-in fold. Elsewhere, and with ``Resolution(follow_edge=False)``, the
+whole curve is traced by arclength on a band of uniform fine spacing that follows the contact
+edge in steps, graded beyond it (:class:`~femadh.studies.smooth_sphere.PointSetup`,
+:class:`Resolution`); ``band_offset`` reports how far the edge strayed from the band's
+centre, the guards refuse a point whose edge left it, whose nodes snap alone or whose contact
+reaches the analysis radius.
 
 Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
 grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).
@@ -54,7 +61,8 @@ from ..reference.maugis import lj_dugdale_lambda, maugis_fixed_grip_pull_off, ma
 # the smooth-sphere problem of one point (re-exported: the map's public names)
 from .smooth_sphere import (ANALYSIS_RADIUS, BAND, BAND_MU, DS_MAX,  # noqa: F401
                             EDGE_GAP, GRADING, SPACING, TRACE_CORRECTION, PointSetup,  # noqa
-                            Resolution, e_star_length, lateral_length, lj_force, trace_point)
+                            Resolution, e_star_length, lateral_length, lj_force, trace_edge_point,
+                            trace_point)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
@@ -259,6 +267,8 @@ def solve_point(mu, radius, law, res, tol, progress):
     progress : callable or None
     """
     setup = PointSetup(mu, radius, law, res)
+    if setup.follows_edge:
+        return _read_edge(setup, trace_edge_point(setup, tol))
     curve = trace_point(setup, tol, progress)
     q = _read(setup, curve)
     q.update(setup=setup, n_points=len(curve.points), n_solves=curve.n_solves,
@@ -266,17 +276,49 @@ def solve_point(mu, radius, law, res, tol, progress):
     return q
 
 
-def _coarse_member(mu, radius, law, res, tol):
+def _read_edge(setup, e):
+    """The map's readout (units of the map) of a point traced with the grid following the
+    edge (:func:`~femadh.studies.smooth_sphere.trace_edge_point`): two grids (the approach
+    branch's and the contact branch's), the edge on a node of the latter at every state
+    (band offset 0), two folds traced (jump-in and jump-out; the unstable branch between
+    them, with its two further folds at mu >= 5, is not traced)."""
+    z0 = setup.z0
+    scale = math.pi * setup.radius * setup.dg
+    (da, fa), (dr, fr) = e["approach"], e["retract"]
+    return {
+        "pull_off": float(e["pull_off"] / scale),
+        "pull_off_displacement": float(e["pull_off_displacement"] / scale),
+        "jump_in": float(e["jump_in"] / z0), "jump_out": float(e["jump_out"] / z0),
+        "hysteresis": float(e["hysteresis"] / (scale * z0)),
+        "hysteresis_trapezoid": float(e["loop_work"] / (scale * z0)),
+        "trapping": float(e["trapping"]), "edge_ratio": float(e["edge_ratio"]),
+        "band_offset": 0.0, "nodes": int(e["nodes"]),
+        "curves": {"curve_d": e["curve_d"] / z0, "curve_F": e["curve_F"] / scale,
+                   "curve_stable": e["curve_stable"],
+                   "approach_d": da / z0, "approach_F": fa / scale,
+                   "retract_d": dr / z0, "retract_F": fr / scale,
+                   "n_factor": e["n_factor"], "n_krylov": e["n_krylov"],
+                   "n_newton": e["n_newton"]},
+        "setup": setup, "n_points": e["n_points"], "n_solves": e["n_solves"],
+        "n_folds": e["n_folds"], "n_grids": 2,
+    }
+
+
+def _coarse_member(mu, radius, law, res, tol, edge):
     """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
-    traced). Returns (result, ratio)."""
-    for ratio in (COARSE_RATIO, 2.0):
+    traced; where the grid follows the edge (``edge``) x COARSE_RATIO_EDGE, else x
+    COARSE_RATIO). Returns (result, ratio)."""
+    ratios = (COARSE_RATIO_EDGE, COARSE_RATIO) if edge else (COARSE_RATIO, 2.0)
+    why = None
+    for ratio in ratios:
         try:
             return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio
-        except (ConvergenceError, ValueError):
+        except (ConvergenceError, ValueError) as exc:
+            why = str(exc)
             continue
-    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x 1.5, x 2 of "
-                          f"{res.spacing:g} ell) cannot be traced: no error estimate; lower "
-                          f"spacing")
+    raise ResolutionError(f"mu = {mu:g}: the coarser grids (spacing x {ratios[0]:g}, "
+                          f"x {ratios[1]:g} of {res.spacing:g} ell) cannot be traced ({why}): "
+                          f"no error estimate; lower spacing")
 
 
 def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
@@ -329,6 +371,7 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     over = {k: v for k, v in (("spacing", spacing), ("stiffness_target", stiffness_target),
                               ("min_nodes", min_nodes), ("ds_max", ds_max)) if v is not None}
     res = replace(res, **over)
+    edge = PointSetup(mu, radius, law, res).follows_edge
     if accuracy is not None:
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
@@ -337,11 +380,16 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
             raise ValueError(f"judged must name some of {', '.join(QUANTITIES)}, got "
                              f"{', '.join(sorted(unknown)) or 'none'}")
         if "spacing" not in over and not res.legacy:
-            cap = (lattice_cap(mu, radius, law) if "pull_off_displacement" in judged
-                   else None)
+            if edge:
+                # the grid follows the edge: no lattice wiggles to cap the spacing for
+                cap = MAX_SPACING_EDGE / COARSE_RATIO_EDGE
+            elif "pull_off_displacement" in judged:
+                cap = lattice_cap(mu, radius, law)
+            else:
+                cap = None
             res = replace(res, spacing=initial_spacing(accuracy, cap))
     member = {}
-    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol)
+    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol, edge)
 
     def attempt(res):
         fine = solve_point(mu, radius, law, res, tol, progress)
@@ -433,6 +481,17 @@ MAX_SPACING = 0.2
 LATTICE_SPACING = 0.075
 #: spacing ratio of the coarser member (1.5: both members in the asymptotic range)
 COARSE_RATIO = 1.5
+#: where the grid follows the edge (:func:`~femadh.studies.smooth_sphere.trace_edge_point`;
+#: units of ell) the lattice cap does not apply (the edge sits on a node at every state), but
+#: the pull-off leaves the spacing^2 line above ~0.15 ell, where nodes soften to more than
+#: ~0.25 of their stiffness (measured, errors against spacing 0.025: LJ mu = 2: 4.4e-4 at
+#: 0.2, 3.7e-4 at 0.133 (ratio 1.2 for order-2's 2.25), 1.9e-4 at 0.1; mu = 3: 5.8e-4 at
+#: 0.167, 2.8e-4 at 0.133, 1.5e-4 at 0.1; the peer's Lj82 at mu = 3: 1.3e-3 at 0.25, 4.8e-3
+#: at 0.3). The coarser member is at most MAX_SPACING_EDGE, COARSE_RATIO_EDGE times the fine
+#: one: the pair (0.167, 0.133) estimates the mu = 2 and 3 pull-offs 1.8-1.9x high (the 0.2
+#: member would put the mu = 2 estimate 7x low)
+MAX_SPACING_EDGE = 1.0 / 6.0
+COARSE_RATIO_EDGE = 1.25
 
 
 def regime_map(mus, progress=None, **kw):

@@ -104,9 +104,8 @@ class Body:
 
 def read_sphere(reader, data):
     """The [sphere] table as a Sphere (None when it has errors, recorded in ``reader``)."""
-    sp = reader.read(SPHERE, data.get("sphere"), "sphere")
-    if "sphere" not in data:
-        reader.fail("sphere", None, "a [sphere] table (it is required)")
+    sp = reader.read(SPHERE, data.get("sphere"), "sphere",
+                     missing="a [sphere] table (it is required)")
     return None if any_bad(sp) else Sphere(sp["radius"], sp["profile"])
 
 
@@ -121,9 +120,9 @@ def _material(reader, raw, path):
 
 def read_materials(reader, data):
     """(E*, disk, slider) of the [materials] table; E* is BAD when it has errors."""
-    mt = reader.read(MATERIALS, data.get("materials"), "materials")
+    mt = reader.read(MATERIALS, data.get("materials"), "materials",
+                     missing="a [materials] table (it is required)")
     if "materials" not in data:
-        reader.fail("materials", None, "a [materials] table (it is required)")
         return BAD, None, None
     if any_bad(mt):
         return BAD, None, None

@@ -1,0 +1,359 @@
+"""The contact branch of a smooth adhesive sphere traced in its edge radius, on a grid that
+moves with the edge.
+
+On the JKR side of the smooth-sphere problem (no sigma-gap; paper 1 eqs 5-6 with a smooth law)
+the law acts in a cohesive zone ~ell wide at a contact edge that travels hundreds of ell along
+the curve (mu = 20: ~500 ell). A grid exchanged in steps as the edge moves (a band that is
+re-centred once the edge has left its middle, :class:`~femadh.discretisation.moving.MovingBand`)
+sees the edge cross its nodes: the discrete curve carries lattice wiggles of the node spacing,
+which near the flat jump-out fold become extra folds unless the band is very fine, and the
+continuation's predictor moves the edge by a fraction of the cohesive zone per step.
+
+Here the grid follows the edge continuously: its nodes are r_i = lambda r_i^0 with
+lambda = c / r_k^0, where c is the edge radius (the continuation parameter) and r^0 a banded
+grid (:class:`~femadh.discretisation.family.GridFamily`) fine around its node k. The edge sits
+on node k at every state, so the discretisation seen by the edge is the same along the branch:
+no lattice wiggles, and the branch is a smooth function of c. The half-space compliance is
+homogeneous of degree one in length (Johnson 1985 eq 3.41: a uniform pressure p on a disk of
+radius a displaces the surface by p a / E* times a function of r / a), so the operator of the
+scaled grid is C = lambda C^0 and K = K^0 / lambda exactly: one Green operator serves the
+whole branch.
+
+Unknowns at edge radius c: the displacements w (m) and the separation d (m), with
+
+    K w - P(h) = 0,   h_k - g_e = 0,   h = d + shape(r) - w,
+
+the second pinning the edge gap g_e (the gap that marks the edge) on node k. On the JKR side
+the contact radius increases monotonically along the whole curve (the folds are extrema of
+d(c), not turning points of c), so the branch is traced by plain Newton in c, folds included:
+the jump-out fold is the root of dd/dc (from the linearised system), the load-controlled
+pull-off the largest tension, the landing after the jump-in the root of d(c) = d_in.
+"""
+from dataclasses import dataclass
+import copy
+import math
+
+import numpy as np
+from scipy import optimize
+from scipy.linalg import lapack
+
+from ..errors import ConvergenceError
+from ..interrupt import check as safe_point
+from .problem import ContactProblem
+
+#: Newton iterations allowed per state
+MAX_ITER = 40
+#: largest fraction of its gap one Newton step may close (LJ repulsion grows like h^-9)
+GAP_CLOSURE = 0.3
+#: the relative change of c per step starts here and adapts to the Newton iterations
+STEP0 = 0.02
+#: largest and smallest relative steps in c
+STEP_MAX = 0.08
+STEP_MIN = 1e-5
+#: Newton iterations a step aims at (the step grows below, shrinks above)
+TARGET_ITER = 4
+#: relative accuracy in c of the fold and of the landing (root finding: the fold's tension and
+#: the landing's work move by ~this relative to themselves)
+C_XTOL = 1e-8
+#: relative accuracy in c of the largest tension's location: the value at a smooth maximum
+#: is off by ~(this)^2 relative
+MAX_XTOL = 1e-4
+#: the branch ends after this many states (a cap: a healthy branch takes 30-80)
+MAX_STATES = 2000
+
+
+def edge_grid(radius, edge, spacing, half, grading, max_nodes=4000):
+    """A radial grid with a node exactly at ``edge`` (m), uniform spacing h within ``half`` of
+    it on both sides and coarsening linearly beyond, Delta = h (1 + (|r - edge| - half) /
+    grading) (the banded family of :class:`~femadh.discretisation.family.GridFamily`, laid
+    out from the edge node instead of from r = 0): its members at every h are refinements of
+    one mesh density around the edge node, whatever h, which a Richardson estimate of the
+    edge-following trace needs (a band laid out from r = 0 puts its node nearest the edge up
+    to h/2 off the band's centre, differently for each h). Towards r = 0 the last step is
+    cut to land on 0 (the contact's interior, where the solution is smooth)."""
+    if not (0.0 < edge < radius and spacing > 0 and half >= 0 and grading > 0):
+        raise ValueError(f"edge grid needs 0 < edge ({edge:.4g} m) < radius ({radius:.4g} m), "
+                         f"spacing > 0 ({spacing:.4g} m), grading > 0 ({grading:.4g} m)")
+
+    def delta(x):
+        return spacing * (1.0 + max(x - half, 0.0) / grading)
+
+    def walk(limit):
+        out, x = [], 0.0
+        while True:
+            step = delta(x + 0.5 * delta(x))
+            if x + step >= limit:
+                return out, x
+            x += step
+            out.append(x)
+            if len(out) > max_nodes:
+                raise ValueError(f"edge grid needs more than {max_nodes} nodes (spacing "
+                                 f"{spacing:.3g} m on a radius of {radius:.3g} m)")
+    inner, _ = walk(edge)
+    # outside: stop where the last annulus (half-way edge to a) would be narrower than a step
+    outer, x = [], 0.0
+    while True:
+        step = delta(x + 0.5 * delta(x))
+        if edge + x + 1.5 * step > radius:
+            break
+        x += step
+        outer.append(x)
+        if len(outer) > max_nodes:
+            raise ValueError(f"edge grid needs more than {max_nodes} nodes")
+    if inner and edge - inner[-1] < 0.5 * delta(inner[-1]):
+        inner = inner[:-1]          # no sliver of a last step before r = 0
+    nodes = np.r_[0.0, edge - np.array(inner[::-1]), edge, edge + np.array(outer)]
+    from ..elastic.grid import RadialGrid
+    return RadialGrid.from_nodes(nodes, radius, fine_radius=edge + half), len(inner) + 1
+
+
+class ScaledOperator:
+    """The half-space operator of a grid scaled by lambda from a reference grid: C = lambda
+    C^0, K = K^0 / lambda (the compliance is homogeneous of degree one in length)."""
+
+    name = "green-scaled"
+
+    def __init__(self, base, lam):
+        g = base.grid
+        # a scaled valid grid is valid: its checks (monotone edges, nodes inside their
+        # annuli) are not repeated at every state
+        self.grid = object.__new__(type(g))
+        for name, value in (("nodes", g.nodes * lam), ("edges", g.edges * lam),
+                            ("fine_radius", None if g.fine_radius is None
+                             else g.fine_radius * lam)):
+            object.__setattr__(self.grid, name, value)
+        self.compliance = lam * base.compliance
+        self.stiffness = base.stiffness / lam
+        self.lam = lam
+
+
+@dataclass
+class EdgeState:
+    """A state of the contact branch: edge radius c (m), separation d (m), displacements w (m)
+    on the grid scaled to c, Newton iterations and residual (m)."""
+
+    c: float
+    d: float
+    w: np.ndarray
+    n_iter: int
+    residual: float
+    problem: ContactProblem = None
+    dd_dc: float = math.nan
+    force: float | None = None    # the caller's force of this state (N), once computed
+
+
+class EdgeBranch:
+    """Solves of the contact branch at given edge radii.
+
+    Parameters
+    ----------
+    base : GreenOperator
+        The operator on the reference grid.
+    k : int
+        Index of the edge node of the reference grid.
+    sphere, effects
+        As :class:`~femadh.contact.problem.ContactProblem`.
+    edge_gap : float
+        The gap g_e (m) that marks the edge.
+    tol : float
+        Residual of eq (6) every state meets (m).
+    """
+
+    def __init__(self, base, k, sphere, effects, edge_gap, tol):
+        self.base, self.k, self.sphere, self.effects = base, k, sphere, effects
+        self.edge_gap, self.tol = edge_gap, tol
+        self.r0 = float(base.grid.nodes[k])
+        self.n = base.grid.n
+        self.n_solves = 0
+        self.n_iter = 0
+        self._base = ContactProblem(base, sphere, effects, check_laws=False)
+
+    def problem(self, c):
+        """The problem on the grid whose node k sits at c (m): the reference problem with its
+        operator scaled (its energy stiffness diag(area) K scales like lambda too)."""
+        lam = c / self.r0
+        op = ScaledOperator(self.base, lam)
+        pb = copy.copy(self._base)
+        pb.operator, pb.grid = op, op.grid
+        pb.shape = self.sphere.shape(op.grid.nodes)
+        pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
+        pb.S_sym = lam * self._base.S_sym
+        pb._finest = None
+        return pb
+
+    def softening_ratio(self):
+        """The largest softening stiffness of the laws against the edge node's own stiffness
+        K_kk on the reference grid (:meth:`ContactProblem.surface_force_stiffness`'s law
+        side): near 1 a node snaps on its own."""
+        _, _, soft, _ = self._base.surface_force_stiffness()
+        return soft / float(self._base.K[self.k, self.k])
+
+    def _jacobian(self, pb, D):
+        n, k = self.n, self.k
+        J = np.zeros((n + 1, n + 1))
+        J[:n, :n] = pb.K
+        J[np.arange(n), np.arange(n)] += D
+        J[:n, n] = -D
+        J[n, k] = -1.0
+        J[n, n] = 1.0
+        return J
+
+    def solve(self, c, w0, d0):
+        """The state with its edge at c (m) from the guess (w0, d0) (Newton, steps limited so
+        that no gap closes by more than GAP_CLOSURE of itself). Returns an EdgeState, or
+        None if Newton did not converge in MAX_ITER iterations."""
+        pb = self.problem(c)
+        n, k, ge = self.n, self.k, self.edge_gap
+        w, d = np.array(w0, float), float(d0)
+        self.n_solves += 1
+        for it in range(1, MAX_ITER + 1):
+            safe_point()
+            h = pb.contour(d) - w
+            if np.any(h <= 0):
+                return None
+            P = pb.pressure(h)
+            res = float(np.max(np.abs(w - pb.C @ P)))
+            g = h[k] - ge
+            if res <= self.tol and abs(g) <= 1e-9 * ge:
+                self.n_iter += it - 1
+                return EdgeState(c, d, w, it - 1, res, pb)
+            D = pb.dpressure(h)
+            rhs = np.r_[P - pb.K @ w, -g]
+            lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
+            if info > 0:
+                return None
+            dx = lapack.dgetrs(lu, piv, rhs)[0]
+            if not np.all(np.isfinite(dx)):
+                return None
+            closing = dx[:n] - dx[n]        # dh = dd - dw: gaps close where dw > dd
+            alpha = 1.0
+            if np.any(closing > 0):
+                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[closing > 0]
+                                              / closing[closing > 0])))
+            w = w + alpha * dx[:n]
+            d = d + alpha * dx[n]
+        self.n_iter += MAX_ITER
+        return None
+
+    def slope(self, st):
+        """dd/dc (-) along the branch at a state: J dx/dc = -dF/dc with K = K^0 r_k^0 / c and
+        the contour's shape on nodes that move with c."""
+        pb, n, k = st.problem, self.n, self.k
+        h = pb.contour(st.d) - st.w
+        D = pb.dpressure(h)
+        r = pb.grid.nodes
+        dshape = self.sphere.slope(r) * r / st.c          # d shape(r_i(c)) / dc
+        rhs = -np.r_[-(pb.K @ st.w) / st.c - D * dshape, dshape[k]]
+        lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
+        if info > 0:
+            raise ConvergenceError("edge branch: singular Jacobian", d=st.d,
+                                   residual=st.residual, n_iter=0)
+        return float(lapack.dgetrs(lu, piv, rhs)[0][n])
+
+
+def tail_energy_change(law, radius, a, d1, d2):
+    """E_tail(d1) - E_tail(d2) (J): the change of the interaction energy beyond the analysis
+    radius a of a rigid paraboloid, E_tail(d) = 2 pi int_a^inf U(d + r^2/2R) r dr
+    = 2 pi R int_b^inf U(h) dh with b = d + a^2/2R (the surface is undeformed there), i.e.
+    2 pi R int_b1^b2 U(h) dh: 16-point Gauss-Legendre (U is smooth at these gaps, b >= 20 z0
+    at the smallest analysis radius)."""
+    b1, b2 = d1 + a * a / (2 * radius), d2 + a * a / (2 * radius)
+    x, wq = np.polynomial.legendre.leggauss(16)
+    h = 0.5 * (b1 + b2) + 0.5 * (b2 - b1) * x
+    return 2 * math.pi * radius * 0.5 * (b2 - b1) * float(wq @ law.energy(h))
+
+
+class BranchTrace:
+    """The traced contact branch: states in increasing c and what is read off it."""
+
+    def __init__(self, branch):
+        self.branch = branch
+        self.states = []
+
+    def _guess(self, c):
+        """Secant extrapolation in c from the two nearest traced states (w on the moving
+        nodes is a smooth function of c)."""
+        s = sorted(self.states, key=lambda x: abs(x.c - c))[:2]
+        if len(s) == 1:
+            return s[0].w, s[0].d
+        a, b = s
+        t = (c - a.c) / (b.c - a.c)
+        return a.w + t * (b.w - a.w), a.d + t * (b.d - a.d)
+
+    def at(self, c):
+        """The state at edge radius c (from the traced states); ConvergenceError if Newton
+        fails."""
+        w0, d0 = self._guess(c)
+        st = self.branch.solve(c, w0, d0)
+        if st is None:
+            raise ConvergenceError(f"edge branch: Newton failed at edge radius c = {c:.6g} m",
+                                   d=d0, residual=math.nan, n_iter=MAX_ITER)
+        return st
+
+    def march(self, start, direction, done):
+        """Trace from ``start`` (an EdgeState) in the direction of c (+1, -1) until
+        ``done(states_in_march_order)`` is True; the states join ``self.states``."""
+        run = [start]
+        step = STEP0
+        while not done(run):
+            if len(self.states) + len(run) > MAX_STATES:
+                raise ConvergenceError(f"edge branch: more than {MAX_STATES} states",
+                                       d=run[-1].d, residual=math.nan, n_iter=0)
+            p = run[-1]
+            c = p.c * (1 + direction * step)
+            if len(run) >= 2:
+                q = run[-2]
+                t = (c - q.c) / (p.c - q.c)
+                w0, d0 = q.w + t * (p.w - q.w), q.d + t * (p.d - q.d)
+            else:
+                w0, d0 = p.w, p.d
+            st = self.branch.solve(c, w0, d0)
+            if st is None:
+                step *= 0.5
+                if step < STEP_MIN:
+                    raise ConvergenceError(f"edge branch stalled at c = {p.c:.6g} m "
+                                           f"(d = {p.d:.6g} m): Newton fails at every step",
+                                           d=p.d, residual=math.nan, n_iter=MAX_ITER)
+                continue
+            run.append(st)
+            step = min(STEP_MAX, step * (1.5 if st.n_iter <= TARGET_ITER else 0.7))
+        self.states.extend(run[1:])
+        self.states.sort(key=lambda x: x.c)
+        return run
+
+    def fold(self, lo, hi):
+        """The fold (root of dd/dc) between edge radii lo and hi (m)."""
+        cache = {}
+
+        def slope(c):
+            st = self.at(c)
+            st.dd_dc = self.branch.slope(st)
+            cache[c] = st
+            return st.dd_dc
+        c = optimize.brentq(slope, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
+        return cache.get(c) or self.at(c)
+
+    def where_d(self, d, lo, hi):
+        """The state at separation d (m) between edge radii lo and hi."""
+        cache = {}
+
+        def f(c):
+            st = self.at(c)
+            cache[c] = st
+            return st.d - d
+        c = optimize.brentq(f, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
+        return cache.get(c) or self.at(c)
+
+    def maximize(self, value, lo, hi):
+        """The state of largest value(state) between edge radii lo and hi (bounded Brent)."""
+        best = []
+
+        def neg(c):
+            st = self.at(c)
+            v = value(st)
+            if not best or v > best[0]:
+                best[:] = [v, st]
+            return -v
+        optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                                 options={"xatol": MAX_XTOL * hi})
+        return best[0], best[1]

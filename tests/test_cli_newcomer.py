@@ -1,0 +1,126 @@
+"""A newcomer's wrong scenes on the command line (a trial on a fresh clone): each mistake is one
+line naming the file, the key, the value as written and what was expected - with the unit of
+a range's bounds, a misspelt table shown by its keys, TOML's own spelling of a boolean, and a
+file that is not TOML named without a key it does not have."""
+import subprocess
+import sys
+from pathlib import Path
+
+from femadh.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG3 = (ROOT / "validation/scenes/paper1_fig3.toml").read_text()
+
+
+def _check(tmp_path, capsys, text, name="s.toml"):
+    """``femadh check`` on ``text``: (exit code, the error lines)."""
+    path = tmp_path / name
+    path.write_text(text)
+    code = main(["check", str(path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    return code, err, str(path)
+
+
+def _edit(old, new):
+    assert FIG3.count(old) == 1
+    return FIG3.replace(old, new)
+
+
+def test_a_length_out_of_range_names_the_bounds_unit_and_what_it_came_to(tmp_path, capsys):
+    code, err, path = _check(tmp_path, capsys, _edit('radius = "2 mm"', 'radius = "2 furlongs"'))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [sphere.radius] = '2 furlongs': expected a length "
+                   "in (0, 0.1 m]; it is 402.3 m"]
+
+
+def test_a_sign_error_is_not_padded_with_its_si_value(tmp_path, capsys):
+    code, err, path = _check(tmp_path, capsys, _edit('sigma = "1.0 nm"', 'sigma = "-1.0 nm"'))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [effects.asperity_gap.sigma] = '-1.0 nm': "
+                   "expected a length > 0"]
+
+
+def test_a_misspelt_table_or_key_is_one_line(tmp_path, capsys):
+    """[sweeps] for [sweep]: one line, the unknown table shown by its keys, with the
+    suggestion; not a second line that [sweep] is missing nor one per key of it (six in all
+    before). Likewise a misspelt required key: no second line that the key is missing."""
+    code, err, path = _check(tmp_path, capsys, _edit("[sweep]", "[sweeps]"))
+    assert code == 2
+    assert err == [
+        f"femadh: error: {path}: [sweeps] = (a table of start, stop, step, directions): "
+        "expected no such key here; did you mean 'sweep'? allowed keys are effects, "
+        "instrument, materials, output, scene, solver, sphere, study, substrate, sweep"]
+    code, err, path = _check(tmp_path, capsys, _edit('hamaker = "1e-19 J"',
+                                                     'hamaker_constant = "1e-19 J"'))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [effects.lennard_jones.hamaker_constant] = "
+                   "'1e-19 J': expected no such key here; did you mean 'hamaker'? allowed "
+                   "keys are equilibrium_distance, hamaker"]
+    # a key nothing resembles still leaves the required one missing: both lines
+    code, err, path = _check(tmp_path, capsys, _edit('hamaker = "1e-19 J"', 'A = "1e-19 J"'))
+    assert len(err) == 2 and "[effects.lennard_jones.hamaker] = (missing)" in err[1]
+
+
+def test_a_missing_sphere_or_materials_table_is_one_line(tmp_path, capsys):
+    text = _edit('[sphere]\nradius = "2 mm"\nprofile = "paraboloid"            # eq 4\n', "")
+    code, err, path = _check(tmp_path, capsys, text)
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [sphere] = (missing): expected a [sphere] table "
+                   "(it is required)"]
+    start = FIG3.index("[materials]")
+    end = FIG3.index("[effects.lennard_jones]")
+    code, err, path = _check(tmp_path, capsys, FIG3[:start] + FIG3[end:])
+    assert err == [f"femadh: error: {path}: [materials] = (missing): expected a [materials] "
+                   "table (it is required)"]
+
+
+def test_a_wrong_type_is_shown_as_written(tmp_path, capsys):
+    code, err, path = _check(tmp_path, capsys, _edit('step = "0.2 nm"', "step = true"))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [sweep.step] = true: expected a length such as "
+                   "'2 mm' or '0.165 nm'"]
+
+
+def test_a_file_that_is_not_toml_or_not_there_is_one_line_without_a_key(tmp_path, capsys):
+    code, err, path = _check(tmp_path, capsys, 'radius = "2 mm"\n[[[\n')
+    assert code == 2
+    assert err == [f"femadh: error: {path}: expected valid TOML (Invalid initial character "
+                   "for a key part (at line 2, column 3))"]
+    missing = tmp_path / "nowhere.toml"
+    assert main(["check", str(missing)]) == 2
+    assert capsys.readouterr().err.strip() == (f"femadh: error: {missing}: expected a "
+                                               "readable file (No such file or directory)")
+
+
+def test_help_lists_every_exit_code_the_readme_does():
+    """README's exit codes (0, 2-6, 130/143 and 1, a bug) are all in `femadh --help`."""
+    out = subprocess.run([sys.executable, "-m", "femadh", "--help"], capture_output=True,
+                         text=True, cwd=ROOT).stdout
+    epilog = " ".join(out[out.index("exit codes"):].split())
+    for code in ("0 done", "2 bad scene", "3 solve failed", "4 output not writable",
+                 "5 missing dependency", "6 time limit", "130/143 interrupted",
+                 "1 an internal error"):
+        assert code in epilog, code
+
+
+def test_a_celsius_temperature_written_c_names_the_coulomb(tmp_path, capsys):
+    """'25 C' is 25 coulomb to pint: the line says so and how Celsius is written."""
+    text = (ROOT / "validation/scenes/paper2_ethanol_100nm.toml").read_text()
+    assert text.count('temperature = "298.15 K"') == 1
+    code, err, path = _check(tmp_path, capsys, text.replace('temperature = "298.15 K"',
+                                                            'temperature = "25 C"'))
+    assert code == 2
+    assert err == [f"femadh: error: {path}: [meniscus.temperature] = '25 C': expected a "
+                   "temperature such as '298.15 K', but it has units of C (C is the coulomb: "
+                   "Celsius is 'degC')"]
+
+
+def test_check_names_the_grid_the_run_will_use(capsys):
+    """An adaptive scene (no [solver] nodes) is not run on the default node count: `femadh
+    check` says 'adaptive grid to accuracy 0.001' (the run then chose 181 nodes for Fig 3),
+    not '200 nodes'; an explicit count is printed as given."""
+    assert main(["check", str(ROOT / "validation/scenes/paper1_fig3.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "adaptive grid to accuracy 0.001" in out and "200 nodes" not in out
+    assert main(["check", str(ROOT / "validation/scenes/afm_tip_cantilever.toml")]) == 0
+    assert ", 150 nodes, green" in capsys.readouterr().out
