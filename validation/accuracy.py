@@ -257,6 +257,10 @@ def main(argv=None):
               "| elements | achieved | estimated (half the elements, order 4) | effectivity | "
               "ms per force |", "|---|---|---|---|---|"]
     lines += [f"| {n} | {tr:.2e} | {es:.2e} | {eff:.2f} | {t:.2f} |" for n, tr, es, eff, t in men]
+    # the times mean something only if the machine stayed quiet: the load at the end too
+    end = os.getloadavg() if hasattr(os, "getloadavg") else (math.nan,) * 3
+    lines[2] = lines[2][:-1] + (f"; at the end {end[0]:.2f} (5-minute average "
+                                f"{end[1]:.2f}).")
     lines += [""] + _verdict(all_rows, men)
     print("\n".join(lines[-12:]))
     if not (args.only or args.adaptive):
