@@ -843,6 +843,36 @@ DEFECTS = [
     D("landing_no_whole_descent", "landing: a polish that fails after the settled descent is "
       "final (no whole descent)", "femadh/contact/landing.py",
       (("if not trapped and not (st.converged and st.stable):", "if False:"),)),
+    # -- the estimate's members solved where the headline numbers are read (estimate branch)
+    D("mem_fold_lattice_step", "member fold search: each trial two lattice steps beyond the "
+      "accepted ones (the fold off the fine run's lattice)", "femadh/runner/members.py",
+      (("        d = d_fold + (j + step) * r", "        d = d_fold + (j + 2 * step) * r"),)),
+    D("mem_state_neighbour", "member state solved at the separation of the fine run's "
+      "previous state", "femadh/runner/members.py",
+      (("        c = snaps[k]", "        c = snaps[max(k - 1, 0)]"),)),
+    D("mem_uniform_reduced", "reduced members on a uniform grid (its members' branches "
+      "differ from the fine one's)", "femadh/runner/members.py",
+      (('    if getattr(scene, "grid", None) is None:', "    if False:"),)),
+    D("lock_edge_exponent", "contact edge placed from a gap opening like (r - r_e)^2",
+      "femadh/runner/members.py",
+      (("    q = (g2 / g1) ** (2.0 / 3.0)", "    q = (g2 / g1) ** (1.0 / 2.0)"),)),
+    D("lock_phase_off", "members for the deepest state at whole spacings to the edge "
+      "(not at the fine grid's fraction)", "femadh/runner/members.py",
+      (("    f = x - math.floor(x)", "    f = 0.0"),)),
+    D("lock_first_state", "members placed by the edge of the sweep's first state",
+      "femadh/runner/members.py",
+      (('    snap = sink.committed["approach"][-1]', '    snap = sink.committed["approach"][0]'),)),
+    D("lock_ratio_swap", "uneven Richardson: the two ratios swapped",
+      "femadh/runner/estimates.py",
+      (("ratio=h1 / h0, ratio2=h2 / h1).items():", "ratio=h2 / h1, ratio2=h1 / h0).items():"),)),
+    D("uneven_order_formula", "uneven observed order: r2^p (r1^p - 1) / (r2^p - 1)",
+      "femadh/estimate/richardson.py",
+      (("        return ratio**p * (ratio2**p - 1.0) / (ratio**p - 1.0) - rho",
+        "        return ratio2**p * (ratio**p - 1.0) / (ratio2**p - 1.0) - rho"),)),
+    D("fe_green_sign", "FE mesh part of a homogeneous body: Q_FE - Q_Green",
+      "femadh/runner/estimates.py",
+      (("    return {k: green[k] - v for k, v in fe.items()",
+        "    return {k: v - green[k] for k, v in fe.items()"),)),
     # -- a newcomer's second trial: the instrument's whole-sphere pull-off, the meniscus lines
     D("newcomer_pull_off_no_tail", "instrument: the pull-off at the peak without the tail "
       "beyond the analysis radius (the disk's max adhesion)", "femadh/runner/instrument.py",

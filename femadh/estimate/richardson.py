@@ -54,12 +54,33 @@ def observed_order(fine, coarse, coarser, ratio):
     return math.log(abs(d2) / abs(d1)) / math.log(ratio)
 
 
+def observed_order_uneven(fine, coarse, coarser, ratio, ratio2, lo=0.05, hi=8.0):
+    """Order p three members of spacings h, r1 h, r1 r2 h show where r1 != r2: the root of
+    (Q(r1 h) - Q(r1 r2 h)) / (Q(h) - Q(r1 h)) = r1^p (r2^p - 1) / (r1^p - 1), which grows
+    monotonically with p (bisection on [lo, hi]); None where the members do not converge
+    monotonically or the root is outside [lo, hi]. With r1 = r2 it is
+    :func:`observed_order`'s."""
+    d1, d2 = fine - coarse, coarse - coarser
+    if not (d1 * d2 > 0):
+        return None
+    rho = d2 / d1
+
+    def g(p):
+        return ratio**p * (ratio2**p - 1.0) / (ratio**p - 1.0) - rho
+    if g(lo) > 0 or g(hi) < 0:
+        return None
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) < 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def _finite(x):
     return isinstance(x, float) and math.isfinite(x)
 
 
 def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_order=MAX_ORDER,
-                   envelope_order=ENVELOPE_ORDER):
+                   envelope_order=ENVELOPE_ORDER, ratio2=None):
     """Signed estimate of each number's discretisation error, Q* - Q(h), from the coarser
     members of its grid family.
 
@@ -71,6 +92,11 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
     ratio : float
         Spacing ratio r of consecutive members (2 for N, N/2, N/4; sqrt 2 for the runner's
         banded members).
+    ratio2 : float, optional
+        Spacing ratio of the coarser member to the coarse one where it differs from
+        ``ratio`` (members placed by the contact edge,
+        :func:`femadh.runner.members.locked_spacings`): the order observed by
+        :func:`observed_order_uneven`, the envelope's second difference scaled by it.
     order : float
         The order of a two-member estimate and the floor of an observed one.
     max_order, envelope_order : float
@@ -92,13 +118,16 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
         p = order
         cc = (coarser or {}).get(k)
         if _finite(cc) and v != c and cc != c:
-            seen = observed_order(v, c, cc, ratio)
+            uneven = ratio2 is not None and ratio2 != ratio
+            seen = (observed_order_uneven(v, c, cc, ratio, ratio2) if uneven
+                    else observed_order(v, c, cc, ratio))
             if seen is None:
                 # oscillating (a contact edge hopping between nodes): the two differences
                 # may cancel by chance; the envelope of both at the family's order
                 d1, d2 = v - c, c - cc
                 p = envelope_order
-                out[k] = math.copysign(max(abs(d1), abs(d2) / ratio**p), d1) / (ratio**p - 1)
+                out[k] = math.copysign(max(abs(d1), abs(d2) / (ratio2 if uneven else ratio)**p),
+                                       d1) / (ratio**p - 1)
                 continue
             # monotone convergence: the order it shows
             p = min(max_order, max(order, seen))

@@ -3,11 +3,16 @@ and accuracy on demand.
 
 Each headline number gets an a-posteriori estimate made of
 - **discretisation**: the same scene on the coarser members of its grid family (N/2 and N/4
-  nodes of a uniform grid, spacings r h and r^2 h of a banded one; FE runs: also the FE body against the exact Green function on the same nodes, or
-  for a layered body, which has none, against the next coarser mesh of its family with
+  nodes of a uniform grid, spacings r h and r^2 h of a banded one; FE runs: also the FE body
+  against the exact Green function on the same nodes, or for a layered body, which has
+  none, against the next coarser mesh of its family with
   Richardson at the P2 body's order 3 and the size ratio the two meshes actually have), the
   fine grid's error estimated by Richardson with the order observed over the three levels
-  (clamped to [1, 2]), or by the envelope of both differences where they oscillate;
+  (clamped to [1, 1.5]), or by the envelope of both differences where they oscillate. A
+  banded member is solved only at the states its numbers are read at, from the fine run's
+  (:mod:`femadh.runner.members`); the forces at the deepest separation take members placed
+  so that the contact edge sits at the fine grid's fraction of a spacing (Richardson over
+  their uneven ratios);
 - **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
   the grid separations by a bounded scalar search on fresh states (its bracket is its error);
   a fold is located to 2^-10 of the grid step (the jump's resolution);
@@ -37,6 +42,7 @@ import numpy as np
 from scipy import optimize
 
 from ..contact.forces import tail_force
+from .members import deepest_locked, reduced_member
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError,  # noqa: F401
                                TrappingError, check_state, outside_bounds)
@@ -50,6 +56,10 @@ FE_ORDER = 3
 MAX_NODES = 3200
 #: refinements accuracy mode may make
 MAX_REFINEMENTS = 5
+#: the coarser members solve only the states the headline numbers are read at, from the fine
+#: run's (femadh.runner.members); False traces every member whole (the reference the reduced
+#: members are tested against)
+REDUCED_MEMBERS = True
 
 
 def tolerance_force(problem, state, tol):
@@ -57,15 +67,20 @@ def tolerance_force(problem, state, tol):
     return float(problem.areas @ np.abs(problem.dpressure(state.h)) * tol)
 
 
-def state_between(problem, a, b, d, scene):
+def state_between(problem, a, b, d, scene, reuse=False):
     """A fresh equilibrium at separation d between two states a and b of one branch, solved
     from the displacements interpolated between them, or None unless it converged, is stable
-    and stayed on that branch (every gap within a quarter of the interpolation's)."""
+    and stayed on that branch (every gap within a quarter of the interpolation's). With
+    ``reuse``, the nearer state's factorisation (if it has one) serves the corrector's chord
+    steps, as in a sweep's step (an estimate's member: a third of the fresh factorisations;
+    the fine run's own search keeps its fresh Newton, its bits unchanged)."""
     from ..contact import solve_state
 
     t = (d - a.d) / (b.d - a.d)
     w0, near = (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
     kw = {}
+    if reuse and getattr(near, "lu", None) is not None:
+        kw["factor"] = near.lu
     if problem.contact_model == "hertz-closure":
         kw["r_c0"] = near.r_c or None
     elif problem.sigma is not None:
@@ -78,27 +93,32 @@ def state_between(problem, a, b, d, scene):
     return st
 
 
-def peak_adhesion(problem, prev, best, nxt, scene):
+def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). The states may be
     :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
-    hold them. Returns (F, d, half-width of the final d bracket)."""
+    hold them. ``within`` = (lo, hi) narrows the search to that part of the bracket (an
+    estimate's member near the fine run's peak: fewer fresh states, the same absolute
+    tolerance in d); ``reuse``: see :func:`state_between`. Returns (F, d, half-width of the
+    final d bracket)."""
     from ..contact.forces import state_forces
 
     f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
+    xatol = 1e-4 * (hi - lo)
+    if within is not None:
+        lo, hi = max(lo, within[0]), min(hi, within[1])
     found = {}
 
     def neg(d):
         a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
-        st = state_between(problem, a, b, d, scene)
+        st = state_between(problem, a, b, d, scene, reuse)
         if st is None:
             return -f_best
         found[d] = state_forces(problem, st)[2]
         return -found[d]
-    xatol = 1e-4 * (hi - lo)
     optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
                              options={"xatol": xatol, "maxiter": 40})
     F, d = max([(f_best, best.d)] + [(v, x) for x, v in found.items()])
@@ -181,9 +201,11 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
     bracket (:func:`refine_peak`); ``run`` runs the coarser members
     (:func:`femadh.runner.run.run`)."""
+    import time
     import warnings
 
     from ..errors import MeshResolutionWarning
+    t0 = time.perf_counter()
     _run_quiet = run
 
     def run(*a, **kw):
@@ -216,10 +238,12 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                 g = run(other, progress=False, estimate="peak")
         _stop_if_stopped(g)
         if g is not None and g.status == "converged":
-            for k, v in g.headline.items():
-                if isinstance(v, float) and isinstance(hl.get(k), float):
-                    parts.setdefault(k, {})["fe_mesh"] = (
-                        (hl[k] - v) / (ratio**FE_ORDER - 1) if layered else v - hl[k])
+            # layered: Richardson at the P2 body's order over the meshes' size ratio (the
+            # error machinery's one Richardson); else the exact Green function's difference
+            mesh = (discretisation(hl, g.headline, ratio=ratio, order=FE_ORDER) if layered
+                    else fe_against_green(hl, g.headline))
+            for k, v in mesh.items():
+                parts.setdefault(k, {})["fe_mesh"] = v
             if not layered:
                 fine_hl = dict(g.headline)       # the grid part: the Green function's in N
         elif g is not None:
@@ -229,16 +253,27 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 "estimated: the stated errors lack it")
     levels = []
     ratio, members = coarser_members(scene, problem, green)
+    solved = []
     for i, (label, member) in enumerate(members):
         with _phase(f"estimate: {label}"):
+            # the member solved only where the headline numbers are read, from the fine
+            # run's states (femadh.runner.members); traced whole where it cannot stand in
+            hl_m, how = (reduced_member(scene, member, problem, sink, res) if REDUCED_MEMBERS
+                         else (None, "reduced members off"))
+            if hl_m is not None:
+                levels.append(hl_m)
+                solved.append({"member": label, "reduced": True, "solves": how})
+                continue
             r = run(member, progress=False, estimate="peak")
         _stop_if_stopped(r)
+        solved.append({"member": label, "reduced": False, "why": how})
         if r.status != "converged":
             res.warnings.append(member_note(label, r.error, _fine_label(scene, problem),
                                             [lb for lb, _ in members[:i]]))
             res.grid["failed_member"] = {"member": label, "error": r.error}
             break
         levels.append(dict(r.headline))
+    res.grid["member_solves"] = solved
     res.grid["member_ratio"] = ratio
     res.grid["members"] = [lb for lb, _ in members][:len(levels)]
     if scene.grid is not None:
@@ -247,6 +282,18 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
                                    ratio=ratio).items():
             parts.setdefault(k, {})["grid"] = v
+    # the forces at the deepest separation: members placed by its contact edge (the same
+    # fraction of a spacing as the fine grid's), where they can be
+    locked = deepest_locked(scene, problem, sink, ratio, variant) if REDUCED_MEMBERS and \
+        levels else None
+    if locked is not None:
+        (h1, h2), (lv1, lv2) = locked
+        h0 = float(problem.grid.nodes[1])
+        for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
+                                   ratio=h1 / h0, ratio2=h2 / h1).items():
+            parts.setdefault(k, {})["grid"] = v
+        res.grid["deepest_member_spacings_m"] = [h1, h2]
+        res.grid["deepest_members"] = [lv1, lv2]
     # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
         js = [j for j in res.jumps if j["branch"] == branch]
@@ -274,7 +321,21 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # can cancel where the true errors do not, so the total is an upper estimate
         comp["total"] = float(sum(abs(v) for v in comp.values()))
         hl[f"{k}_error"] = comp["total"]
+    # the error estimate alone (the members, the tail, ...): estimate_s also holds the peak
+    # search, which locates the headline's largest adhesion itself
+    res.timings["error_estimate_s"] = time.perf_counter() - t0
     return parts
+
+
+def fe_against_green(fe, green):
+    """{name: Q_Green - Q_FE}: the FE body's error of each number where the exact Green
+    function on the same nodes gives the body without its mesh (finite floats only)."""
+    return {k: green[k] - v for k, v in fe.items()
+            if _finite(v) and _finite(green.get(k))}
+
+
+def _finite(x):
+    return isinstance(x, float) and math.isfinite(x)
 
 
 def _stop_if_stopped(member):

@@ -54,6 +54,9 @@ class Sink:
         self.last_state = None
         # an instrument's readout solves fresh states between the branch's own
         self.states, self.jump_states = {}, []
+        # every committed state's snapshot per branch (the estimate's coarser members
+        # start from them: femadh.runner.members)
+        self.committed, self.folds = {}, []
         self._keep = getattr(self.scene, "instrument", None) is not None
 
     def plan(self, branch, n, total=None):
@@ -70,6 +73,7 @@ class Sink:
         f = state_forces(self.problem, st)[2]
         snap = Committed(st.d, st.w, st.p_contact != 0, st.r_c, f)
         self._track_peak(branch, snap)
+        self.committed.setdefault(branch, []).append(snap)
         if self._keep:
             self.states.setdefault(branch, []).append(st)
         rows = self.rows.setdefault(branch, [])
@@ -110,6 +114,9 @@ class Sink:
         p = self.problem
         if self._keep:
             self.jump_states.append((jump.branch, jump.before, jump.after))
+        # (each fold's last state and landing: where the estimate's members look for theirs)
+        self.folds.append((jump.branch, jump.d_fold, jump.d_land, *(
+            Committed(s.d, s.w, s.active, s.r_c, math.nan) for s in (jump.before, jump.after))))
         # hysteresis: the energy released by the snap, both states at the landing separation
         # (the closure has no energy: nan)
         released = (math.nan if p.contact_model == "hertz-closure" else
