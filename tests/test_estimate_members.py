@@ -65,10 +65,12 @@ def test_reduced_members_give_the_whole_trace_estimate(fig4_both):
          for k in whole.estimates if "grid" in whole.estimates[k]}
     assert set(g) >= {"max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",
                       "jump_out_d_m", "hysteresis_J"}
-    # the folds: the same lattice point of the same grid step (identical), their energy to
-    # round-off (measured 1e-12 relative)
+    # the folds: the same lattice point of the same grid step - equal to the round-off of
+    # the separations (the two searches reach the lattice point by different sums: measured
+    # 3 ulps of the fold's d; a lattice step is 2^-10 of a grid step, ~1e9 ulps), their
+    # energy to round-off (measured 1e-12 relative)
     for k in ("jump_in_d_m", "jump_out_d_m"):
-        assert g[k][0] == g[k][1], k
+        assert abs(g[k][0] - g[k][1]) <= 16 * np.spacing(abs(red.headline[k])), k
     assert g["hysteresis_J"][0] == pytest.approx(g["hysteresis_J"][1], rel=1e-9, abs=0)
     # one state at the deepest separation: the same equilibrium to the solver tolerance
     # (measured 1e-11 of the force)
