@@ -109,7 +109,7 @@ class ContactProblem:
         # the nodes of the fine band (all, on a uniform grid): a graded far field never comes
         # close, and its wide annuli are softer by design
         k_node = float(np.min(np.diag(self.K)[self.grid.fine]))
-        if not self.effects:
+        if not self.collocated:
             return 0.0, math.nan, 0.0, k_node
         if self.sigma is not None:
             floor = self.sigma
@@ -118,9 +118,10 @@ class ContactProblem:
             repulsive = np.flatnonzero(self._sum("pressure", scan) < 0)
             floor = float(scan[repulsive[0]]) if repulsive.size else float(scan[-1])
         h = floor * np.logspace(0, 2, 400)
-        # the laws pointwise (a sub-grid law's nodal softening depends on the state's gap
-        # slope: :meth:`node_softening_ratio` measures it on the states)
-        soft = -self._sum("dpressure", h)
+        # the collocated laws pointwise; a sub-grid law is left out: its nodal softening is
+        # not its pointwise -P'(h) (P0/(4w) for a step) but depends on the gap's slope
+        # across the node, which :meth:`node_softening_ratio` measures on the states
+        soft = -self._sum("dpressure", h, self.collocated)
         k = int(np.argmax(soft))
         return float(max(soft[k], 0.0) / k_node), float(h[k]), float(soft[k]), k_node
 

@@ -68,87 +68,90 @@ class SubgridStep:
         self._last = None
 
     # -- per-element integrals -----------------------------------------------------------
-    def _element_integrals(self, x0, x1):
+    def _element_integrals(self, x0, x1, energy):
         """Integrals over t in [0, 1] of each element (x linear from x0 to x1, r from r_e to
-        r_e + dr): I[name] arrays per element of
-        s0 = int S (1-t) r dt, s1 = int S t r dt,
-        d00 = int S' (1-t)^2 r dt, d01 = int S' (1-t) t r dt, d11 = int S' t^2 r dt,
-        e = int softplus(x) r dt   (S' = dS/dx = S (1 - S); r in m)."""
+        r_e + dr), rows of an array per element: s0 = int S (1-t) r dt, s1 = int S t r dt,
+        d00 = int S' (1-t)^2 r dt, d01 = int S' (1-t) t r dt, d11 = int S' t^2 r dt
+        (S' = dS/dx = S (1 - S); r in m) - or, with ``energy``, the one row
+        e = int softplus(x) r dt."""
         re, dr = self.r[:-1], self.dr
         dx = x1 - x0
         # closed forms for a saturated element: S = 1 (x > L everywhere) or 0 (x < -L)
         full = np.minimum(x0, x1) > WINDOW
-        out = {k: np.zeros(re.size) for k in ("s0", "s1", "d00", "d01", "d11", "e")}
-        m1 = re / 2 + dr / 6          # int (1-t) r dt
-        m2 = re / 2 + dr / 3          # int t r dt
-        out["s0"][full] = m1[full]
-        out["s1"][full] = m2[full]
-        # softplus(x) = x there: int x(t) r(t) dt = x0 (re + dr/2) + dx (re/2 + dr/3)
-        out["e"][full] = (x0 * (re + dr / 2) + dx * m2)[full]
+        out = np.zeros((1 if energy else 5, re.size))
+        if energy:
+            # softplus(x) = x there: int x(t) r(t) dt = x0 (re + dr/2) + dx (re/2 + dr/3)
+            out[0, full] = (x0 * (re + dr / 2) + dx * (re / 2 + dr / 3))[full]
+        else:
+            out[0, full] = (re / 2 + dr / 6)[full]          # int (1-t) r dt
+            out[1, full] = (re / 2 + dr / 3)[full]          # int t r dt
         empty = np.maximum(x0, x1) < -WINDOW
         quad = np.flatnonzero(~(full | empty))
         if quad.size:
-            self._quadrature(out, quad, x0[quad], dx[quad], re[quad], dr[quad])
+            out[:, quad] = self._quadrature(x0[quad], dx[quad], re[quad], dr[quad], energy)
         return out
 
-    def _quadrature(self, out, idx, x0, dx, re, dr):
-        """Gauss panels on the elements ``idx``: the part of t in [0, 1] inside |x| <= L in
-        panels of at most PANEL in x, the saturated rest (S = 0 or 1 there) in one panel."""
+    @staticmethod
+    def _quadrature(x0, dx, re, dr, energy):
+        """Gauss panels on some elements: the part of t in [0, 1] inside |x| <= L in panels
+        of at most PANEL in x, the saturated rest (S = 0 or 1 there) in one panel each.
+        Returns the rows of :meth:`_element_integrals` for these elements."""
+        ne = x0.size
         with np.errstate(divide="ignore", invalid="ignore"):
             ta = np.where(dx != 0, (-WINDOW - x0) / dx, -np.inf)
             tb = np.where(dx != 0, (WINDOW - x0) / dx, np.inf)
         lo = np.clip(np.minimum(ta, tb), 0.0, 1.0)
         hi = np.clip(np.maximum(ta, tb), 0.0, 1.0)
-        # flat elements inside the window: the whole element is one panel
-        flat = dx == 0
-        lo[flat], hi[flat] = 0.0, 1.0
         m = np.maximum(1, np.ceil(np.abs(dx) * (hi - lo) / PANEL).astype(int))
         # panels: [0, lo], m panels across [lo, hi], [hi, 1] (empty ones weigh nothing)
-        k = np.repeat(np.arange(idx.size), m + 2)
+        k = np.repeat(np.arange(ne), m + 2)
         j = np.arange(k.size) - np.repeat(np.cumsum(m + 2) - (m + 2), m + 2)
-        mk = m[k]
-        t0 = np.where(j == 0, 0.0, np.where(j <= mk, lo[k] + (j - 1) * (hi - lo)[k] / mk,
-                                            hi[k]))
-        t1 = np.where(j == 0, lo[k], np.where(j <= mk, lo[k] + j * (hi - lo)[k] / mk, 1.0))
+        mk, lok, hik = m[k], lo[k], hi[k]
+        step = (hik - lok) / mk
+        t0 = np.where(j == 0, 0.0, np.minimum(lok + (j - 1) * step, hik))
+        t1 = np.where(j == 0, lok, np.where(j <= mk, lok + j * step, 1.0))
         t = t0[:, None] + (t1 - t0)[:, None] * _GT          # (panels, 8)
         wt = (t1 - t0)[:, None] * _GW
         x = x0[k, None] + dx[k, None] * t
-        r = re[k, None] + dr[k, None] * t
+        rw = (re[k, None] + dr[k, None] * t) * wt
+        if energy:
+            return np.bincount(k, (np.logaddexp(0.0, x) * rw).sum(axis=1), minlength=ne)
         s = _logistic(x)
-        sp = s * (1.0 - s)
-        sf = np.logaddexp(0.0, x)
-        a, b = (1.0 - t), t
-        for name, val in (("s0", s * a * r), ("s1", s * b * r), ("d00", sp * a * a * r),
-                          ("d01", sp * a * b * r), ("d11", sp * b * b * r), ("e", sf * r)):
-            out[name][idx] = np.bincount(k, (val * wt).sum(axis=1), minlength=idx.size)
+        sp = s * (1.0 - s) * rw
+        s = s * rw
+        a = 1.0 - t
+        rows = (s * a, s * t, sp * a * a, sp * a * t, sp * t * t)
+        return np.array([np.bincount(k, v.sum(axis=1), minlength=ne) for v in rows])
 
     # -- nodal quantities ----------------------------------------------------------------
+    def _x(self, h):
+        law = self.law
+        return (law._center - np.asarray(h, float)) / law.width
+
     def _eval(self, h):
-        """(f (N), T diagonal (N/m), T off-diagonal (N/m), energy (J)) at nodal gaps h,
-        cached for the last h (a Newton iteration asks for force and stiffness at once)."""
+        """(f (N), T diagonal (N/m), T off-diagonal (N/m)) at nodal gaps h, cached for the
+        last h (a Newton iteration asks for force and stiffness at once)."""
         h = np.asarray(h, float)
         if self._last is not None and np.array_equal(self._last[0], h):
             return self._last[1]
         law = self.law
-        P0, hc, w = law._amplitude, law._center, law.width
-        x = (hc - h) / w
-        I = self._element_integrals(x[:-1], x[1:])
+        P0, w = law._amplitude, law.width
+        x = self._x(h)
+        s0, s1, d00, d01, d11 = self._element_integrals(x[:-1], x[1:], False)
         c = 2 * np.pi * self.dr
         f = np.zeros(self.n)
-        f[:-1] += P0 * c * I["s0"]
-        f[1:] += P0 * c * I["s1"]
+        f[:-1] += P0 * c * s0
+        f[1:] += P0 * c * s1
         kd = -P0 / w * c            # P'(h) = -P0 S'(x) / w
         Td = np.zeros(self.n)
-        Td[:-1] += kd * I["d00"]
-        Td[1:] += kd * I["d11"]
-        To = kd * I["d01"]
-        E = float(np.sum(-P0 * w * c * I["e"]))
+        Td[:-1] += kd * d00
+        Td[1:] += kd * d11
+        To = kd * d01
         # beyond the last node: the gap held at h_{n-1} (collocated there)
         hl = h[-1:]
         f[-1] += self.outer * float(law.pressure(hl)[0])
         Td[-1] += self.outer * float(law.dpressure(hl)[0])
-        E += self.outer * float(law.energy(hl)[0])
-        out = (f, Td, To, E)
+        out = (f, Td, To)
         self._last = (h.copy(), out)
         return out
 
@@ -158,12 +161,17 @@ class SubgridStep:
 
     def stiffness(self, h):
         """(diagonal, off-diagonal) of T = df/dh (N/m), symmetric tridiagonal."""
-        _, d, o, _ = self._eval(h)
+        _, d, o = self._eval(h)
         return d, o
 
     def energy(self, h):
-        """int U(h(r)) dA (J) over the analysis disk for the piecewise-linear gap field."""
-        return self._eval(h)[3]
+        """int U(h(r)) dA (J) over the analysis disk for the piecewise-linear gap field
+        (U = -P0 w softplus(x))."""
+        law = self.law
+        h = np.asarray(h, float)
+        (e,) = self._element_integrals(*(lambda x: (x[:-1], x[1:]))(self._x(h)), True)
+        return float(np.sum(-law._amplitude * law.width * 2 * np.pi * self.dr * e)) \
+            + self.outer * float(law.energy(h[-1:])[0])
 
 
 # -- the law Jacobian J = dP/dh of ContactProblem.law_jacobian: a vector (collocated laws,
