@@ -162,14 +162,20 @@ class ContactProblem:
         symmetric tridiagonal d f / d h of the sub-grid laws plus the collocated diagonal."""
         if not self.integrated:
             return self.dpressure(h)
-        T = np.diag(self.areas * self._sum("dpressure", h, self.collocated))
-        for sub in self.integrated.values():
+        a = self.areas
+        diag = self._sum("dpressure", h, self.collocated)
+        off = np.zeros(a.size - 1)
+        for name, sub in self.integrated.items():
             d, o = sub.stiffness(h)
-            i = np.arange(self.grid.n)
-            T[i, i] += d
-            T[i[:-1], i[1:]] += o
-            T[i[1:], i[:-1]] += o
-        return T / self.areas[:, None]
+            diag = diag + self._finite(name, "dpressure", d / a, h)
+            off = off + o
+        n = a.size
+        J = np.zeros((n, n))
+        flat = J.reshape(-1)
+        flat[::n + 1] = diag
+        flat[1::n + 1] = off / a[:-1]          # row k, column k + 1: T_k,k+1 / area_k
+        flat[n::n + 1] = off / a[1:]           # row k + 1, column k
+        return J
 
     def effect_pressures(self, h):
         """Each law's nodal pressure (Pa) at nodal gaps h, by name (what a State carries:

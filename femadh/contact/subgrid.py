@@ -103,9 +103,12 @@ class SubgridStep:
         lo = np.clip(np.minimum(ta, tb), 0.0, 1.0)
         hi = np.clip(np.maximum(ta, tb), 0.0, 1.0)
         m = np.maximum(1, np.ceil(np.abs(dx) * (hi - lo) / PANEL).astype(int))
-        # panels: [0, lo], m panels across [lo, hi], [hi, 1] (empty ones weigh nothing)
-        k = np.repeat(np.arange(ne), m + 2)
-        j = np.arange(k.size) - np.repeat(np.cumsum(m + 2) - (m + 2), m + 2)
+        # panels: [0, lo], m panels across [lo, hi], [hi, 1]; the saturated ends only where
+        # they are not empty (most elements near a wide meniscus edge lie inside the window)
+        first, last = (lo > 0).astype(int), (hi < 1).astype(int)
+        cnt = m + first + last
+        k = np.repeat(np.arange(ne), cnt)
+        j = np.arange(k.size) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1 - first[k]
         mk, lok, hik = m[k], lo[k], hi[k]
         step = (hik - lok) / mk
         t0 = np.where(j == 0, 0.0, np.minimum(lok + (j - 1) * step, hik))
@@ -193,10 +196,17 @@ def add_jacobian(M, J, idx):
 
 
 def apply_jacobian(J, idx, v):
-    """J[idx, idx] @ v (Pa) for v on the nodes ``idx`` (m)."""
+    """J[idx, idx] @ v (Pa) for v on the nodes ``idx`` (m); a matrix J is tridiagonal
+    (ContactProblem.law_jacobian), applied by its three diagonals for a slice of nodes."""
     if J.ndim == 1:
         return J[idx] * v
-    return (J[idx][:, idx] if not isinstance(idx, slice) else J[idx, idx]) @ v
+    if not isinstance(idx, slice):
+        return J[idx][:, idx] @ v
+    B = J[idx, idx]
+    out = np.diagonal(B) * v
+    out[:-1] += np.diagonal(B, 1) * v[1:]
+    out[1:] += np.diagonal(B, -1) * v[:-1]
+    return out
 
 
 def jacobian_row_sums(J, idx):
