@@ -807,7 +807,8 @@ DEFECTS = [
       (("(x0 * (re + dr / 2) + dx * (re / 2 + dr / 3))[full]",
         "(x0 * (re + dr / 3) + dx * (re / 2 + dr / 3))[full]"),)),
     D("subgrid_row_sums", "tangent: the law's J_II 1 read as its diagonal",
-      "femadh/contact/subgrid.py", (("    return B.sum(axis=1)", "    return np.diag(B)"),)),
+      "femadh/contact/subgrid.py",
+      (("    out[:-1] += np.where(mask[1:], np.diagonal(J, 1), 0.0)", "    pass"),)),
     D("subgrid_krylov_apply", "Krylov Newton step: the law Jacobian's lower diagonal applied "
       "with the upper's entries (area-scaled rows: J is not symmetric)",
       "femadh/contact/subgrid.py",
@@ -825,8 +826,8 @@ DEFECTS = [
         "out[name] = eff.pressure(h)"),)),
     D("subgrid_hessian_diagonal", "energy Hessian: the sub-grid law's band left out",
       "femadh/contact/problem.py",
-      (("            H = self.S_sym + self.areas[:, None] * self.law_jacobian(h)",
-        "            H = self.S_sym + np.diag(self.areas * np.diag(self.law_jacobian(h)))"),)),
+      (("            flat[n::n + 1] += a[1:] * np.diagonal(J, -1)",
+        "            flat[n::n + 1] += a[:-1] * np.diagonal(J, 1)"),)),
 
 ]
 

@@ -377,7 +377,7 @@ def tangent(problem, state):
     D = problem.law_jacobian(state.h)
     # with a sub-grid law J_II 1 (a free node's pressure also moves with its free
     # neighbours' gaps; the held nodes' gaps stay at sigma)
-    rhs = jacobian_row_sums(D, np.flatnonzero(I)) - problem.K[np.ix_(I, A)].sum(axis=1)
+    rhs = jacobian_row_sums(D, I) - problem.K[np.ix_(I, A)].sum(axis=1)
     m = disk_size(A)
     if isinstance(state.lu, TrailingCholesky) and m is not None and state.lu.covers(m):
         a, K_II = problem.areas[m:], problem.K[m:, m:]

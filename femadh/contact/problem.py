@@ -228,7 +228,13 @@ class ContactProblem:
         all by default): sym(S) + diag(area P'(h)), with a sub-grid law's tridiagonal
         T = df/dh in place of its diagonal. Positive definite = a stable state."""
         if self.integrated:
-            H = self.S_sym + self.areas[:, None] * self.law_jacobian(h)
+            # area x J is the symmetric tridiagonal T (plus the collocated diagonal)
+            J, a, n = self.law_jacobian(h), self.areas, self.grid.n
+            H = self.S_sym.copy()
+            flat = H.reshape(-1)
+            flat[::n + 1] += a * np.diagonal(J)
+            flat[1::n + 1] += a[:-1] * np.diagonal(J, 1)
+            flat[n::n + 1] += a[1:] * np.diagonal(J, -1)
             return H if free is None else H[np.ix_(free, free)]
         if free is None:
             H = self.S_sym.copy()
