@@ -832,10 +832,10 @@ DEFECTS = [
       "femadh/contact/problem.py",
       (("out[name] = eff.pressure(h) if sub is None else sub.force(h) / self.areas",
         "out[name] = eff.pressure(h)"),)),
-    D("subgrid_hessian_diagonal", "energy Hessian: the sub-grid law's band left out",
+    D("subgrid_hessian_band", "energy Hessian: the lower band scaled by the wrong node's area",
       "femadh/contact/problem.py",
       (("            flat[n::n + 1] += a[1:] * np.diagonal(J, -1)",
-        "            flat[n::n + 1] += a[:-1] * np.diagonal(J, 1)"),)),
+        "            flat[n::n + 1] += a[:-1] * np.diagonal(J, -1)"),)),
 
 ]
 
