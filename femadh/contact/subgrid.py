@@ -30,6 +30,7 @@ forms of polynomials; inside, Gauss-Legendre panels of at most PANEL in x (the l
 poles at x = +-i pi bound the error of 8 points on a panel of half-width 1 by ~1e-13).
 """
 import numpy as np
+from scipy.special import expit
 
 #: |x| beyond which the logistic counts as saturated (S = 0 or 1 to e^-36 ~ 2e-16)
 WINDOW = 36.0
@@ -70,6 +71,11 @@ class SubgridStep:
         self.outer = np.pi * (radius ** 2 - self.r[-1] ** 2)
         self._last = None
         self._last_energy = None
+        # per element, constants of the rules: int (1-t) r dt, int t r dt, r at the 8 points
+        re = self.r[:-1]
+        self._m1 = re / 2 + self.dr / 6
+        self._m2 = re / 2 + self.dr / 3
+        self._r8 = re[:, None] + self.dr[:, None] * _GT
 
     # -- per-element integrals -----------------------------------------------------------
     def _element_integrals(self, x0, x1, energy):
@@ -87,24 +93,25 @@ class SubgridStep:
             # softplus(x) = x there: int x(t) r(t) dt = x0 (re + dr/2) + dx (re/2 + dr/3)
             out[0, full] = (x0 * (re + dr / 2) + dx * (re / 2 + dr / 3))[full]
         else:
-            out[0, full] = (re / 2 + dr / 6)[full]          # int (1-t) r dt
-            out[1, full] = (re / 2 + dr / 3)[full]          # int t r dt
+            out[0, full] = self._m1[full]          # int (1-t) r dt
+            out[1, full] = self._m2[full]          # int t r dt
         empty = np.maximum(x0, x1) < -WINDOW
         inside = ~(full | empty)
-        # elements inside the window spanning at most one panel: one 8-point rule on [0, 1]
-        # whose weights times the polynomials in t are constants (two small products)
-        one = inside & (np.abs(x0) <= WINDOW) & (np.abs(x1) <= WINDOW) & \
-            (np.abs(dx) <= PANEL)
+        # elements spanning at most one panel (also where they reach past the window: the
+        # rule is as accurate on the saturated part): one 8-point rule on [0, 1] whose
+        # weights times the polynomials in t are constants (two small products)
+        one = inside & (np.abs(dx) <= PANEL)
         k = np.flatnonzero(one)
         if k.size:
             x = x0[k, None] + dx[k, None] * _GT
-            r = re[k, None] + dr[k, None] * _GT
+            r = self._r8[k]
             if energy:
                 out[0, k] = (np.logaddexp(0.0, x) * r) @ _GW
             else:
-                sv = _logistic(x)
-                out[:2, k] = ((sv * r) @ _WS).T
-                out[2:, k] = ((sv * (1.0 - sv) * r) @ _WD).T
+                sv = expit(x)
+                svr = sv * r
+                out[:2, k] = (svr @ _WS).T
+                out[2:, k] = ((svr - sv * svr) @ _WD).T
         quad = np.flatnonzero(inside & ~one)
         if quad.size:
             out[:, quad] = self._quadrature(x0[quad], dx[quad], re[quad], dr[quad], energy)
@@ -169,10 +176,10 @@ class SubgridStep:
         Td[:-1] += kd * d00
         Td[1:] += kd * d11
         To = kd * d01
-        # beyond the last node: the gap held at h_{n-1} (collocated there)
-        hl = h[-1:]
-        f[-1] += self.outer * float(law.pressure(hl)[0])
-        Td[-1] += self.outer * float(law.dpressure(hl)[0])
+        # beyond the last node: the gap held at h_{n-1} (the law collocated there)
+        sl = float(expit(x[-1]))
+        f[-1] += self.outer * P0 * sl
+        Td[-1] += self.outer * (-P0 / w) * sl * (1.0 - sl)
         out = (f, Td, To)
         self._last = (h.copy(), out)
         return out
