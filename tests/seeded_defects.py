@@ -81,7 +81,7 @@ DEFECTS = [
       (("rows = (s * a, s * t, sp * a * a,", "rows = (s * a, s * a, sp * a * a,"),)),
     D("subgrid_saturated_moment", "sub-grid force: filled element's int t r dt with dr/6",
       "femadh/contact/subgrid.py",
-      (("out[1, full] = (re / 2 + dr / 3)[full]", "out[1, full] = (re / 2 + dr / 6)[full]"),)),
+      (("self._m2 = re / 2 + self.dr / 3", "self._m2 = re / 2 + self.dr / 6"),)),
     D("subgrid_one_panel_weights", "sub-grid force: one-panel elements with the two nodes' "
       "weights swapped", "femadh/contact/subgrid.py",
       (("_WS = np.stack([_GW * (1 - _GT), _GW * _GT], axis=1)",
