@@ -200,6 +200,7 @@ class _Tracer:
     """Predictor-corrector machinery shared by the trace and the fold location."""
 
     def __init__(self, problem, scale, tol, curve):
+        problem.require_collocated("the arclength tracer")
         self.problem, self.scale, self.tol, self.curve = problem, scale, tol, curve
         self.n = problem.grid.n
         self.omega = 1.0 / self.n

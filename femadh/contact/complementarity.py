@@ -39,6 +39,7 @@ from ..interrupt import check as safe_point
 from .linalg import TrailingCholesky, TrailingLU, disk_size, gmres
 from .stability import is_stable
 from .state import State
+from .subgrid import add_jacobian, apply_jacobian, jacobian_row_sums
 
 #: a chord step (reused factorisation) must cut the residual at least by this factor
 CHORD_RATE = 0.05
@@ -69,7 +70,7 @@ def _damping(h, dh_closing):
 def _effect_pressures(problem, h, A=None):
     """Each law's pressure at gaps h; with the eq 20 adhesion on the contact set (A), its
     P_LJa on the contact nodes as "asperity_adhesion"."""
-    out = {name: eff.pressure(h) for name, eff in problem.effects.items()}
+    out = problem.effect_pressures(h)
     adh = problem.gap.adhesion if problem.gap is not None else 0.0
     if adh and A is not None:
         out["asperity_adhesion"] = np.where(A, adh, 0.0)
@@ -243,11 +244,12 @@ def _krylov_step(problem, h, A, m, F_I, pre):
     positive definite on the free nodes (an iterate off the stable branch): the LU path
     takes the step."""
     n = h.size
-    D = problem.dpressure(h)
-    a, D_I, K_II = problem.areas[m:], D[m:], problem.K[m:, m:]
+    D = problem.law_jacobian(h)     # a vector; a tridiagonal matrix with a sub-grid law
+    a, K_II = problem.areas[m:], problem.K[m:, m:]
+    fr = slice(m, None)
 
     def apply_a(v):
-        return a * (K_II @ v + D_I * v)
+        return a * (K_II @ v + apply_jacobian(D, fr, v))
 
     rhs = -a * F_I
     n_factor = 0
@@ -256,7 +258,7 @@ def _krylov_step(problem, h, A, m, F_I, pre):
             # held nodes of the margin enter with D = 0 (they are fixed; when released the
             # Krylov iteration corrects their stiffness)
             m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-            pre = TrailingCholesky(problem.S_sym, problem.areas, np.where(A, 0.0, D), m0)
+            pre = TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0)
             n_factor += 1
             if not pre.covers(m):
                 return None, pre, n_factor
@@ -285,7 +287,7 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
     if m is not None:
         if not (isinstance(lu, TrailingLU) and lu.covers(m)) or stalled:
             m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-            cand = TrailingLU(K, problem.dpressure(h), m0, problem.areas)
+            cand = TrailingLU(K, problem.law_jacobian(h), m0, problem.areas)
             n_factor += 1
             if cand.covers(m):
                 lu, lu_I, fresh = cand, None, True
@@ -301,7 +303,7 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
                 or stalled:
             idx = np.flatnonzero(I)
             M = K[idx[:, None], idx]
-            M[np.diag_indices_from(M)] += problem.dpressure(h[I])
+            add_jacobian(M, problem.law_jacobian(h), idx)
             lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
             n_factor += 1
             res_prev = math.inf
@@ -345,6 +347,17 @@ def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
                  factor)
 
 
+def _held_zero(D, A):
+    """The law Jacobian with the held (contact) nodes' rows and columns zeroed: they enter
+    the preconditioner with their stiffness alone."""
+    if D.ndim == 1:
+        return np.where(A, 0.0, D)
+    out = D.copy()
+    out[A] = 0.0
+    out[:, A] = 0.0
+    return out
+
+
 def _contact_pressure(problem, pc, A):
     """The asperities' elastic (repulsive) pressure lambda >= 0 on the contact nodes: the net
     contact traction pc plus the eq 20 adhesion they carry (pc alone without it)."""
@@ -361,12 +374,14 @@ def tangent(problem, state):
     A = state.active
     I = ~A
     t = np.ones(state.w.size)
-    D = problem.dpressure(state.h)
-    rhs = D[I] - problem.K[np.ix_(I, A)].sum(axis=1)
+    D = problem.law_jacobian(state.h)
+    # with a sub-grid law J_II 1 (a free node's pressure also moves with its free
+    # neighbours' gaps; the held nodes' gaps stay at sigma)
+    rhs = jacobian_row_sums(D, I) - problem.K[np.ix_(I, A)].sum(axis=1)
     m = disk_size(A)
     if isinstance(state.lu, TrailingCholesky) and m is not None and state.lu.covers(m):
         a, K_II = problem.areas[m:], problem.K[m:, m:]
-        t_I, _, ok = gmres(lambda v: a * (K_II @ v + D[m:] * v),
+        t_I, _, ok = gmres(lambda v: a * (K_II @ v + apply_jacobian(D, slice(m, None), v)),
                            lambda r: state.lu.solve(m, r), a * rhs, GMRES_RTOL)
         if not ok:
             return np.zeros(state.w.size)  # no converged solve: zeroth order

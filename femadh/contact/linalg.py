@@ -19,7 +19,10 @@ class TrailingLU:
         n = K.shape[0]
         # reversed trailing block, a copy (the reversed slice is cheaper than fancy indexing)
         M = np.array(K[m0:, m0:][::-1, ::-1])
-        M[np.diag_indices_from(M)] += D[m0:][::-1]
+        if D.ndim == 2:     # a sub-grid law's tridiagonal Jacobian (ContactProblem.law_jacobian)
+            M += D[m0:, m0:][::-1, ::-1]
+        else:
+            M[np.diag_indices_from(M)] += D[m0:][::-1]
         # rows scaled by the annulus areas: diag(area) K is nearly symmetric (the energy
         # Hessian), for which partial pivoting rarely swaps rows - so one factorisation keeps
         # covering every trailing block
@@ -82,7 +85,10 @@ class TrailingCholesky:
 
         n = S_sym.shape[0]
         M = np.array(S_sym[m0:, m0:][::-1, ::-1], order="F")
-        M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
+        if D.ndim == 2:     # a sub-grid law: area x its Jacobian is the symmetric df/dh
+            M += (areas[m0:, None] * D[m0:, m0:])[::-1, ::-1]
+        else:
+            M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
         self.n, self.m0 = n, m0
         self.k_valid = n - m0 if info == 0 else int(info) - 1

@@ -34,6 +34,13 @@ class ContactProblem:
         Verify each law's derivative and energy against finite differences of its value
         (:func:`femadh.laws.check_law`) before solving; a LawError names the first
         inconsistency. Off only for deliberately partial laws (tests).
+    subgrid : bool
+        Integrate the step laws that ask for it (``SUBGRID = True``: the capillary
+        condensate) over the gap field piecewise-linear between the nodes
+        (:mod:`femadh.contact.subgrid`) instead of collocating them at the nodes. Their
+        nodal force then depends on the neighbours' gaps: the law Jacobian is tridiagonal
+        (:meth:`law_jacobian`). Off for the solvers that take only a diagonal law Jacobian
+        (the Hertz closure; the scene builder turns it off for arclength continuation).
     """
 
     operator: object
@@ -41,6 +48,7 @@ class ContactProblem:
     effects: dict
     gap: AsperityGap | None = None
     check_laws: bool = True
+    subgrid: bool = True
     shape: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -58,6 +66,27 @@ class ContactProblem:
         # Symmetric force-displacement stiffness for the energy and the stability test.
         S = self.areas[:, None] * self.K
         self.S_sym = 0.5 * (S + S.T)
+        # the laws integrated over the sub-grid gap field (by name), and the ones collocated
+        self.integrated = {}
+        if self.subgrid and self.contact_model != "hertz-closure":
+            from .subgrid import SubgridStep
+
+            self.integrated = {name: SubgridStep(law, g.nodes, g.radius)
+                               for name, law in self.effects.items()
+                               if getattr(law, "SUBGRID", False)}
+        self.collocated = {k: v for k, v in self.effects.items() if k not in self.integrated}
+
+    @property
+    def banded(self):
+        """True when a law is integrated sub-grid: the law Jacobian is then tridiagonal."""
+        return bool(self.integrated)
+
+    def require_collocated(self, solver):
+        """Raise ValueError (one line) for a solver that takes only a diagonal law Jacobian
+        when a law is integrated sub-grid (build the problem with ``subgrid=False``)."""
+        if self.integrated:
+            raise ValueError(f"{solver} takes collocated laws only; the problem integrates "
+                             f"{sorted(self.integrated)} sub-grid (build it with subgrid=False)")
 
     @property
     def contact_model(self):
@@ -80,16 +109,19 @@ class ContactProblem:
         # the nodes of the fine band (all, on a uniform grid): a graded far field never comes
         # close, and its wide annuli are softer by design
         k_node = float(np.min(np.diag(self.K)[self.grid.fine]))
-        if not self.effects:
+        if not self.collocated:
             return 0.0, math.nan, 0.0, k_node
         if self.sigma is not None:
             floor = self.sigma
         else:
             scan = np.logspace(-7, -11, 4000)            # 100 nm down to 0.01 nm
-            repulsive = np.flatnonzero(self.pressure(scan) < 0)
+            repulsive = np.flatnonzero(self._sum("pressure", scan) < 0)
             floor = float(scan[repulsive[0]]) if repulsive.size else float(scan[-1])
         h = floor * np.logspace(0, 2, 400)
-        soft = -self.dpressure(h)
+        # the collocated laws pointwise; a sub-grid law is left out: its nodal softening is
+        # not its pointwise -P'(h) (P0/(4w) for a step) but depends on the gap's slope
+        # across the node, which :meth:`node_softening_ratio` measures on the states
+        soft = -self._sum("dpressure", h, self.collocated)
         k = int(np.argmax(soft))
         return float(max(soft[k], 0.0) / k_node), float(h[k]), float(soft[k]), k_node
 
@@ -97,18 +129,76 @@ class ContactProblem:
         """b(r_k; d) (m) at the nodes."""
         return d + self.shape
 
+    def _nodal(self, h):
+        """True when h is a field of nodal gaps (shape (n,)) and a law is integrated
+        sub-grid; any other array is a set of gaps at which the laws are evaluated
+        pointwise (scans, the contact gap)."""
+        return bool(self.integrated) and np.shape(h) == (self.grid.n,)
+
     def pressure(self, h):
-        """Sum of the effect pressures (Pa, attractive positive) at gaps h."""
-        return self._sum("pressure", h)
+        """Sum of the effect pressures (Pa, attractive positive) at gaps h: at the nodes
+        (h of shape (n,)) a sub-grid law's nodal pressure f_k / area_k, else every law
+        pointwise."""
+        if not self._nodal(h):
+            return self._sum("pressure", h)
+        out = self._sum("pressure", h, self.collocated)
+        for name, sub in self.integrated.items():
+            out = out + self._finite(name, "pressure", sub.force(h) / self.areas, h)
+        return out
 
     def dpressure(self, h):
-        """d/dh of :meth:`pressure` (Pa/m)."""
-        return self._sum("dpressure", h)
+        """d/dh of :meth:`pressure` (Pa/m); at the nodes with a sub-grid law, the diagonal
+        d P_k / d h_k of the (tridiagonal) law Jacobian :meth:`law_jacobian`."""
+        if not self._nodal(h):
+            return self._sum("dpressure", h)
+        out = self._sum("dpressure", h, self.collocated)
+        for name, sub in self.integrated.items():
+            out = out + self._finite(name, "dpressure", sub.stiffness(h)[0] / self.areas, h)
+        return out
 
-    def _sum(self, part, h):
-        """Sum of one part of every law; a non-finite value stops the solve where it arose."""
-        out = np.zeros_like(h)
+    def law_jacobian(self, h):
+        """J = dP/dh (Pa/m) of the nodal pressures at nodal gaps h: a vector (the diagonal)
+        when every law is collocated, else the dense (n, n) matrix diag(1/area) T with T the
+        symmetric tridiagonal d f / d h of the sub-grid laws plus the collocated diagonal."""
+        if not self.integrated:
+            return self.dpressure(h)
+        a = self.areas
+        diag = self._sum("dpressure", h, self.collocated)
+        off = np.zeros(a.size - 1)
+        for name, sub in self.integrated.items():
+            d, o = sub.stiffness(h)
+            diag = diag + self._finite(name, "dpressure", d / a, h)
+            off = off + o
+        n = a.size
+        J = np.zeros((n, n))
+        flat = J.reshape(-1)
+        flat[::n + 1] = diag
+        flat[1::n + 1] = off / a[:-1]          # row k, column k + 1: T_k,k+1 / area_k
+        flat[n::n + 1] = off / a[1:]           # row k + 1, column k
+        return J
+
+    def effect_pressures(self, h):
+        """Each law's nodal pressure (Pa) at nodal gaps h, by name (what a State carries:
+        :func:`femadh.contact.forces.state_forces` sums area x pressure)."""
+        out = {}
         for name, eff in self.effects.items():
+            sub = self.integrated.get(name)
+            out[name] = eff.pressure(h) if sub is None else sub.force(h) / self.areas
+        return out
+
+    @staticmethod
+    def _finite(name, part, v, h):
+        if not np.all(np.isfinite(v)):
+            k = int(np.flatnonzero(~np.isfinite(v))[0])
+            raise ConvergenceError(f"law {name!r}: {part} is not finite at node {k} "
+                                   f"(gap h = {np.ravel(h)[k]:.6g} m)")
+        return v
+
+    def _sum(self, part, h, laws=None):
+        """Sum of one part of every law (or of ``laws``), pointwise; a non-finite value stops
+        the solve where it arose."""
+        out = np.zeros_like(h)
+        for name, eff in (self.effects if laws is None else laws).items():
             v = getattr(eff, part)(h)
             if not np.all(np.isfinite(v)):
                 k = int(np.flatnonzero(~np.isfinite(v))[0])
@@ -124,8 +214,10 @@ class ContactProblem:
         merit function that decides where the surface lands after a jump.
         """
         h = self.contour(d) - w
-        u = sum(eff.energy(h) for eff in self.effects.values()) if self.effects else 0.0 * h
-        return 0.5 * w @ (self.S_sym @ w) + self.areas @ u
+        u = sum(eff.energy(h) for eff in self.collocated.values()) if self.collocated \
+            else 0.0 * h
+        sub = sum(s.energy(h) for s in self.integrated.values())
+        return 0.5 * w @ (self.S_sym @ w) + self.areas @ u + sub
 
     def energy_gradient(self, w, d):
         h = self.contour(d) - w
@@ -133,7 +225,17 @@ class ContactProblem:
 
     def energy_hessian(self, h, free=None):
         """Symmetric Hessian (N/m) of :meth:`energy` at gaps h, on the nodes ``free`` (mask;
-        all by default): sym(S) + diag(area P'(h)). Positive definite = a stable state."""
+        all by default): sym(S) + diag(area P'(h)), with a sub-grid law's tridiagonal
+        T = df/dh in place of its diagonal. Positive definite = a stable state."""
+        if self.integrated:
+            # area x J is the symmetric tridiagonal T (plus the collocated diagonal)
+            J, a, n = self.law_jacobian(h), self.areas, self.grid.n
+            H = self.S_sym.copy()
+            flat = H.reshape(-1)
+            flat[::n + 1] += a * np.diagonal(J)
+            flat[1::n + 1] += a[:-1] * np.diagonal(J, 1)
+            flat[n::n + 1] += a[1:] * np.diagonal(J, -1)
+            return H if free is None else H[np.ix_(free, free)]
         if free is None:
             H = self.S_sym.copy()
             H[np.diag_indices_from(H)] += self.areas * self.dpressure(h)
@@ -151,7 +253,10 @@ class ContactProblem:
         out: inside the contact of a grid whose fine band follows the edge (coarse there by
         design) they are pinned by the constraint, and the edge, where nodes are released or
         join, is always in the band. On a uniform grid or a static band [0, r_b] every node
-        that reaches the floor has the finest spacing (the ratio is the max over all)."""
+        that reaches the floor has the finest spacing (the ratio is the max over all).
+
+        With a sub-grid law, -P'(h_k) is the diagonal -T_kk / area_k of its integrated
+        stiffness: the energy's curvature when node k moves alone against S_kk = area_k K_kk."""
         ratio = -self.dpressure(h) / np.diag(self.K)
         if self.sigma is not None:
             keep = (h > self.sigma * (1 + 1e-9)) | self.finest_nodes

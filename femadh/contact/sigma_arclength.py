@@ -83,6 +83,7 @@ class _Piece:
     """
 
     def __init__(self, problem, active, scale, tol, curve):
+        problem.require_collocated("the sigma-gap arclength tracer")
         self.problem, self.scale, self.tol, self.curve = problem, scale, tol, curve
         self.active = np.asarray(active, bool).copy()
         self.I = np.flatnonzero(~self.active)

@@ -12,6 +12,10 @@ with S a logistic step of width w (a small fraction of h_fill) so that the law i
 Newton; U(h) = -(gamma/|r_K|) w softplus((h_fill - h)/w), dU/dh = P. For a rigid sphere
 with R >> |r_K| >> t the force is 4 pi R gamma (1 + t/|r_K|): the textbook limit.
 The surface-tension ring force at the meniscus edge (relative size ~ sqrt(|r_K|/R)) is left out.
+
+On the Green path the contact problem integrates this law over the gap field between the nodes
+(``SUBGRID``; :mod:`femadh.contact.subgrid`): the edge is ~w / |dh/dr| wide in r, far narrower
+than a node's annulus where the gap is shallow, and collocated it snaps node by node.
 """
 from dataclasses import dataclass
 
@@ -23,6 +27,8 @@ from .step import SmoothStepLaw
 class CapillaryCondensate(SmoothStepLaw):
     """Attributes: surface_tension gamma (N/m), kelvin_radius r_K (m, < 0), film t (m),
     width w (m) of the smoothed meniscus edge."""
+
+    SUBGRID = True
 
     surface_tension: float
     kelvin_radius: float

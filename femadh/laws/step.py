@@ -7,7 +7,15 @@ import numpy as np
 
 
 class SmoothStepLaw:
-    """Mixin: subclasses provide ``_amplitude`` (P0, Pa), ``_center`` (h_c, m), ``width`` (m)."""
+    """Mixin: subclasses provide ``_amplitude`` (P0, Pa), ``_center`` (h_c, m), ``width`` (m).
+
+    ``SUBGRID``: whether the contact problem integrates the step over the gap field between
+    the nodes (:mod:`femadh.contact.subgrid`) rather than collocating it at the nodes. Off by
+    default (eq 20's asperity adhesion sits on the sigma-gap and stays as it was); the
+    capillary condensate, whose edge is narrower than the gap change across a node, sets it.
+    """
+
+    SUBGRID = False
 
     def _x(self, h):
         return (self._center - np.asarray(h, float)) / self.width

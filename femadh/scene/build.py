@@ -77,4 +77,7 @@ def build_problem(scene, operator=None, progress=None):
     from ..contact import ContactProblem
 
     operator = operator or build_operator(scene, progress)
-    return ContactProblem(operator, scene.sphere, dict(scene.effects), scene.gap)
+    # sub-grid step laws (a tridiagonal law Jacobian) on the stepping solvers; the arclength
+    # tracers take a diagonal one and keep the laws collocated
+    return ContactProblem(operator, scene.sphere, dict(scene.effects), scene.gap,
+                          subgrid=getattr(scene, "continuation", "steps") != "arclength")
