@@ -58,6 +58,8 @@ C_XTOL = 1e-8
 #: relative accuracy in c of the largest tension's location: the value at a smooth maximum
 #: is off by ~(this)^2 relative
 MAX_XTOL = 1e-4
+#: solves the maximum search may take (a smooth maximum: 2-4)
+MAX_PARABOLA = 30
 #: the branch ends after this many states (a cap: a healthy branch takes 30-80)
 MAX_STATES = 2000
 
@@ -167,6 +169,24 @@ class EdgeBranch:
         self.n_solves = 0
         self.n_iter = 0
         self._base = ContactProblem(base, sphere, effects, check_laws=False)
+        # the laws' own pressure and derivative, called directly in the Newton loop (the
+        # problem's sum checks every law's values for NaN at every call: here one check of
+        # the residual, which any non-finite pressure makes non-finite, does it per iteration)
+        self._laws = tuple(effects.values())
+        idx = np.arange(self.n)
+        self._diag = idx * (self.n + 2)         # flat indices of J's first n diagonal entries
+
+    def _pressure(self, h):
+        P = self._laws[0].pressure(h)
+        for law in self._laws[1:]:
+            P = P + law.pressure(h)
+        return P
+
+    def _dpressure(self, h):
+        D = self._laws[0].dpressure(h)
+        for law in self._laws[1:]:
+            D = D + law.dpressure(h)
+        return D
 
     def problem(self, c):
         """The problem on the grid whose node k sits at c (m): the reference problem with its
@@ -190,10 +210,11 @@ class EdgeBranch:
 
     def _jacobian(self, pb, D):
         n, k = self.n, self.k
-        J = np.zeros((n + 1, n + 1))
+        J = np.empty((n + 1, n + 1))
         J[:n, :n] = pb.K
-        J[np.arange(n), np.arange(n)] += D
+        J.ravel()[self._diag] += D
         J[:n, n] = -D
+        J[n, :] = 0.0
         J[n, k] = -1.0
         J[n, n] = 1.0
         return J
@@ -206,19 +227,24 @@ class EdgeBranch:
         n, k, ge = self.n, self.k, self.edge_gap
         w, d = np.array(w0, float), float(d0)
         self.n_solves += 1
+        contour, C, K = pb.shape + 0.0, pb.C, pb.K
         for it in range(1, MAX_ITER + 1):
             safe_point()
-            h = pb.contour(d) - w
-            if np.any(h <= 0):
+            h = (contour + d) - w
+            if h.min() <= 0:
                 return None
-            P = pb.pressure(h)
-            res = float(np.max(np.abs(w - pb.C @ P)))
+            P = self._pressure(h)
+            res = float(np.abs(w - C @ P).max())
+            if not math.isfinite(res):
+                raise ConvergenceError(f"edge branch: the law's pressure is not finite at "
+                                       f"c = {c:.6g} m (smallest gap {h.min():.6g} m)",
+                                       d=d, residual=res, n_iter=it - 1)
             g = h[k] - ge
             if res <= self.tol and abs(g) <= 1e-9 * ge:
                 self.n_iter += it - 1
                 return EdgeState(c, d, w, it - 1, res, pb)
-            D = pb.dpressure(h)
-            rhs = np.r_[P - pb.K @ w, -g]
+            D = self._dpressure(h)
+            rhs = np.r_[P - K @ w, -g]
             lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
             if info > 0:
                 return None
@@ -227,9 +253,9 @@ class EdgeBranch:
                 return None
             closing = dx[:n] - dx[n]        # dh = dd - dw: gaps close where dw > dd
             alpha = 1.0
-            if np.any(closing > 0):
-                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[closing > 0]
-                                              / closing[closing > 0])))
+            if closing.max() > 0:
+                pos = closing > 0
+                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / closing[pos])))
             w = w + alpha * dx[:n]
             d = d + alpha * dx[n]
         self.n_iter += MAX_ITER
@@ -282,7 +308,11 @@ class BranchTrace:
 
     def at(self, c):
         """The state at edge radius c (from the traced states); ConvergenceError if Newton
-        fails."""
+        fails. A traced state at exactly c is returned as it is (the root and maximum
+        searches start from brackets of traced states)."""
+        for st in self.states:
+            if st.c == c:
+                return st
         w0, d0 = self._guess(c)
         st = self.branch.solve(c, w0, d0)
         if st is None:
@@ -327,7 +357,8 @@ class BranchTrace:
 
         def slope(c):
             st = self.at(c)
-            st.dd_dc = self.branch.slope(st)
+            if math.isnan(st.dd_dc):
+                st.dd_dc = self.branch.slope(st)
             cache[c] = st
             return st.dd_dc
         c = optimize.brentq(slope, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
@@ -344,16 +375,33 @@ class BranchTrace:
         c = optimize.brentq(f, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
         return cache.get(c) or self.at(c)
 
-    def maximize(self, value, lo, hi):
-        """The state of largest value(state) between edge radii lo and hi (bounded Brent)."""
-        best = []
-
-        def neg(c):
-            st = self.at(c)
-            v = value(st)
-            if not best or v > best[0]:
-                best[:] = [v, st]
-            return -v
-        optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
-                                 options={"xatol": MAX_XTOL * hi})
-        return best[0], best[1]
+    def maximize(self, value, lo, mid, hi):
+        """The state of largest value(state) in the bracket of traced states lo < mid < hi
+        (value(mid) >= value(lo), value(hi)): successive parabolic interpolation through the
+        three best states, which keep bracketing the maximum (a smooth maximum: the vertex
+        converges superlinearly; a vertex outside the bracket or too near a known state is
+        replaced by a golden-section point). Stops when the vertex moves by less than
+        MAX_XTOL of c, after at most MAX_PARABOLA solves. Returns (value, state)."""
+        pts = [(st.c, value(st), st) for st in (lo, mid, hi)]
+        for _ in range(MAX_PARABOLA):
+            (a, fa, _), (b, fb, _), (c, fc, _) = pts
+            num = (b - a) ** 2 * (fb - fc) - (b - c) ** 2 * (fb - fa)
+            den = (b - a) * (fb - fc) - (b - c) * (fb - fa)
+            x = b - 0.5 * num / den if den != 0 else math.nan
+            tol = MAX_XTOL * c
+            if abs(x - b) <= tol:       # the vertex is on the best state: located
+                break
+            if not (a + tol < x < c - tol):
+                # a degenerate vertex: golden section in the larger half
+                x = b + 0.381966 * ((c - b) if c - b > b - a else (a - b))
+            st = self.at(x)
+            fx = value(st)
+            if fx > fb:     # the new best: the old one bounds on its side
+                pts = [pts[0], (x, fx, st), pts[1]] if x < b else [pts[1], (x, fx, st), pts[2]]
+            else:           # the best stays: x bounds on its side
+                pts = [(x, fx, st), pts[1], pts[2]] if x < b else [pts[0], pts[1], (x, fx, st)]
+        else:
+            raise ConvergenceError(f"edge branch: the largest value between c = {lo.c:.6g} "
+                                   f"and {hi.c:.6g} m not located in {MAX_PARABOLA} solves",
+                                   d=pts[1][2].d, residual=math.nan, n_iter=MAX_PARABOLA)
+        return pts[1][1], pts[1][2]
