@@ -223,8 +223,12 @@ class EdgeBranch:
         """The state with its edge at c (m) from the guess (w0, d0) (Newton, steps limited so
         that no gap closes by more than GAP_CLOSURE of itself). Returns an EdgeState, or
         None if Newton did not converge in MAX_ITER iterations."""
-        pb = self.problem(c)
-        n, k, ge = self.n, self.k, self.edge_gap
+        return self._newton(self.problem(c), c, w0, d0, self.edge_gap)
+
+    def _newton(self, pb, c, w0, d0, ge):
+        """Newton on K w - P(h) = 0, h_k = ge on the problem pb from (w0, d0); the state is
+        labelled by the parameter c. Returns an EdgeState or None."""
+        n, k = self.n, self.k
         w, d = np.array(w0, float), float(d0)
         self.n_solves += 1
         contour, C, K = pb.shape + 0.0, pb.C, pb.K
@@ -275,6 +279,54 @@ class EdgeBranch:
             raise ConvergenceError("edge branch: singular Jacobian", d=st.d,
                                    residual=st.residual, n_iter=0)
         return float(lapack.dgetrs(lu, piv, rhs)[0][n])
+
+
+class CentreGapBranch(EdgeBranch):
+    """Solves of the approach branch (no contact yet) at given centre gaps, on one grid.
+
+    Before the jump-in the surface bulges towards the sphere and the gap at r = 0,
+    g = d - w(0), decreases monotonically along the branch, through the jump-in fold (d(g)
+    has its smallest value there: a root of dd/dg, not a turning point of g). The branch is
+    therefore traced by plain Newton in g with the same unknowns (w, d) and the same pinned
+    gap as the contact branch's edge node, here node 0 at g: K w - P(h) = 0, h_0 - g = 0.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        The approach grid's problem (a node at r = 0).
+    tol : float
+        Residual of eq (6) every state meets (m).
+    """
+
+    def __init__(self, problem, tol):
+        if problem.grid.nodes[0] != 0.0:
+            raise ValueError("centre-gap branch: the grid needs a node at r = 0")
+        self.pb, self.k, self.n, self.tol = problem, 0, problem.grid.n, tol
+        self.sphere, self.effects = problem.sphere, problem.effects
+        self.n_solves = 0
+        self.n_iter = 0
+        self._laws = tuple(problem.effects.values())
+        self._diag = np.arange(self.n) * (self.n + 2)
+
+    def problem(self, g):
+        return self.pb
+
+    def solve(self, g, w0, d0):
+        """The approach state of centre gap g (m) from the guess (w0, d0); an EdgeState
+        (``c`` = g) or None if Newton did not converge."""
+        return self._newton(self.pb, g, w0, d0, g)
+
+    def slope(self, st):
+        """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
+        h = self.pb.contour(st.d) - st.w
+        rhs = np.zeros(self.n + 1)
+        rhs[self.n] = 1.0
+        lu, piv, info = lapack.dgetrf(self._jacobian(self.pb, self._dpressure(h)),
+                                      overwrite_a=True)
+        if info > 0:
+            raise ConvergenceError("centre-gap branch: singular Jacobian", d=st.d,
+                                   residual=st.residual, n_iter=0)
+        return float(lapack.dgetrs(lu, piv, rhs)[0][self.n])
 
 
 def tail_energy_change(law, radius, a, d1, d2):

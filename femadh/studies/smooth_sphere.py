@@ -378,7 +378,8 @@ def trace_edge_point(setup, tol):
         The headline quantities in SI (pull_off, pull_off_displacement (N), jump_in,
         jump_out (m), hysteresis, loop_work (J)) and the states and counts the map reports.
     """
-    from ..contact.edge_branch import BranchTrace, EdgeBranch, edge_grid, tail_energy_change
+    from ..contact.edge_branch import (BranchTrace, CentreGapBranch, EdgeBranch, edge_grid,
+                                       tail_energy_change)
 
     law, z0, R = setup.law, setup.z0, setup.radius
     ell, h = setup.ell, setup.spacing
@@ -386,20 +387,28 @@ def trace_edge_point(setup, tol):
     def force(pb, d, w):
         return lj_force(pb, law, d, w)
 
-    # approach branch: the centre band of the point's family, up to the jump-in fold
+    # approach branch: the centre band of the point's family, traced in its centre gap g
+    # (d(g) is smooth through the jump-in fold, its minimum) up to the fold
     app = setup.problem(0.0)
     # (from beyond Maugis-Dugdale's jump-out: the approach state at the traced jump-out is
     # found there, or solved on its own if the traced one lies further out)
     d_app = min(setup.d_start, max(APPROACH_START * setup.d_out_md, setup.d_out_md + z0))
-    curve = trace_curve(app, d_app, setup.d_end, tol=tol, scale=z0, ds=0.2,
-                        ds_max=max(DS_MAX, APPROACH_DS * d_app / z0),
-                        stop=lambda cv: bool(cv.folds), max_points=20000,
-                        target_correction=TRACE_CORRECTION)
-    if not curve.folds:
+    abranch = CentreGapBranch(app, tol)
+    atr = BranchTrace(abranch)
+    g_app = d_app + float(app.shape[0])
+    first = abranch.solve(g_app, np.zeros(app.grid.n), d_app)
+    if first is None:
+        raise ConvergenceError(f"edge trace: no approach state at d = {d_app / z0:.4g} z0",
+                               d=d_app)
+    atr.states.append(first)
+    g_floor = z0     # below it the centre is in repulsive contact: no jump-in before
+    arun = atr.march(first, -1, lambda run: (len(run) >= 3 and run[-1].d > run[-2].d)
+                     or run[-1].c < g_floor)
+    if arun[-1].c < g_floor or len(arun) < 3:
         raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
-                               f"d = {curve.points[-1].d / z0:.4g} z0", d=curve.points[-1].d)
-    fin = curve.folds[0]
-    apts = curve.points[:fin.index + 1]
+                               f"the centre gap {arun[-1].c / z0:.4g} z0", d=arun[-1].d)
+    fin = atr.fold(arun[-1].c, arun[-3].c)
+    apts = sorted([s for s in atr.states if s.c > fin.c], key=lambda s: -s.c)
     # contact branch: reference grid fine around its node k at JKR's load-controlled
     # pull-off radius (9 pi dg R^2 / 8 E*)^(1/3), where it starts (the
     # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
@@ -454,11 +463,14 @@ def trace_edge_point(setup, tol):
                                "is not stable", d=fin.d)
     # the retract path leaves the contact at the fold and lands on the approach branch
     d_out = fout.d
-    pba = curve.problem_of(0)
+    pba = app
     ia = next((i for i in range(len(apts) - 1)
                if (apts[i].d - d_out) * (apts[i + 1].d - d_out) <= 0), None)
     if ia is not None:
-        w_out = curve.point_at(ia, d_out)
+        w_out = atr.where_d(d_out, apts[ia + 1].c, apts[ia].c).w
+    elif d_out < fin.d:
+        raise ConvergenceError(f"edge trace: the jump-out separation {d_out / z0:.4g} z0 lies "
+                               f"below the jump-in's {fin.d / z0:.4g} z0", d=d_out)
     else:   # beyond the traced approach branch: Newton from the undeformed surface
         out = solve_complementarity(pba, d_out, np.zeros(pba.grid.n), tol=tol, max_iter=60)
         if not (out.converged and out.stable
@@ -505,12 +517,12 @@ def trace_edge_point(setup, tol):
         "nodes": max(app.grid.n, grid.n), "nodes_approach": app.grid.n, "nodes_contact": grid.n,
         "n_points": len(apts) + len(all_c), "n_approach": len(apts),
         "n_branch_solves": branch.n_solves,
-        "n_solves": curve.n_solves + branch.n_solves,
-        "n_newton": branch.n_iter,
-        "n_folds": len(curve.folds) + 1,
+        "n_solves": abranch.n_solves + branch.n_solves,
+        "n_newton": abranch.n_iter + branch.n_iter,
+        "n_folds": 2,
         "curve_d": np.r_[da, fin.d, [s.d for s in all_c]],
         "curve_F": np.r_[fa, force(pba, fin.d, fin.w), [F(s) for s in all_c]],
         "curve_stable": np.r_[np.ones(len(apts), bool), False, [s.c > fout.c for s in all_c]],
         "approach": (app_d, app_F), "retract": (ret_d, ret_F),
-        "n_factor": curve.n_factor + branch.n_iter, "n_krylov": curve.n_krylov,
+        "n_factor": abranch.n_iter + branch.n_iter, "n_krylov": 0,
     }
