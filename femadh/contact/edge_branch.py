@@ -31,6 +31,7 @@ pull-off the largest tension, the landing after the jump-in the root of d(c) = d
 """
 from dataclasses import dataclass
 import copy
+import functools
 import math
 
 import numpy as np
@@ -232,6 +233,7 @@ class EdgeBranch:
         w, d = np.array(w0, float), float(d0)
         self.n_solves += 1
         contour, C, K = pb.shape + 0.0, pb.C, pb.K
+        rhs = np.empty(n + 1)
         for it in range(1, MAX_ITER + 1):
             safe_point()
             h = (contour + d) - w
@@ -248,7 +250,8 @@ class EdgeBranch:
                 self.n_iter += it - 1
                 return EdgeState(c, d, w, it - 1, res, pb)
             D = self._dpressure(h)
-            rhs = np.r_[P - K @ w, -g]
+            rhs[:n] = P - K @ w
+            rhs[n] = -g
             lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
             if info > 0:
                 return None
@@ -273,7 +276,9 @@ class EdgeBranch:
         D = pb.dpressure(h)
         r = pb.grid.nodes
         dshape = self.sphere.slope(r) * r / st.c          # d shape(r_i(c)) / dc
-        rhs = -np.r_[-(pb.K @ st.w) / st.c - D * dshape, dshape[k]]
+        rhs = np.empty(n + 1)
+        rhs[:n] = (pb.K @ st.w) / st.c + D * dshape
+        rhs[n] = -dshape[k]
         lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
         if info > 0:
             raise ConvergenceError("edge branch: singular Jacobian", d=st.d,
@@ -329,6 +334,15 @@ class CentreGapBranch(EdgeBranch):
         return float(lapack.dgetrs(lu, piv, rhs)[0][self.n])
 
 
+@functools.lru_cache(maxsize=8)
+def gauss_legendre(n):
+    """Nodes and weights of n-point Gauss-Legendre on [-1, 1] (computed once per n: an
+    eigenvalue problem of ~1 ms, a tenth of a small member's trace)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
+
+
 def tail_energy_change(law, radius, a, d1, d2):
     """E_tail(d1) - E_tail(d2) (J): the change of the interaction energy beyond the analysis
     radius a of a rigid paraboloid, E_tail(d) = 2 pi int_a^inf U(d + r^2/2R) r dr
@@ -336,7 +350,7 @@ def tail_energy_change(law, radius, a, d1, d2):
     2 pi R int_b1^b2 U(h) dh: 16-point Gauss-Legendre (U is smooth at these gaps, b >= 20 z0
     at the smallest analysis radius)."""
     b1, b2 = d1 + a * a / (2 * radius), d2 + a * a / (2 * radius)
-    x, wq = np.polynomial.legendre.leggauss(16)
+    x, wq = gauss_legendre(16)
     h = 0.5 * (b1 + b2) + 0.5 * (b2 - b1) * x
     return 2 * math.pi * radius * 0.5 * (b2 - b1) * float(wq @ law.energy(h))
 

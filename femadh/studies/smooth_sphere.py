@@ -157,6 +157,8 @@ class Resolution:
         On the JKR side, trace the contact branch on a grid whose nodes move with the edge
         (:func:`trace_edge_point`; the default); False: the whole curve by arclength on the
         moving band (:func:`trace_point`).
+    edge_grading : float or None
+        Grading length (units of ell) of the edge-following contact grid; None: EDGE_GRADING.
     """
 
     spacing: float = SPACING
@@ -167,6 +169,7 @@ class Resolution:
     stiffness_target: float | None = None
     min_nodes: int | None = None
     follow_edge: bool = True
+    edge_grading: float | None = None
 
     @property
     def legacy(self):
@@ -379,7 +382,7 @@ def trace_edge_point(setup, tol):
         jump_out (m), hysteresis, loop_work (J)) and the states and counts the map reports.
     """
     from ..contact.edge_branch import (BranchTrace, CentreGapBranch, EdgeBranch, edge_grid,
-                                       tail_energy_change)
+                                       gauss_legendre, tail_energy_change)
 
     law, z0, R = setup.law, setup.z0, setup.radius
     ell, h = setup.ell, setup.spacing
@@ -415,7 +418,8 @@ def trace_edge_point(setup, tol):
     c0 = (9 * math.pi * setup.dg * R * R / (8 * setup.e_star)) ** (1 / 3)
     a_ref = EDGE_RADIUS_MARGIN * setup.a
     half = EDGE_BAND * ell
-    grid, k = edge_grid(a_ref, c0, h, half, EDGE_GRADING * ell)
+    grading = (setup.res.edge_grading or EDGE_GRADING) * ell
+    grid, k = edge_grid(a_ref, c0, h, half, grading)
     base = GreenOperator(grid, setup.e_star)
     branch = EdgeBranch(base, k, setup.sphere, {"law": law}, EDGE_GAP * z0, tol)
     # a grid whose nodes snap on their own cannot carry the edge (a priori, at the law's
@@ -484,7 +488,7 @@ def trace_edge_point(setup, tol):
     # less the same along the approach branch (its energy difference on one grid: F = dE/dd
     # with the exact tail). Energies of states on grids of different analysis radii are not
     # compared: the deformation beyond the radius is not modelled, differently on each
-    x, wq = np.polynomial.legendre.leggauss(HYSTERESIS_NODES)
+    x, wq = gauss_legendre(HYSTERESIS_NODES)
     half_c, mid_c = 0.5 * (land.c - fout.c), 0.5 * (land.c + fout.c)
     contact_work = 0.0
     for xi, wi in zip(x, wq):
