@@ -51,8 +51,13 @@ STEP0 = 0.02
 #: largest and smallest relative steps in c
 STEP_MAX = 0.08
 STEP_MIN = 1e-5
-#: Newton iterations a step aims at (the step grows below, shrinks above)
+#: Newton iterations a step aims at (the step grows below, shrinks above; a state's count is
+#: its factorisations plus its chord steps / CHORD_PER_FACTOR)
 TARGET_ITER = 4
+#: the Newton loop keeps its factorisation while each step cuts the residual to below this
+#: fraction of the previous one (chord steps), and refactorises otherwise
+CHORD_RATE = 0.1
+CHORD_PER_FACTOR = 3
 #: relative accuracy in c of the fold and of the landing (root finding: the fold's tension and
 #: the landing's work move by ~this relative to themselves)
 C_XTOL = 1e-8
@@ -169,6 +174,7 @@ class EdgeBranch:
         self.n = base.grid.n
         self.n_solves = 0
         self.n_iter = 0
+        self.n_factor = 0
         self._base = ContactProblem(base, sphere, effects, check_laws=False)
         # the laws' own pressure and derivative, called directly in the Newton loop (the
         # problem's sum checks every law's values for NaN at every call: here one check of
@@ -234,6 +240,9 @@ class EdgeBranch:
         self.n_solves += 1
         contour, C, K = pb.shape + 0.0, pb.C, pb.K
         rhs = np.empty(n + 1)
+        lu = None
+        last = math.inf         # the residual before the last step
+        n_lu = 0
         for it in range(1, MAX_ITER + 1):
             safe_point()
             h = (contour + d) - w
@@ -248,13 +257,21 @@ class EdgeBranch:
             g = h[k] - ge
             if res <= self.tol and abs(g) <= 1e-9 * ge:
                 self.n_iter += it - 1
-                return EdgeState(c, d, w, it - 1, res, pb)
-            D = self._dpressure(h)
+                self.n_factor += n_lu
+                return EdgeState(c, d, w, n_lu + (it - 1 - n_lu) // CHORD_PER_FACTOR,
+                                 res, pb)
+            r = max(res, abs(g))
             rhs[:n] = P - K @ w
             rhs[n] = -g
-            lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
-            if info > 0:
-                return None
+            # chord: the last factorisation serves while it contracts the residual by
+            # CHORD_RATE per step (a solve with it costs ~1/10 of a factorisation)
+            if lu is None or r > CHORD_RATE * last:
+                lu, piv, info = lapack.dgetrf(self._jacobian(pb, self._dpressure(h)),
+                                              overwrite_a=True)
+                n_lu += 1
+                if info > 0:
+                    return None
+            last = r
             dx = lapack.dgetrs(lu, piv, rhs)[0]
             if not np.all(np.isfinite(dx)):
                 return None
@@ -265,6 +282,7 @@ class EdgeBranch:
                 alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / closing[pos])))
             w = w + alpha * dx[:n]
             d = d + alpha * dx[n]
+        self.n_factor += n_lu
         self.n_iter += MAX_ITER
         return None
 
@@ -310,6 +328,7 @@ class CentreGapBranch(EdgeBranch):
         self.sphere, self.effects = problem.sphere, problem.effects
         self.n_solves = 0
         self.n_iter = 0
+        self.n_factor = 0
         self._laws = tuple(problem.effects.values())
         self._diag = np.arange(self.n) * (self.n + 2)
 

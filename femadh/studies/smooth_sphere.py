@@ -528,5 +528,5 @@ def trace_edge_point(setup, tol):
         "curve_F": np.r_[fa, force(pba, fin.d, fin.w), [F(s) for s in all_c]],
         "curve_stable": np.r_[np.ones(len(apts), bool), False, [s.c > fout.c for s in all_c]],
         "approach": (app_d, app_F), "retract": (ret_d, ret_F),
-        "n_factor": abranch.n_iter + branch.n_iter, "n_krylov": 0,
+        "n_factor": abranch.n_factor + branch.n_factor, "n_krylov": 0,
     }
