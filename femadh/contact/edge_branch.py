@@ -481,7 +481,7 @@ class BranchTrace:
                 x = b + 0.381966 * ((c - b) if c - b > b - a else (a - b))
             st = self.at(x)
             fx = value(st)
-            if fx > fb:     # the new best: the old one bounds on its side
+            if fx > fb:     # the new best (the old one bounds on its side)
                 pts = [pts[0], (x, fx, st), pts[1]] if x < b else [pts[1], (x, fx, st), pts[2]]
             else:           # the best stays: x bounds on its side
                 pts = [(x, fx, st), pts[1], pts[2]] if x < b else [pts[0], pts[1], (x, fx, st)]

@@ -16,17 +16,17 @@ displacement-controlled experiment follow from it. Read off the curve:
 Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277; Feng 2000,
 J. Colloid Interface Sci. 238, 318.
 
-Grid: where the curve is bistable (mu > 0.81) the contact branch is traced in its edge
-radius on a grid whose nodes move with the edge, the edge on a node at every state
-(:func:`~femadh.studies.smooth_sphere.trace_edge_point`, :mod:`femadh.contact.edge_branch`):
-no lattice wiggles, a fine band of +-2 ell around the edge only, nodes growing like ln mu
-(mu = 20 at 1e-3: 247 nodes, against 852 on the moving band); the approach branch by
-arclength to the jump-in fold. Elsewhere, and with ``Resolution(follow_edge=False)``, the
+Grid: where the curve is bistable (mu > 0.81) the contact branch is traced in its edge radius
+on a grid whose nodes move with the edge, the edge on a node at every state
+(:func:`~femadh.studies.smooth_sphere.trace_edge_point`, :mod:`femadh.contact.edge_branch`): no
+lattice wiggles, a fine band of +-2 ell around the edge only, nodes growing like ln mu (mu = 20
+at 1e-3: 247 nodes, against 852 on the moving band); the approach branch by Newton in its
+centre gap to the jump-in fold. Elsewhere, and with ``Resolution(follow_edge=False)``, the
 whole curve is traced by arclength on a band of uniform fine spacing that follows the contact
 edge in steps, graded beyond it (:class:`~femadh.studies.smooth_sphere.PointSetup`,
-:class:`Resolution`); ``band_offset`` reports how far the edge strayed from the band's
-centre, the guards refuse a point whose edge left it, whose nodes snap alone or whose contact
-reaches the analysis radius.
+:class:`Resolution`); ``band_offset`` reports how far the edge strayed from the band's centre,
+the guards refuse a point whose edge left it, whose nodes snap alone or whose contact reaches
+the analysis radius.
 
 Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
 grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).

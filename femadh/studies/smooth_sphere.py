@@ -368,12 +368,13 @@ def jkr_start(branch, setup, c):
 def trace_edge_point(setup, tol):
     """One bistable map point traced with the grid following the contact edge.
 
-    The approach branch (no contact yet) is traced by arclength
-    (:func:`~femadh.contact.arclength.trace_curve`) on a band at the centre up to the jump-in
-    fold; the contact branch by Newton in its edge radius c on a grid that moves with the edge
-    (:mod:`femadh.contact.edge_branch`), from JKR's pull-off radius down through the largest
-    tension to the jump-out fold and up past the landing of the jump-in. The unstable branch
-    between the folds is not traced: no headline quantity is read off it.
+    The approach branch (no contact yet) is traced by Newton in its centre gap g on the band at
+    the centre (:class:`~femadh.contact.edge_branch.CentreGapBranch`: d(g) is smooth through
+    the jump-in fold, its minimum) up to the jump-in fold; the contact branch by Newton in its
+    edge radius c on a grid that moves with the edge (:mod:`femadh.contact.edge_branch`), from
+    JKR's pull-off radius down through the largest tension to the jump-out fold and up past the
+    landing of the jump-in. The unstable branch between the folds is not traced: no headline
+    quantity is read off it.
 
     Returns
     -------
