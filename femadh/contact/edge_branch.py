@@ -405,11 +405,12 @@ class BranchTrace:
                                    d=d0, residual=math.nan, n_iter=MAX_ITER)
         return st
 
-    def march(self, start, direction, done):
-        """Trace from ``start`` (an EdgeState) in the direction of c (+1, -1) until
-        ``done(states_in_march_order)`` is True; the states join ``self.states``."""
+    def march(self, start, direction, done, step0=STEP0):
+        """Trace from ``start`` (an EdgeState) in the direction of c (+1, -1), the first
+        relative step ``step0``, until ``done(states_in_march_order)`` is True; the states
+        join ``self.states``."""
         run = [start]
-        step = STEP0
+        step = step0
         while not done(run):
             if len(self.states) + len(run) > MAX_STATES:
                 raise ConvergenceError(f"edge branch: more than {MAX_STATES} states",

@@ -339,6 +339,9 @@ EDGE_RADIUS_MARGIN = 3.0
 #: the surface barely deforms and the predictor is near exact
 APPROACH_START = 1.2
 APPROACH_DS = 0.05
+#: first relative step in the centre gap of the approach branch (the branch starts beyond the
+#: jump-out, where the surface barely deforms and the secant predictor is near exact)
+APPROACH_STEP0 = 0.08
 #: Gauss-Legendre nodes of the contact branch's work between the landing and the fold (F d'(c)
 #: is smooth in c: 6, 8 and 12 nodes agree to 1e-9 relative at mu = 1, 3, 20; 4 nodes move
 #: the hysteresis by 3.7e-7, 4e-8 and 1.2e-8 relative at mu = 1, 3, 20 (LJ, spacing 0.1 ell,
@@ -407,7 +410,7 @@ def trace_edge_point(setup, tol):
     atr.states.append(first)
     g_floor = z0     # below it the centre is in repulsive contact: no jump-in before
     arun = atr.march(first, -1, lambda run: (len(run) >= 3 and run[-1].d > run[-2].d)
-                     or run[-1].c < g_floor)
+                     or run[-1].c < g_floor, step0=APPROACH_STEP0)
     if arun[-1].c < g_floor or len(arun) < 3:
         raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
                                f"the centre gap {arun[-1].c / z0:.4g} z0", d=arun[-1].d)
