@@ -610,6 +610,10 @@ DEFECTS = [
     D("centre_gap_fold_state", "edge trace: the jump-in taken at the traced state before the "
       "fold, not located", "femadh/studies/smooth_sphere.py",
       (("    fin = atr.fold(arun[-1].c, arun[-3].c)\n", "    fin = arun[-2]\n"),)),
+    D("approach_at_separation_jacobian", "centre-gap branch: the fixed-separation Newton's "
+      "Jacobian with the law's stiffness subtracted", "femadh/contact/edge_branch.py",
+      (("J.ravel()[np.arange(n) * (n + 1)] += self._dpressure(h)",
+        "J.ravel()[np.arange(n) * (n + 1)] -= self._dpressure(h)"),)),
     D("parabola_stop_early", "edge branch: the maximum search stops once its vertex is "
       "within 300x MAX_XTOL of the best state", "femadh/contact/edge_branch.py",
       (("            if abs(x - b) <= tol:       # the vertex is on the best state",

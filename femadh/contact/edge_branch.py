@@ -340,6 +340,51 @@ class CentreGapBranch(EdgeBranch):
         (``c`` = g) or None if Newton did not converge."""
         return self._newton(self.pb, g, w0, d0, g)
 
+    def at_separation(self, d, w0):
+        """The approach state at separation d (m) from the guess w0 (interpolated between
+        two traced states that bracket d): Newton on K w - P(d + shape - w) = 0 with chord
+        steps as in :meth:`_newton`. Returns an EdgeState (``c`` = its centre gap) or None if
+        Newton did not converge."""
+        pb, n = self.pb, self.n
+        K, C = pb.K, pb.C
+        contour = pb.contour(d)
+        w = np.array(w0, float)
+        lu, last, n_lu = None, math.inf, 0
+        self.n_solves += 1
+        for it in range(1, MAX_ITER + 1):
+            safe_point()
+            h = contour - w
+            if h.min() <= 0:
+                return None
+            P = self._pressure(h)
+            res = float(np.abs(w - C @ P).max())
+            if not math.isfinite(res):
+                raise ConvergenceError(f"centre-gap branch: the law's pressure is not finite "
+                                       f"at d = {d:.6g} m", d=d, residual=res, n_iter=it - 1)
+            if res <= self.tol:
+                self.n_iter += it - 1
+                self.n_factor += n_lu
+                return EdgeState(float(h[0]), d, w, it - 1, res, pb)
+            if lu is None or res > CHORD_RATE * last:
+                J = K.copy()
+                J.ravel()[np.arange(n) * (n + 1)] += self._dpressure(h)
+                lu, piv, info = lapack.dgetrf(J, overwrite_a=True)
+                n_lu += 1
+                if info > 0:
+                    return None
+            last = res
+            dw = lapack.dgetrs(lu, piv, P - K @ w)[0]
+            if not np.all(np.isfinite(dw)):
+                return None
+            alpha = 1.0
+            if dw.max() > 0:        # gaps close where dw > 0
+                pos = dw > 0
+                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / dw[pos])))
+            w = w + alpha * dw
+        self.n_iter += MAX_ITER
+        self.n_factor += n_lu
+        return None
+
     def slope(self, st):
         """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
         h = self.pb.contour(st.d) - st.w

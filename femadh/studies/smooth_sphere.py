@@ -475,7 +475,14 @@ def trace_edge_point(setup, tol):
     ia = next((i for i in range(len(apts) - 1)
                if (apts[i].d - d_out) * (apts[i + 1].d - d_out) <= 0), None)
     if ia is not None:
-        w_out = atr.where_d(d_out, apts[ia + 1].c, apts[ia].c).w
+        # Newton at d_out from the states on either side (the approach branch is a function
+        # of d there); the state must lie between them in centre gap, else located in g
+        hi, lo = apts[ia], apts[ia + 1]
+        t = (d_out - hi.d) / (lo.d - hi.d)
+        st = abranch.at_separation(d_out, hi.w + t * (lo.w - hi.w))
+        if st is None or not lo.c <= st.c <= hi.c:
+            st = atr.where_d(d_out, lo.c, hi.c)
+        w_out = st.w
     elif d_out < fin.d:
         raise ConvergenceError(f"edge trace: the jump-out separation {d_out / z0:.4g} z0 lies "
                                f"below the jump-in's {fin.d / z0:.4g} z0", d=d_out)
