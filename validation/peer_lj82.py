@@ -97,9 +97,13 @@ pull-off's measured error model C spacing^2 (2 ell / G)^1.5 at half the request
 (femadh.studies.regime.pull_off_grading): 0.77 ell at 3e-3 (2 ell at 1e-4, where the band
 spacing sets the error).
 
-Before this change (main at 449d272, quiet machine): μ = 1 at 3e-3 54 ms (99 nodes, 41
-contact-branch solves and an arclength approach branch per member, achieved 3.0e-4 = a
-tenth of the request), μ = 3 at 3e-3 ~0.24 s inferred; 1e-4: 0.224 s and 1.027 s.
+Before this change (main at 449d272): μ = 1 at 3e-3 54 ms on a quiet machine (99 nodes,
+achieved 3.0e-4 = a tenth of the request); the fine member's counts 66 solves and 167 LU
+factorisations at μ = 1, 66 and 198 at μ = 3 (41 contact-branch solves and an arclength
+approach branch). Now 49 solves and 52 factorisations at μ = 1, 49 and 69 at μ = 3. Back to
+back at load 5.2 (one core free, wall = cpu), median of 9: μ = 1 63 -> 27.5 ms, μ = 3 87 ->
+32 ms; 1e-4 (pull-offs unchanged in their 6 printed digits): 0.224 s and 1.027 s before,
+quiet.
 
 Peer (ContactMechanics/Adhesion, our earlier run, not re-run here): μ = 1: {PEER[1.0]};
 μ = 3: {PEER[3.0]}.
