@@ -653,6 +653,28 @@ DEFECTS = [
     D("edge_radius_margin", "edge trace: the reference grid's radius equal to the point's "
       "(the grid shrinks below it at the fold)", "femadh/studies/smooth_sphere.py",
       (("EDGE_RADIUS_MARGIN = 3.0", "EDGE_RADIUS_MARGIN = 1.0"),)),
+    # -- the peer problem's cuts: approach branch in its centre gap, parabolic maximum,
+    #    the pull-off's grading
+    D("centre_gap_slope_rhs", "centre-gap branch: dd/dg with the unit load on node 0's "
+      "equation, not the pinned gap's", "femadh/contact/edge_branch.py",
+      (("        rhs[self.n] = 1.0\n", "        rhs[0] = 1.0\n"),)),
+    D("centre_gap_fold_state", "edge trace: the jump-in taken at the traced state before the "
+      "fold, not located", "femadh/studies/smooth_sphere.py",
+      (("    fin = atr.fold(arun[-1].c, arun[-3].c)\n", "    fin = arun[-2]\n"),)),
+    D("approach_at_separation_jacobian", "centre-gap branch: the fixed-separation Newton's "
+      "Jacobian with the law's stiffness subtracted", "femadh/contact/edge_branch.py",
+      (("J.ravel()[np.arange(n) * (n + 1)] += self._dpressure(h)",
+        "J.ravel()[np.arange(n) * (n + 1)] -= self._dpressure(h)"),)),
+    D("parabola_stop_early", "edge branch: the maximum search stops once its vertex is "
+      "within 300x MAX_XTOL of the best state", "femadh/contact/edge_branch.py",
+      (("            if abs(x - b) <= tol:       # the vertex is on the best state",
+        "            if abs(x - b) <= 300 * tol:       # the vertex is on the best state"),)),
+    D("parabola_bracket", "edge branch: a better state dropped from the maximum's bracket",
+      "femadh/contact/edge_branch.py",
+      (("            if fx > fb:     # the new best", "            if fx < fb:     # the new best"),)),
+    D("peer_grading_contact", "regime: the pull-off's grading applied to the approach grid "
+      "only", "femadh/studies/regime.py",
+      (("res = replace(res, grading=g, edge_grading=g)", "res = replace(res, grading=g)"),)),
     # -- fold accounting
     D("closure_jump_resolution", "closure: a fold's resolution reported as the grid step",
       "femadh/contact/closure/trace.py",

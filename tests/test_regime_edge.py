@@ -143,3 +143,94 @@ def test_hysteresis_is_insensitive_to_the_analysis_radius():
                           None) for ar in (8.0, 4.0))
     assert abs(q4["hysteresis"] - q8["hysteresis"]) < 5e-4 * q8["hysteresis"]
     assert q4["pull_off"] == pytest.approx(q8["pull_off"], rel=1e-5, abs=0)
+
+
+def _approach(mu=3.0, spacing=0.133):
+    """The centre-gap branch of one map point's approach grid, its setup and first state."""
+    from femadh.contact.edge_branch import CentreGapBranch
+    from femadh.studies.smooth_sphere import PointSetup, Resolution
+
+    st = PointSetup(mu, R, LennardJones(HAMAKER, Z0), Resolution(spacing=spacing))
+    br = CentreGapBranch(st.problem(0.0), 1e-19)
+    return br, st
+
+
+def test_centre_gap_slope_is_the_finite_difference_of_the_separation():
+    """dd/dg of the approach branch (J dx/dg = e_n) against a central difference of solved
+    states at g +- 1e-5 g, 2 z0 from the centre (measured agreement 6.5e-11 relative,
+    asserted 1e-6); the state pins the centre gap and meets eq (6)."""
+    br, st = _approach()
+    g = 2.0 * Z0
+    s0 = br.solve(g, np.zeros(br.n), g)
+    assert s0 is not None
+    e = 1e-5 * g
+    sp, sm = br.solve(g + e, s0.w, s0.d), br.solve(g - e, s0.w, s0.d)
+    fd = (sp.d - sm.d) / (2 * e)
+    assert br.slope(s0) == pytest.approx(fd, rel=1e-6, abs=0)
+    h = br.pb.contour(s0.d) - s0.w
+    assert h[0] == pytest.approx(g, rel=1e-9, abs=0)
+    assert np.max(np.abs(s0.w - br.pb.C @ br.pb.pressure(h))) <= 1e-19
+
+
+def test_largest_tension_by_parabolas_is_brents():
+    """The contact branch's largest tension located by parabolic interpolation from its
+    traced bracket against bounded Brent at 1e-9 c on the same branch (mu = 3, spacing
+    0.133 ell): measured 1.04e-8 relative apart in the force (the search stops at
+    MAX_XTOL = 1e-4 of c: a smooth maximum's value is off by ~(1e-4)^2), asserted 3e-8, in
+    at most 4 solves."""
+    from scipy import optimize
+
+    from femadh.contact.edge_branch import BranchTrace
+    from femadh.studies.smooth_sphere import jkr_start, lj_force
+
+    br, st, c0 = _branch()
+    tr = BranchTrace(br)
+    s0 = br.solve(br.r0, *jkr_start(br, st, br.r0))
+    tr.states.append(s0)
+
+    def F(s):
+        return lj_force(s.problem, st.law, s.d, s.w)
+    tr.march(s0, -1, lambda run: len(run) >= 3 and F(run[-1]) < F(run[-2]))
+    tr.march(s0, +1, lambda run: len(run) >= 2 and F(run[-1]) < F(run[-2]))
+    states = sorted(tr.states, key=lambda s: s.c)
+    i = int(np.argmax([F(s) for s in states]))
+    n0 = br.n_solves
+    best, _ = tr.maximize(F, states[i - 1], states[i], states[i + 1])
+    assert br.n_solves - n0 <= 4
+    ref = optimize.minimize_scalar(lambda c: -F(tr.at(c)), bounds=(states[i - 1].c,
+                                   states[i + 1].c), method="bounded",
+                                   options={"xatol": 1e-9 * states[i].c})
+    assert best == pytest.approx(-ref.fun, rel=3e-8, abs=0)
+
+
+def test_peer_request_is_met_not_over_delivered():
+    """The peer problem (Lj82, R = 100 z0, mu = 1) asked 3e-3 of its pull-off: the grading
+    length comes from the pull-off's measured error model (0.77 ell, not 2), the achieved
+    error against a finer member (spacing 0.04 ell, grading 2: 2.5e-5 from the peer
+    script's reference at 0.0125 ell, measured) lies within [request/30, request] (measured
+    1.26e-3) and the estimate's effectivity within 0.5-5 (measured 1.03)."""
+    from femadh.laws import Lj82
+    from femadh.studies.regime import EDGE_GRADING, lj_sphere
+
+    law = Lj82(0.05, 1e-9)
+    p = lj_sphere(1.0, radius=100e-9, law=law, accuracy=3e-3, judged=("pull_off",))
+    ref = lj_sphere(1.0, radius=100e-9, law=law, spacing=0.04)
+    true = abs(p.pull_off - ref.pull_off) / ref.pull_off
+    assert (p.resolution.edge_grading or EDGE_GRADING) < 0.5 * EDGE_GRADING
+    assert 3e-3 / 30 <= true <= 3e-3
+    assert 0.5 <= p.relative_error("pull_off") / true <= 5
+
+
+def test_approach_state_at_a_separation_is_the_centre_gap_state():
+    """The approach branch solved at fixed separation (the jump-out's landing) against the
+    same state solved at fixed centre gap: the state of centre gap 2 z0 has separation d;
+    solved at d from a guess 10 % off, it returns centre gap 2 z0 and the same w (measured
+    2.6e-10 and 2.2e-10 relative: both states meet the residual test, 1e-19 m; asserted
+    1e-9)."""
+    br, st = _approach()
+    g = 2.0 * Z0
+    s0 = br.solve(g, np.zeros(br.n), g)
+    s1 = br.at_separation(s0.d, 0.9 * s0.w)
+    assert s1 is not None
+    assert s1.c == pytest.approx(g, rel=1e-9, abs=0)
+    assert np.max(np.abs(s1.w - s0.w)) <= 1e-9 * np.max(np.abs(s0.w))

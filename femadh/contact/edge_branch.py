@@ -31,6 +31,7 @@ pull-off the largest tension, the landing after the jump-in the root of d(c) = d
 """
 from dataclasses import dataclass
 import copy
+import functools
 import math
 
 import numpy as np
@@ -50,14 +51,21 @@ STEP0 = 0.02
 #: largest and smallest relative steps in c
 STEP_MAX = 0.08
 STEP_MIN = 1e-5
-#: Newton iterations a step aims at (the step grows below, shrinks above)
+#: Newton iterations a step aims at (the step grows below, shrinks above; a state's count is
+#: its factorisations plus its chord steps / CHORD_PER_FACTOR)
 TARGET_ITER = 4
+#: the Newton loop keeps its factorisation while each step cuts the residual to below this
+#: fraction of the previous one (chord steps), and refactorises otherwise
+CHORD_RATE = 0.1
+CHORD_PER_FACTOR = 3
 #: relative accuracy in c of the fold and of the landing (root finding: the fold's tension and
 #: the landing's work move by ~this relative to themselves)
 C_XTOL = 1e-8
 #: relative accuracy in c of the largest tension's location: the value at a smooth maximum
 #: is off by ~(this)^2 relative
 MAX_XTOL = 1e-4
+#: solves the maximum search may take (a smooth maximum: 2-4)
+MAX_PARABOLA = 30
 #: the branch ends after this many states (a cap: a healthy branch takes 30-80)
 MAX_STATES = 2000
 
@@ -166,7 +174,26 @@ class EdgeBranch:
         self.n = base.grid.n
         self.n_solves = 0
         self.n_iter = 0
+        self.n_factor = 0
         self._base = ContactProblem(base, sphere, effects, check_laws=False)
+        # the laws' own pressure and derivative, called directly in the Newton loop (the
+        # problem's sum checks every law's values for NaN at every call: here one check of
+        # the residual, which any non-finite pressure makes non-finite, does it per iteration)
+        self._laws = tuple(effects.values())
+        idx = np.arange(self.n)
+        self._diag = idx * (self.n + 2)         # flat indices of J's first n diagonal entries
+
+    def _pressure(self, h):
+        P = self._laws[0].pressure(h)
+        for law in self._laws[1:]:
+            P = P + law.pressure(h)
+        return P
+
+    def _dpressure(self, h):
+        D = self._laws[0].dpressure(h)
+        for law in self._laws[1:]:
+            D = D + law.dpressure(h)
+        return D
 
     def problem(self, c):
         """The problem on the grid whose node k sits at c (m): the reference problem with its
@@ -190,10 +217,11 @@ class EdgeBranch:
 
     def _jacobian(self, pb, D):
         n, k = self.n, self.k
-        J = np.zeros((n + 1, n + 1))
+        J = np.empty((n + 1, n + 1))
         J[:n, :n] = pb.K
-        J[np.arange(n), np.arange(n)] += D
+        J.ravel()[self._diag] += D
         J[:n, n] = -D
+        J[n, :] = 0.0
         J[n, k] = -1.0
         J[n, n] = 1.0
         return J
@@ -202,36 +230,59 @@ class EdgeBranch:
         """The state with its edge at c (m) from the guess (w0, d0) (Newton, steps limited so
         that no gap closes by more than GAP_CLOSURE of itself). Returns an EdgeState, or
         None if Newton did not converge in MAX_ITER iterations."""
-        pb = self.problem(c)
-        n, k, ge = self.n, self.k, self.edge_gap
+        return self._newton(self.problem(c), c, w0, d0, self.edge_gap)
+
+    def _newton(self, pb, c, w0, d0, ge):
+        """Newton on K w - P(h) = 0, h_k = ge on the problem pb from (w0, d0); the state is
+        labelled by the parameter c. Returns an EdgeState or None."""
+        n, k = self.n, self.k
         w, d = np.array(w0, float), float(d0)
         self.n_solves += 1
+        contour, C, K = pb.shape + 0.0, pb.C, pb.K
+        rhs = np.empty(n + 1)
+        lu = None
+        last = math.inf         # the residual before the last step
+        n_lu = 0
         for it in range(1, MAX_ITER + 1):
             safe_point()
-            h = pb.contour(d) - w
-            if np.any(h <= 0):
+            h = (contour + d) - w
+            if h.min() <= 0:
                 return None
-            P = pb.pressure(h)
-            res = float(np.max(np.abs(w - pb.C @ P)))
+            P = self._pressure(h)
+            res = float(np.abs(w - C @ P).max())
+            if not math.isfinite(res):
+                raise ConvergenceError(f"edge branch: the law's pressure is not finite at "
+                                       f"c = {c:.6g} m (smallest gap {h.min():.6g} m)",
+                                       d=d, residual=res, n_iter=it - 1)
             g = h[k] - ge
             if res <= self.tol and abs(g) <= 1e-9 * ge:
                 self.n_iter += it - 1
-                return EdgeState(c, d, w, it - 1, res, pb)
-            D = pb.dpressure(h)
-            rhs = np.r_[P - pb.K @ w, -g]
-            lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
-            if info > 0:
-                return None
+                self.n_factor += n_lu
+                return EdgeState(c, d, w, n_lu + (it - 1 - n_lu) // CHORD_PER_FACTOR,
+                                 res, pb)
+            r = max(res, abs(g))
+            rhs[:n] = P - K @ w
+            rhs[n] = -g
+            # chord: the last factorisation serves while it contracts the residual by
+            # CHORD_RATE per step (a solve with it costs ~1/10 of a factorisation)
+            if lu is None or r > CHORD_RATE * last:
+                lu, piv, info = lapack.dgetrf(self._jacobian(pb, self._dpressure(h)),
+                                              overwrite_a=True)
+                n_lu += 1
+                if info > 0:
+                    return None
+            last = r
             dx = lapack.dgetrs(lu, piv, rhs)[0]
             if not np.all(np.isfinite(dx)):
                 return None
             closing = dx[:n] - dx[n]        # dh = dd - dw: gaps close where dw > dd
             alpha = 1.0
-            if np.any(closing > 0):
-                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[closing > 0]
-                                              / closing[closing > 0])))
+            if closing.max() > 0:
+                pos = closing > 0
+                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / closing[pos])))
             w = w + alpha * dx[:n]
             d = d + alpha * dx[n]
+        self.n_factor += n_lu
         self.n_iter += MAX_ITER
         return None
 
@@ -243,12 +294,117 @@ class EdgeBranch:
         D = pb.dpressure(h)
         r = pb.grid.nodes
         dshape = self.sphere.slope(r) * r / st.c          # d shape(r_i(c)) / dc
-        rhs = -np.r_[-(pb.K @ st.w) / st.c - D * dshape, dshape[k]]
+        rhs = np.empty(n + 1)
+        rhs[:n] = (pb.K @ st.w) / st.c + D * dshape
+        rhs[n] = -dshape[k]
         lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
         if info > 0:
             raise ConvergenceError("edge branch: singular Jacobian", d=st.d,
                                    residual=st.residual, n_iter=0)
         return float(lapack.dgetrs(lu, piv, rhs)[0][n])
+
+
+class CentreGapBranch(EdgeBranch):
+    """Solves of the approach branch (no contact yet) at given centre gaps, on one grid.
+
+    Before the jump-in the surface bulges towards the sphere and the gap at r = 0,
+    g = d - w(0), decreases monotonically along the branch, through the jump-in fold (d(g)
+    has its smallest value there: a root of dd/dg, not a turning point of g). The branch is
+    therefore traced by plain Newton in g with the same unknowns (w, d) and the same pinned
+    gap as the contact branch's edge node, here node 0 at g: K w - P(h) = 0, h_0 - g = 0.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        The approach grid's problem (a node at r = 0).
+    tol : float
+        Residual of eq (6) every state meets (m).
+    """
+
+    def __init__(self, problem, tol):
+        if problem.grid.nodes[0] != 0.0:
+            raise ValueError("centre-gap branch: the grid needs a node at r = 0")
+        self.pb, self.k, self.n, self.tol = problem, 0, problem.grid.n, tol
+        self.sphere, self.effects = problem.sphere, problem.effects
+        self.n_solves = 0
+        self.n_iter = 0
+        self.n_factor = 0
+        self._laws = tuple(problem.effects.values())
+        self._diag = np.arange(self.n) * (self.n + 2)
+
+    def problem(self, g):
+        return self.pb
+
+    def solve(self, g, w0, d0):
+        """The approach state of centre gap g (m) from the guess (w0, d0); an EdgeState
+        (``c`` = g) or None if Newton did not converge."""
+        return self._newton(self.pb, g, w0, d0, g)
+
+    def at_separation(self, d, w0):
+        """The approach state at separation d (m) from the guess w0 (interpolated between
+        two traced states that bracket d): Newton on K w - P(d + shape - w) = 0 with chord
+        steps as in :meth:`_newton`. Returns an EdgeState (``c`` = its centre gap) or None if
+        Newton did not converge."""
+        pb, n = self.pb, self.n
+        K, C = pb.K, pb.C
+        contour = pb.contour(d)
+        w = np.array(w0, float)
+        lu, last, n_lu = None, math.inf, 0
+        self.n_solves += 1
+        for it in range(1, MAX_ITER + 1):
+            safe_point()
+            h = contour - w
+            if h.min() <= 0:
+                return None
+            P = self._pressure(h)
+            res = float(np.abs(w - C @ P).max())
+            if not math.isfinite(res):
+                raise ConvergenceError(f"centre-gap branch: the law's pressure is not finite "
+                                       f"at d = {d:.6g} m", d=d, residual=res, n_iter=it - 1)
+            if res <= self.tol:
+                self.n_iter += it - 1
+                self.n_factor += n_lu
+                return EdgeState(float(h[0]), d, w, it - 1, res, pb)
+            if lu is None or res > CHORD_RATE * last:
+                J = K.copy()
+                J.ravel()[np.arange(n) * (n + 1)] += self._dpressure(h)
+                lu, piv, info = lapack.dgetrf(J, overwrite_a=True)
+                n_lu += 1
+                if info > 0:
+                    return None
+            last = res
+            dw = lapack.dgetrs(lu, piv, P - K @ w)[0]
+            if not np.all(np.isfinite(dw)):
+                return None
+            alpha = 1.0
+            if dw.max() > 0:        # gaps close where dw > 0
+                pos = dw > 0
+                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / dw[pos])))
+            w = w + alpha * dw
+        self.n_iter += MAX_ITER
+        self.n_factor += n_lu
+        return None
+
+    def slope(self, st):
+        """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
+        h = self.pb.contour(st.d) - st.w
+        rhs = np.zeros(self.n + 1)
+        rhs[self.n] = 1.0
+        lu, piv, info = lapack.dgetrf(self._jacobian(self.pb, self._dpressure(h)),
+                                      overwrite_a=True)
+        if info > 0:
+            raise ConvergenceError("centre-gap branch: singular Jacobian", d=st.d,
+                                   residual=st.residual, n_iter=0)
+        return float(lapack.dgetrs(lu, piv, rhs)[0][self.n])
+
+
+@functools.lru_cache(maxsize=8)
+def gauss_legendre(n):
+    """Nodes and weights of n-point Gauss-Legendre on [-1, 1] (computed once per n: an
+    eigenvalue problem of ~1 ms, a tenth of a small member's trace)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
 
 
 def tail_energy_change(law, radius, a, d1, d2):
@@ -258,7 +414,7 @@ def tail_energy_change(law, radius, a, d1, d2):
     2 pi R int_b1^b2 U(h) dh: 16-point Gauss-Legendre (U is smooth at these gaps, b >= 20 z0
     at the smallest analysis radius)."""
     b1, b2 = d1 + a * a / (2 * radius), d2 + a * a / (2 * radius)
-    x, wq = np.polynomial.legendre.leggauss(16)
+    x, wq = gauss_legendre(16)
     h = 0.5 * (b1 + b2) + 0.5 * (b2 - b1) * x
     return 2 * math.pi * radius * 0.5 * (b2 - b1) * float(wq @ law.energy(h))
 
@@ -282,7 +438,11 @@ class BranchTrace:
 
     def at(self, c):
         """The state at edge radius c (from the traced states); ConvergenceError if Newton
-        fails."""
+        fails. A traced state at exactly c is returned as it is (the root and maximum
+        searches start from brackets of traced states)."""
+        for st in self.states:
+            if st.c == c:
+                return st
         w0, d0 = self._guess(c)
         st = self.branch.solve(c, w0, d0)
         if st is None:
@@ -290,11 +450,12 @@ class BranchTrace:
                                    d=d0, residual=math.nan, n_iter=MAX_ITER)
         return st
 
-    def march(self, start, direction, done):
-        """Trace from ``start`` (an EdgeState) in the direction of c (+1, -1) until
-        ``done(states_in_march_order)`` is True; the states join ``self.states``."""
+    def march(self, start, direction, done, step0=STEP0):
+        """Trace from ``start`` (an EdgeState) in the direction of c (+1, -1), the first
+        relative step ``step0``, until ``done(states_in_march_order)`` is True; the states
+        join ``self.states``."""
         run = [start]
-        step = STEP0
+        step = step0
         while not done(run):
             if len(self.states) + len(run) > MAX_STATES:
                 raise ConvergenceError(f"edge branch: more than {MAX_STATES} states",
@@ -327,7 +488,8 @@ class BranchTrace:
 
         def slope(c):
             st = self.at(c)
-            st.dd_dc = self.branch.slope(st)
+            if math.isnan(st.dd_dc):
+                st.dd_dc = self.branch.slope(st)
             cache[c] = st
             return st.dd_dc
         c = optimize.brentq(slope, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
@@ -344,16 +506,33 @@ class BranchTrace:
         c = optimize.brentq(f, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
         return cache.get(c) or self.at(c)
 
-    def maximize(self, value, lo, hi):
-        """The state of largest value(state) between edge radii lo and hi (bounded Brent)."""
-        best = []
-
-        def neg(c):
-            st = self.at(c)
-            v = value(st)
-            if not best or v > best[0]:
-                best[:] = [v, st]
-            return -v
-        optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
-                                 options={"xatol": MAX_XTOL * hi})
-        return best[0], best[1]
+    def maximize(self, value, lo, mid, hi):
+        """The state of largest value(state) in the bracket of traced states lo < mid < hi
+        (value(mid) >= value(lo), value(hi)): successive parabolic interpolation through the
+        three best states, which keep bracketing the maximum (a smooth maximum: the vertex
+        converges superlinearly; a vertex outside the bracket or too near a known state is
+        replaced by a golden-section point). Stops when the vertex moves by less than
+        MAX_XTOL of c, after at most MAX_PARABOLA solves. Returns (value, state)."""
+        pts = [(st.c, value(st), st) for st in (lo, mid, hi)]
+        for _ in range(MAX_PARABOLA):
+            (a, fa, _), (b, fb, _), (c, fc, _) = pts
+            num = (b - a) ** 2 * (fb - fc) - (b - c) ** 2 * (fb - fa)
+            den = (b - a) * (fb - fc) - (b - c) * (fb - fa)
+            x = b - 0.5 * num / den if den != 0 else math.nan
+            tol = MAX_XTOL * c
+            if abs(x - b) <= tol:       # the vertex is on the best state: located
+                break
+            if not (a + tol < x < c - tol):
+                # a degenerate vertex: golden section in the larger half
+                x = b + 0.381966 * ((c - b) if c - b > b - a else (a - b))
+            st = self.at(x)
+            fx = value(st)
+            if fx > fb:     # the new best (the old one bounds on its side)
+                pts = [pts[0], (x, fx, st), pts[1]] if x < b else [pts[1], (x, fx, st), pts[2]]
+            else:           # the best stays: x bounds on its side
+                pts = [(x, fx, st), pts[1], pts[2]] if x < b else [pts[0], pts[1], (x, fx, st)]
+        else:
+            raise ConvergenceError(f"edge branch: the largest value between c = {lo.c:.6g} "
+                                   f"and {hi.c:.6g} m not located in {MAX_PARABOLA} solves",
+                                   d=pts[1][2].d, residual=math.nan, n_iter=MAX_PARABOLA)
+        return pts[1][1], pts[1][2]

@@ -16,17 +16,17 @@ displacement-controlled experiment follow from it. Read off the curve:
 Classic computations of this problem: Greenwood 1997, Proc. R. Soc. A 453, 1277; Feng 2000,
 J. Colloid Interface Sci. 238, 318.
 
-Grid: where the curve is bistable (mu > 0.81) the contact branch is traced in its edge
-radius on a grid whose nodes move with the edge, the edge on a node at every state
-(:func:`~femadh.studies.smooth_sphere.trace_edge_point`, :mod:`femadh.contact.edge_branch`):
-no lattice wiggles, a fine band of +-2 ell around the edge only, nodes growing like ln mu
-(mu = 20 at 1e-3: 247 nodes, against 852 on the moving band); the approach branch by
-arclength to the jump-in fold. Elsewhere, and with ``Resolution(follow_edge=False)``, the
+Grid: where the curve is bistable (mu > 0.81) the contact branch is traced in its edge radius
+on a grid whose nodes move with the edge, the edge on a node at every state
+(:func:`~femadh.studies.smooth_sphere.trace_edge_point`, :mod:`femadh.contact.edge_branch`): no
+lattice wiggles, a fine band of +-2 ell around the edge only, nodes growing like ln mu (mu = 20
+at 1e-3: 247 nodes, against 852 on the moving band); the approach branch by Newton in its
+centre gap to the jump-in fold. Elsewhere, and with ``Resolution(follow_edge=False)``, the
 whole curve is traced by arclength on a band of uniform fine spacing that follows the contact
 edge in steps, graded beyond it (:class:`~femadh.studies.smooth_sphere.PointSetup`,
-:class:`Resolution`); ``band_offset`` reports how far the edge strayed from the band's
-centre, the guards refuse a point whose edge left it, whose nodes snap alone or whose contact
-reaches the analysis radius.
+:class:`Resolution`); ``band_offset`` reports how far the edge strayed from the band's centre,
+the guards refuse a point whose edge left it, whose nodes snap alone or whose contact reaches
+the analysis radius.
 
 Accuracy: every result carries an a-posteriori error estimate from a coarser member of the
 grid family (spacing x 1.5, or x 2 after a refinement; Richardson with the observed order 2).
@@ -60,7 +60,8 @@ from ..laws import LennardJones
 from ..reference.maugis import lj_dugdale_lambda, maugis_fixed_grip_pull_off, maugis_pull_off
 # the smooth-sphere problem of one point (re-exported: the map's public names)
 from .smooth_sphere import (ANALYSIS_RADIUS, BAND, BAND_MU, DS_MAX,  # noqa: F401
-                            EDGE_GAP, GRADING, SPACING, TRACE_CORRECTION, PointSetup,  # noqa
+                            EDGE_GAP, EDGE_GRADING, GRADING, SPACING,  # noqa: F401
+                            TRACE_CORRECTION, PointSetup,  # noqa: F401
                             Resolution, e_star_length, lateral_length, lj_force, trace_edge_point,
                             trace_point)
 
@@ -388,6 +389,9 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
             else:
                 cap = None
             res = replace(res, spacing=initial_spacing(accuracy, cap))
+            if edge and tuple(judged) == ("pull_off",) and resolution is None:
+                g = pull_off_grading(accuracy, res.spacing)
+                res = replace(res, grading=g, edge_grading=g)
     member = {}
     member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol, edge)
 
@@ -453,6 +457,17 @@ def initial_spacing(accuracy, cap=None):
     return min(cap, (accuracy / (2.0 * C_SPACING)) ** (1.0 / ORDER))
 
 
+def pull_off_grading(accuracy, spacing):
+    """Grading length (units of ell) of both grids of an edge-following point whose accuracy
+    is asked of the load-controlled pull-off alone, at band spacing ``spacing`` (ell): the
+    measured error model of the pull-off, rel_err ~ C_SPACING spacing^ORDER
+    (EDGE_GRADING / grading)^GRADING_ORDER, with a safety factor of 2 on the error, within
+    [MIN_GRADING, EDGE_GRADING]. A request the band spacing alone over-delivers is met with
+    a coarser far field instead of an over-resolved one."""
+    g = EDGE_GRADING * (2.0 * C_SPACING * spacing**ORDER / accuracy) ** (1.0 / GRADING_ORDER)
+    return min(EDGE_GRADING, max(MIN_GRADING, g))
+
+
 def lattice_cap(mu, radius, law):
     """Largest starting band spacing (units of ell) whose coarser member (x COARSE_RATIO) stays
     below LATTICE_SPACING elastocohesive lengths on the JKR side (lattice wiggles at the flat
@@ -492,6 +507,16 @@ COARSE_RATIO = 1.5
 #: member would put the mu = 2 estimate 7x low)
 MAX_SPACING_EDGE = 1.0 / 6.0
 COARSE_RATIO_EDGE = 1.25
+#: the pull-off's error against the grading length G of both grids of an edge-following
+#: point (spacing 0.133 ell, errors against the peer script's reference, Lj82 R = 100 z0):
+#: mu = 1: 3.03e-4 at G = 2 ell, 8.4e-4 at 1, 1.33e-3 at 0.75, 2.66e-3 at 0.5; mu = 3:
+#: 1.78e-4, 4.8e-4, 7.7e-4, 1.60e-3 (G = 2 -> 0.75: factors 4.39 and 4.34, i.e.
+#: G^-1.51 and G^-1.50): the far field's error, which the coarser member (spacing x 1.25,
+#: same G) estimates with effectivity 1.0-1.2. Used only where the accuracy is asked of the
+#: pull-off alone (the other quantities' dependence on G is not measured)
+GRADING_ORDER = 1.5
+#: smallest grading length chosen (units of ell; the smallest measured on the G^-1.5 line)
+MIN_GRADING = 0.5
 
 
 def regime_map(mus, progress=None, **kw):

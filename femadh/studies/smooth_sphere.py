@@ -157,6 +157,8 @@ class Resolution:
         On the JKR side, trace the contact branch on a grid whose nodes move with the edge
         (:func:`trace_edge_point`; the default); False: the whole curve by arclength on the
         moving band (:func:`trace_point`).
+    edge_grading : float or None
+        Grading length (units of ell) of the edge-following contact grid; None: EDGE_GRADING.
     """
 
     spacing: float = SPACING
@@ -167,6 +169,7 @@ class Resolution:
     stiffness_target: float | None = None
     min_nodes: int | None = None
     follow_edge: bool = True
+    edge_grading: float | None = None
 
     @property
     def legacy(self):
@@ -336,9 +339,14 @@ EDGE_RADIUS_MARGIN = 3.0
 #: the surface barely deforms and the predictor is near exact
 APPROACH_START = 1.2
 APPROACH_DS = 0.05
+#: first relative step in the centre gap of the approach branch (the branch starts beyond the
+#: jump-out, where the surface barely deforms and the secant predictor is near exact)
+APPROACH_STEP0 = 0.08
 #: Gauss-Legendre nodes of the contact branch's work between the landing and the fold (F d'(c)
-#: is smooth in c: 6, 8 and 12 nodes agree to 1e-9 relative at mu = 1, 3, 20, measured)
-HYSTERESIS_NODES = 6
+#: is smooth in c: 6, 8 and 12 nodes agree to 1e-9 relative at mu = 1, 3, 20; 4 nodes move
+#: the hysteresis by 3.7e-7, 4e-8 and 1.2e-8 relative at mu = 1, 3, 20 (LJ, spacing 0.1 ell,
+#: measured), below the map's 1e-3 by 2700x, for two solves fewer per member)
+HYSTERESIS_NODES = 4
 
 
 def jkr_start(branch, setup, c):
@@ -363,12 +371,13 @@ def jkr_start(branch, setup, c):
 def trace_edge_point(setup, tol):
     """One bistable map point traced with the grid following the contact edge.
 
-    The approach branch (no contact yet) is traced by arclength
-    (:func:`~femadh.contact.arclength.trace_curve`) on a band at the centre up to the jump-in
-    fold; the contact branch by Newton in its edge radius c on a grid that moves with the edge
-    (:mod:`femadh.contact.edge_branch`), from JKR's pull-off radius down through the largest
-    tension to the jump-out fold and up past the landing of the jump-in. The unstable branch
-    between the folds is not traced: no headline quantity is read off it.
+    The approach branch (no contact yet) is traced by Newton in its centre gap g on the band at
+    the centre (:class:`~femadh.contact.edge_branch.CentreGapBranch`: d(g) is smooth through
+    the jump-in fold, its minimum) up to the jump-in fold; the contact branch by Newton in its
+    edge radius c on a grid that moves with the edge (:mod:`femadh.contact.edge_branch`), from
+    JKR's pull-off radius down through the largest tension to the jump-out fold and up past the
+    landing of the jump-in. The unstable branch between the folds is not traced: no headline
+    quantity is read off it.
 
     Returns
     -------
@@ -376,7 +385,8 @@ def trace_edge_point(setup, tol):
         The headline quantities in SI (pull_off, pull_off_displacement (N), jump_in,
         jump_out (m), hysteresis, loop_work (J)) and the states and counts the map reports.
     """
-    from ..contact.edge_branch import BranchTrace, EdgeBranch, edge_grid, tail_energy_change
+    from ..contact.edge_branch import (BranchTrace, CentreGapBranch, EdgeBranch, edge_grid,
+                                       gauss_legendre, tail_energy_change)
 
     law, z0, R = setup.law, setup.z0, setup.radius
     ell, h = setup.ell, setup.spacing
@@ -384,27 +394,36 @@ def trace_edge_point(setup, tol):
     def force(pb, d, w):
         return lj_force(pb, law, d, w)
 
-    # approach branch: the centre band of the point's family, up to the jump-in fold
+    # approach branch: the centre band of the point's family, traced in its centre gap g
+    # (d(g) is smooth through the jump-in fold, its minimum) up to the fold
     app = setup.problem(0.0)
     # (from beyond Maugis-Dugdale's jump-out: the approach state at the traced jump-out is
     # found there, or solved on its own if the traced one lies further out)
     d_app = min(setup.d_start, max(APPROACH_START * setup.d_out_md, setup.d_out_md + z0))
-    curve = trace_curve(app, d_app, setup.d_end, tol=tol, scale=z0, ds=0.2,
-                        ds_max=max(DS_MAX, APPROACH_DS * d_app / z0),
-                        stop=lambda cv: bool(cv.folds), max_points=20000,
-                        target_correction=TRACE_CORRECTION)
-    if not curve.folds:
+    abranch = CentreGapBranch(app, tol)
+    atr = BranchTrace(abranch)
+    g_app = d_app + float(app.shape[0])
+    first = abranch.solve(g_app, np.zeros(app.grid.n), d_app)
+    if first is None:
+        raise ConvergenceError(f"edge trace: no approach state at d = {d_app / z0:.4g} z0",
+                               d=d_app)
+    atr.states.append(first)
+    g_floor = z0     # below it the centre is in repulsive contact: no jump-in before
+    arun = atr.march(first, -1, lambda run: (len(run) >= 3 and run[-1].d > run[-2].d)
+                     or run[-1].c < g_floor, step0=APPROACH_STEP0)
+    if arun[-1].c < g_floor or len(arun) < 3:
         raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
-                               f"d = {curve.points[-1].d / z0:.4g} z0", d=curve.points[-1].d)
-    fin = curve.folds[0]
-    apts = curve.points[:fin.index + 1]
+                               f"the centre gap {arun[-1].c / z0:.4g} z0", d=arun[-1].d)
+    fin = atr.fold(arun[-1].c, arun[-3].c)
+    apts = sorted([s for s in atr.states if s.c > fin.c], key=lambda s: -s.c)
     # contact branch: reference grid fine around its node k at JKR's load-controlled
     # pull-off radius (9 pi dg R^2 / 8 E*)^(1/3), where it starts (the
     # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
     c0 = (9 * math.pi * setup.dg * R * R / (8 * setup.e_star)) ** (1 / 3)
     a_ref = EDGE_RADIUS_MARGIN * setup.a
     half = EDGE_BAND * ell
-    grid, k = edge_grid(a_ref, c0, h, half, EDGE_GRADING * ell)
+    grading = (setup.res.edge_grading or EDGE_GRADING) * ell
+    grid, k = edge_grid(a_ref, c0, h, half, grading)
     base = GreenOperator(grid, setup.e_star)
     branch = EdgeBranch(base, k, setup.sphere, {"law": law}, EDGE_GAP * z0, tol)
     # a grid whose nodes snap on their own cannot carry the edge (a priori, at the law's
@@ -442,7 +461,7 @@ def trace_edge_point(setup, tol):
     if i in (0, len(traced) - 1):
         raise ConvergenceError("edge trace: the largest tension lies at an end of the traced "
                                f"contact branch (c = {traced[i].c:.4g} m)", d=traced[i].d)
-    pull_c, _ = tr.maximize(F, traced[i - 1].c, traced[i + 1].c)
+    pull_c, _ = tr.maximize(F, traced[i - 1], traced[i], traced[i + 1])
     stable = [s for s in tr.states if s.c > fout.c]
     j = next(j for j in range(len(stable)) if stable[j].d < fin.d)
     land = tr.where_d(fin.d, stable[j - 1].c if j else fout.c, stable[j].c)
@@ -452,11 +471,21 @@ def trace_edge_point(setup, tol):
                                "is not stable", d=fin.d)
     # the retract path leaves the contact at the fold and lands on the approach branch
     d_out = fout.d
-    pba = curve.problem_of(0)
+    pba = app
     ia = next((i for i in range(len(apts) - 1)
                if (apts[i].d - d_out) * (apts[i + 1].d - d_out) <= 0), None)
     if ia is not None:
-        w_out = curve.point_at(ia, d_out)
+        # Newton at d_out from the states on either side (the approach branch is a function
+        # of d there); the state must lie between them in centre gap, else located in g
+        hi, lo = apts[ia], apts[ia + 1]
+        t = (d_out - hi.d) / (lo.d - hi.d)
+        st = abranch.at_separation(d_out, hi.w + t * (lo.w - hi.w))
+        if st is None or not lo.c <= st.c <= hi.c:
+            st = atr.where_d(d_out, lo.c, hi.c)
+        w_out = st.w
+    elif d_out < fin.d:
+        raise ConvergenceError(f"edge trace: the jump-out separation {d_out / z0:.4g} z0 lies "
+                               f"below the jump-in's {fin.d / z0:.4g} z0", d=d_out)
     else:   # beyond the traced approach branch: Newton from the undeformed surface
         out = solve_complementarity(pba, d_out, np.zeros(pba.grid.n), tol=tol, max_iter=60)
         if not (out.converged and out.stable
@@ -470,7 +499,7 @@ def trace_edge_point(setup, tol):
     # less the same along the approach branch (its energy difference on one grid: F = dE/dd
     # with the exact tail). Energies of states on grids of different analysis radii are not
     # compared: the deformation beyond the radius is not modelled, differently on each
-    x, wq = np.polynomial.legendre.leggauss(HYSTERESIS_NODES)
+    x, wq = gauss_legendre(HYSTERESIS_NODES)
     half_c, mid_c = 0.5 * (land.c - fout.c), 0.5 * (land.c + fout.c)
     contact_work = 0.0
     for xi, wi in zip(x, wq):
@@ -503,12 +532,12 @@ def trace_edge_point(setup, tol):
         "nodes": max(app.grid.n, grid.n), "nodes_approach": app.grid.n, "nodes_contact": grid.n,
         "n_points": len(apts) + len(all_c), "n_approach": len(apts),
         "n_branch_solves": branch.n_solves,
-        "n_solves": curve.n_solves + branch.n_solves,
-        "n_newton": branch.n_iter,
-        "n_folds": len(curve.folds) + 1,
+        "n_solves": abranch.n_solves + branch.n_solves,
+        "n_newton": abranch.n_iter + branch.n_iter,
+        "n_folds": 2,
         "curve_d": np.r_[da, fin.d, [s.d for s in all_c]],
         "curve_F": np.r_[fa, force(pba, fin.d, fin.w), [F(s) for s in all_c]],
         "curve_stable": np.r_[np.ones(len(apts), bool), False, [s.c > fout.c for s in all_c]],
         "approach": (app_d, app_F), "retract": (ret_d, ret_F),
-        "n_factor": curve.n_factor + branch.n_iter, "n_krylov": curve.n_krylov,
+        "n_factor": abranch.n_factor + branch.n_factor, "n_krylov": 0,
     }
