@@ -822,8 +822,8 @@ DEFECTS = [
       (('                   else ahead["failure"])', '                   else None)'),)),
     D("adaptive_uncapped_recorded", "adaptive grid: the trial records and refines from the "
       "spacing asked for, not the capped one it ran", "femadh/runner/adaptive.py",
-      (("    return Trial(family, h, op, spacing, follow)",
-        "    return Trial(family, spacing, op, spacing, follow)"),)),
+      (("    return Trial(family, h, spacing, op.grid.n, op, follow)",
+        "    return Trial(family, spacing, spacing, op.grid.n, op, follow)"),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',

@@ -10,11 +10,23 @@ until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
     h <- h * clamp((SAFETY * target / error)^(1/ORDER), MIN_FACTOR, MAX_FACTOR)
 
 A failed solve (a node snapping on its own, a stalled continuation, a landing after a fold
-that Newton cannot polish) halves h, a contact reaching the analysis radius doubles it, a
-feature that left the band widens the band, and members that all fail refine h: each while
-the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. The result says what was
-chosen and every trial (``result.accuracy``), or fails naming the accuracy reached, the nodes
-it used and about how many the request would need.
+that Newton cannot polish) halves h, a contact reaching the analysis radius doubles the
+disk, a feature that left the band widens the band, and members that all fail refine h:
+each while the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. Which remedy a failure gets
+is decided by its kind (``result.failure_kind``, the type of the exception that ended the
+run, :func:`femadh.estimate.guards.failure_kind`), never by the words of its message; a run
+stopped by a signal or its time limit ends the loop. The runs are the attempts of the
+shared refine-until-met loop (:func:`femadh.estimate.refine.refine_until_met`), one
+:class:`Trial` each. The result says what was chosen and every trial
+(``result.accuracy``), or fails naming the accuracy reached, the nodes it used, the time and
+about how many nodes the request would need.
+
+The band is static by default: a band that follows the contact edge
+(``[solver.grid] follow``, FOLLOW_NODES) was measured against it on the Fig 3, Fig 4 and
+slider + meniscus scenes (validation/results/adaptive_follow.md) and did not pay: at the
+same band spacing it has 1/3-1/4 of the nodes, but its estimate (the coarser members follow
+the edge on their own grids) is 3-5x larger and erratic, so the loop refines once more, and
+each of its runs carries the state across a dozen grid exchanges.
 """
 from dataclasses import dataclass
 import math
@@ -44,7 +56,8 @@ REFERENCE_ACCURACY, MIN_BAND_NODES = 1e-3, 48
 BAND_FILL = 0.97
 #: a sigma-gap stepping scene whose static member would have more than this many nodes runs
 #: on a band that follows the contact edge instead ([solver.grid] follow,
-#: :class:`~femadh.discretisation.moving.EdgeBand`; None: never)
+#: :class:`~femadh.discretisation.moving.EdgeBand`; None: never, the default: measured not
+#: to pay, see the module docstring)
 FOLLOW_NODES = None
 #: half-width of that band over the static band's radius
 FOLLOW_HALF = 1 / 6
@@ -112,7 +125,7 @@ def _capped(scene, family, spacing, follow=None):
     return spacing, op, problem
 
 
-@dataclass(frozen=True)
+@dataclass
 class Trial:
     """One setting of the refine loop: a member of a family, as it is run.
 
@@ -122,19 +135,23 @@ class Trial:
     spacing : float
         The band spacing h (m) the member uses: the one asked for, capped below the
         trapping-safe spacing (:func:`_capped` may shrink it).
-    operator : GreenOperator or None
-        The member's operator; None where the member would exceed the family's node limit
-        (:data:`~femadh.discretisation.family.MAX_NODES`).
     asked : float
         The band spacing (m) asked for, before the cap.
+    nodes : int
+        The member's node count; above the node limit where the member was refused.
+    operator : GreenOperator or None
+        The member's operator until it has been run (then dropped: the loop keeps every
+        setting); None where the member would exceed the family's node limit
+        (:data:`~femadh.discretisation.family.MAX_NODES`).
     follow : float or None
         Half-width (m) of a band that follows the contact edge (None: the static band).
     """
 
     family: GridFamily
     spacing: float
-    operator: object
     asked: float
+    nodes: int
+    operator: object = None
     follow: float | None = None
 
     def grid(self):
@@ -144,13 +161,6 @@ class Trial:
             out["follow"] = self.follow
         return out
 
-    @property
-    def nodes(self):
-        """The member's node count; above the node limit where it was refused."""
-        if self.operator is None:
-            return max(self.family.count(self.spacing), MAX_NODES + 1)
-        return self.operator.grid.n
-
 
 def _trial(scene, family, spacing):
     """The :class:`Trial` of ``family`` at band spacing ``spacing`` (m), capped."""
@@ -158,8 +168,9 @@ def _trial(scene, family, spacing):
     try:
         h, op, _ = _capped(scene, family, spacing, follow)
     except ValueError:          # the member would exceed MAX_NODES
-        return Trial(family, spacing, None, spacing, follow)
-    return Trial(family, h, op, spacing, follow)
+        return Trial(family, spacing, spacing, max(family.count(spacing), MAX_NODES + 1),
+                     None, follow)
+    return Trial(family, h, spacing, op.grid.n, op, follow)
 
 
 def _too_many_nodes(trial):
@@ -200,13 +211,14 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         i = len(steps)
         trial = variant(scene, grid=tr.grid(), radius=tr.family.radius)
         ahead["trial"] = trial
-        with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.operator.grid.n} nodes)"):
+        with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.nodes} nodes)"):
             res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
                       operator=tr.operator, folder_id=scene_id(scene), **mode)
+        tr.operator = None            # run: its dense operator need not outlive it
         mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
                           else (math.nan, math.nan))
-        steps.append({"nodes": tr.operator.grid.n, "spacing_m": tr.spacing,
+        steps.append({"nodes": tr.nodes, "spacing_m": tr.spacing,
                       "band_m": tr.family.band, "analysis_radius_m": tr.family.radius,
                       "status": res.status, "grid_rel_error": grid_e,
                       "tail_rel_error": tail_e, "wall_time_s": res.wall_time})
