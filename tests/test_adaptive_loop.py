@@ -241,3 +241,31 @@ def test_check_state_refuses_the_analysis_radius_as_its_own_type():
     with pytest.raises(AnalysisRadiusError, match="analysis radius") as e:
         check_state(pb, st)
     assert isinstance(e.value, GuardError) and failure_kind(e.value) == "analysis_radius"
+
+
+def test_the_follow_switch_hands_each_trial_its_follow_band(monkeypatch):
+    """FOLLOW_NODES = 0 (follow always): the trial's [solver.grid] carries follow = FOLLOW_HALF
+    of the band, and the operator handed to the run is the follow member as the trace
+    starts (centred on r = 0: fewer nodes than the static member of the same spacing, the
+    count recorded); the default (None) keeps the static band."""
+    from femadh.discretisation.moving import follow_family
+    from femadh.discretisation.plan import GRADING_FRACTION
+
+    monkeypatch.setattr(adaptive, "FOLLOW_NODES", 0)
+    ops = []
+    run, seen = scripted([{"grid": 1e-3}])
+
+    def spy(trial, out_dir, **kw):
+        ops.append(kw["operator"].grid.n)
+        return run(trial, out_dir, **kw)
+    res = adaptive.run_adaptive(adaptive_scene(accuracy=1e-2), None, run=spy)
+    (h, band, a, follow), = seen
+    assert follow == pytest.approx(adaptive.FOLLOW_HALF * band, rel=1e-12, abs=0)
+    step = res.accuracy["steps"][0]
+    fam = family_mod.GridFamily(a, band, GRADING_FRACTION * band)
+    follow_n = follow_family(a, follow, fam.grading, 0.0).member(h).n
+    assert ops == [step["nodes"]] == [follow_n] and follow_n < fam.member(h).n
+    monkeypatch.setattr(adaptive, "FOLLOW_NODES", None)
+    run, seen = scripted([{"grid": 1e-3}])
+    adaptive.run_adaptive(adaptive_scene(accuracy=1e-2), None, run=run)
+    assert seen[0][3] is None
