@@ -437,14 +437,13 @@ DEFECTS = [
       (("if edge > BAND_FILL * family.band and", "if edge > 10 * family.band and"),)),
     D("failure_refuses", "adaptive grid: a failed landing ends the run instead of refining",
       "femadh/runner/adaptive.py",
-      (("                h *= 0.5\n            steps[-1][\"refined_after\"] = err_text\n            continue",
-        "                h *= 0.5\n            steps[-1][\"refined_after\"] = err_text\n            break"),)),
+      (("            ahead[\"next\"] = (family, 0.5 * h)", "            ahead[\"next\"] = None"),)),
     D("feature_gap_fraction", "feature gap: |P'| threshold 1e-3 instead of FEATURE_FRACTION",
       "femadh/discretisation/plan.py",
       (("stiff >= FEATURE_FRACTION * top", "stiff >= 1e-3 * top"),)),
     D("tail_refines_h", "adaptive grid: a tail the capped disk cannot hold refines the spacing "
       "in vain", "femadh/runner/adaptive.py",
-      (("        if tail_e > SAFETY * target:", "        if False:"),)),
+      (("    if tail_e > SAFETY * target:", "    if False:"),)),
     # -- the instrument in series with the contact
     D("instrument_z_sign", "instrument: drive z = d - F/k (the spring's force reversed)",
       "femadh/instrument/readout.py",
@@ -841,7 +840,7 @@ DEFECTS = [
     # -- the run lifecycle (femadh/runner/lifecycle.py) and the result base
     D("life_failure_status", "lifecycle: a solver failure ends the run \"converged\"",
       "femadh/runner/lifecycle.py",
-      (("            result.fail(str(exc))",
+      (("            result.fail(str(exc), failure_kind(exc))",
         "            result.status, result.error = \"converged\", str(exc)"),)),
     D("life_stop_status", "result: every stop is \"interrupted\" (the time limit too)",
       "femadh/runner/result.py", (("self.status, self.error, self.exit_code = exc.status,",
@@ -980,6 +979,50 @@ DEFECTS = [
     D("newcomer_meniscus_error_scale", "meniscus report: the F/4πRγ error not divided by "
       "4πRγ (by 4πR)", "femadh/runner/meniscus.py",
       (('f" ± {err / unit4:.1g}"', 'f" ± {err / (4 * math.pi * R):.1g}"'),)),
+    # -- one home for the error machinery: the adaptive run on the refine loop, typed
+    #    failure kinds, a study point's time limit (issue 21)
+    D("adaptive_kind_by_words", "adaptive grid: the remedy picked by the words 'analysis "
+      "radius' in the error, not by the failure's kind", "femadh/runner/adaptive.py",
+      (("        if res.failure_kind == REFINE_RADIUS:",
+        "        if \"analysis radius\" in (res.error or \"\"):"),)),
+    D("accuracy_bound_unrefined", "accuracy mode: a result beyond Derjaguin-Bradley's bound "
+      "ends the request instead of doubling N", "femadh/runner/accuracy.py",
+      (('REFINE_NODES = ("trapping", "bound")', 'REFINE_NODES = ("trapping",)'),)),
+    D("refine_radius_kind_swapped", "refine loops: a trapped grid grows the disk (the radius "
+      "remedy keyed to the wrong kind)", "femadh/runner/accuracy.py",
+      (('REFINE_RADIUS = "analysis_radius"', 'REFINE_RADIUS = "trapping"'),)),
+    D("lifecycle_kind_dropped", "lifecycle: a guard's failure recorded without its kind",
+      "femadh/runner/lifecycle.py",
+      (("            result.fail(str(exc), failure_kind(exc))",
+        "            result.fail(str(exc))"),)),
+    D("guard_radius_untyped", "contact guard: a contact at the analysis radius raised as a "
+      "plain GuardError", "femadh/estimate/guards.py",
+      (("        raise AnalysisRadiusError(", "        raise GuardError("),)),
+    D("bound_untyped", "runner: the bounds guard's refusal not typed as BoundError",
+      "femadh/runner/contact.py",
+      (("            raise BoundError(str(exc)) from None", "            raise"),)),
+    D("adaptive_stop_refines", "adaptive grid: a trial stopped by its time limit is refined "
+      "and run again", "femadh/runner/adaptive.py",
+      (("    if res.status in STOPPED:\n        return res.status",
+        "    if res.status == \"interrupted\":\n        return res.status"),)),
+    D("adaptive_budget_plus_one", "adaptive grid: MAX_TRIALS + 1 runs",
+      "femadh/runner/adaptive.py",
+      (("Budget(MAX_TRIALS - 1, MAX_NODES)", "Budget(MAX_TRIALS, MAX_NODES)"),)),
+    D("adaptive_members_failed_same_h", "adaptive grid: failed members rerun at the same "
+      "spacing", "femadh/runner/adaptive.py",
+      (('        ahead["next"] = (family, h * MAX_FACTOR)',
+        '        ahead["next"] = (family, h)'),)),
+    D("adaptive_last_failure_lost", "adaptive grid: the reason the request ends (a tail the "
+      "disk cannot hold) dropped", "femadh/runner/adaptive.py",
+      (('                   else ahead["failure"])', '                   else None)'),)),
+    D("adaptive_uncapped_recorded", "adaptive grid: the trial records and refines from the "
+      "spacing asked for, not the capped one it ran", "femadh/runner/adaptive.py",
+      (("    return Trial(family, h, spacing, op.grid.n, op, follow)",
+        "    return Trial(family, spacing, spacing, op.grid.n, op, follow)"),)),
+    D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
+      "run", "femadh/studies/sweep.py",
+      (('return rec.get("status") in ("converged", "failed", "time limit")',
+        'return rec.get("status") in ("converged", "failed")'),)),
 ]
 
 

@@ -249,7 +249,7 @@ def test_results_share_one_base_with_exit_code_declared(cls):
     names = [f.name for f in dataclasses.fields(cls)]
     base = [f.name for f in dataclasses.fields(RunResult)]
     assert names[:len(base)] == base == ["name", "scene", "status", "error", "timings",
-                                         "out_dir", "headline", "exit_code"]
+                                         "out_dir", "headline", "exit_code", "failure_kind"]
     r = cls("x", None)
     assert (r.status, r.exit_code, r.wall_time) == ("running", None, 0.0)
     r.stop(Interrupted(signal.SIGTERM), " while drawing the figures")

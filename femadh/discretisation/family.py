@@ -14,9 +14,8 @@ from dataclasses import dataclass
 import math
 
 from ..elastic.grid import RadialGrid
-
-#: largest member a family builds (its dense operator: 8 N^2 doubles, ~0.6 GB at 3000)
-MAX_NODES = 4000
+# the largest member a family builds: the node limits' one home says why 4000
+from ..estimate.refine import BANDED_MAX_NODES as MAX_NODES
 
 
 @dataclass(frozen=True)

@@ -13,13 +13,17 @@ The contact runner (:mod:`femadh.runner.estimates`, :mod:`femadh.runner.accuracy
 regime map (:mod:`femadh.studies.regime`) both use it; what differs between them (the
 quantities, the family's order, how a grid is refined) is passed in.
 """
-from .guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError, TrappingError, check_state,
-                     outside_bounds, trapping_message)
-from .refine import Budget, Outcome, refine_until_met, worst_relative
+from .guards import (EDGE_FRACTION, FAILURE_KINDS, SMOOTH_EDGE_FRACTION, TRAPPING_LIMIT,
+                     AnalysisRadiusError, BoundError, GuardError, TrappingError, check_state,
+                     failure_kind, outside_bounds, trapping_message)
+from .refine import (BANDED_MAX_NODES, CONTINUATION_MAX_NODES, UNIFORM_MAX_NODES, Budget,
+                     Outcome, refine_until_met, worst_relative)
 from .richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER, discretisation, observed_order,
                          richardson)
 
-__all__ = ["Budget", "EDGE_FRACTION", "ENVELOPE_ORDER", "GuardError", "MAX_ORDER", "ORDER",
-           "Outcome", "TRAPPING_LIMIT", "TrappingError", "check_state", "discretisation",
-           "observed_order", "outside_bounds", "refine_until_met", "richardson",
-           "trapping_message", "worst_relative"]
+__all__ = ["AnalysisRadiusError", "BANDED_MAX_NODES", "BoundError", "Budget",
+           "check_state", "CONTINUATION_MAX_NODES", "discretisation", "EDGE_FRACTION",
+           "ENVELOPE_ORDER", "failure_kind", "FAILURE_KINDS", "GuardError", "MAX_ORDER",
+           "observed_order", "ORDER", "Outcome", "outside_bounds", "refine_until_met",
+           "richardson", "SMOOTH_EDGE_FRACTION", "TRAPPING_LIMIT", "trapping_message",
+           "TrappingError", "UNIFORM_MAX_NODES", "worst_relative"]

@@ -11,6 +11,28 @@ silent stop.
 from dataclasses import dataclass, field
 import math
 
+# Node limits: one per discretisation path, each set by what a node costs there. Every path
+# solves on a dense N x N surface operator (memory 8 N^2 bytes per copy; a few copies: the
+# operator, the stiffness, the factorisation), so what limits N is the time per state:
+# N^3 / 3 per LU factorisation of the stepping corrector, N^2 per Krylov iteration of the
+# arclength corrector.
+
+#: largest uniform N of accuracy mode (:mod:`femadh.runner.accuracy`): accuracy mode doubles
+#: N from the scene's nodes (200 by default), and 3200 is four doublings; its sweeps
+#: factorise at every corrector step, measured 3.5 s for 3 states at N = 3200
+#: (:mod:`femadh.scene.resources`, whose unreachable-accuracy refusal quotes this budget)
+UNIFORM_MAX_NODES = 3200
+#: largest member of a banded grid family (:class:`femadh.discretisation.GridFamily`), the
+#: adaptive run's node budget (:mod:`femadh.runner.adaptive`): the family puts its nodes in
+#: the band (the Fig 4 scene meets 1e-3 with ~630, README "Accuracy"), so a member needing
+#: more is a request to refuse; the dense operator of 4000 nodes is 128 MB per copy
+BANDED_MAX_NODES = 4000
+#: node budget of the regime map's refinements (:mod:`femadh.studies.regime`): its arclength
+#: continuation runs a Krylov solve at every point of a curve of hundreds of points, each
+#: iteration ~N^2, so 1600 nodes cost ~10x 500 per point (a map of 20-40 points stays
+#: within minutes)
+CONTINUATION_MAX_NODES = 1600
+
 
 @dataclass(frozen=True)
 class Budget:

@@ -11,6 +11,13 @@ from ..scene import scene_id
 from ..estimate.refine import Budget, refine_until_met
 from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
 
+#: the failure kind (``result.failure_kind``) a larger disk resolves: the contact reached
+#: the analysis radius (a doubles, N doubles: the spacing stays)
+REFINE_RADIUS = "analysis_radius"
+#: the failure kinds more nodes resolve: a node snapping on its own (lattice trapping), a
+#: largest adhesion beyond Derjaguin-Bradley's bound (too coarse for the surface forces)
+REFINE_NODES = ("trapping", "bound")
+
 
 def _relative(res):
     """(grid-like relative error, tail relative error) of the headline forces."""
@@ -58,9 +65,11 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
     def refine(setting, res, error, why):
         nodes, delta = setting
         if why is not None:
-            if "analysis radius" in why:
+            # the failure's kind (its exception's type), never its words, picks the remedy
+            kind = res.failure_kind
+            if kind == REFINE_RADIUS:
                 return 2 * nodes, 4 * delta
-            if "snap on their own" in why or "Derjaguin" in why:
+            if kind in REFINE_NODES:
                 return 2 * nodes, delta
             return None                     # a failure refinement does not address
         grid, tail = records[-1]["grid_rel_error"], records[-1]["tail_rel_error"]
@@ -80,7 +89,7 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
     res.accuracy = {"target": target, "met": met, "nodes": steps[-1]["nodes"],
                     "analysis_radius_m": steps[-1]["analysis_radius_m"], "steps": steps}
     if not met and res.status == "converged":
-        res.status = "failed"
+        res.status, res.failure_kind = "failed", "accuracy"
         res.error = (f"accuracy {target:g} not met: estimated relative error "
                      f"{steps[-1]['grid_rel_error'] + steps[-1]['tail_rel_error']:.2g} with "
                      f"N = {steps[-1]['nodes']} (the budget: N <= {budget.max_nodes}, "

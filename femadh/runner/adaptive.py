@@ -10,12 +10,25 @@ until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
     h <- h * clamp((SAFETY * target / error)^(1/ORDER), MIN_FACTOR, MAX_FACTOR)
 
 A failed solve (a node snapping on its own, a stalled continuation, a landing after a fold
-that Newton cannot polish) halves h, a contact reaching the analysis radius doubles it, a
-feature that left the band widens the band, and members that all fail refine h: each while
-the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. The result says what was
-chosen and every trial (``result.accuracy``), or fails naming the accuracy reached, the nodes
-it used and about how many the request would need.
+that Newton cannot polish) halves h, a contact reaching the analysis radius doubles the
+disk, a feature that left the band widens the band, and members that all fail refine h:
+each while the budget (MAX_TRIALS runs, MAX_NODES nodes) lasts. Which remedy a failure gets
+is decided by its kind (``result.failure_kind``, the type of the exception that ended the
+run, :func:`femadh.estimate.guards.failure_kind`), never by the words of its message; a run
+stopped by a signal or its time limit ends the loop. The runs are the attempts of the
+shared refine-until-met loop (:func:`femadh.estimate.refine.refine_until_met`), one
+:class:`Trial` each. The result says what was chosen and every trial
+(``result.accuracy``), or fails naming the accuracy reached, the nodes it used, the time and
+about how many nodes the request would need.
+
+The band is static by default: a band that follows the contact edge
+(``[solver.grid] follow``, FOLLOW_NODES) was measured against it on the Fig 3, Fig 4 and
+slider + meniscus scenes (validation/results/adaptive_follow.md) and did not pay: at the
+same band spacing it has 1/3-1/4 of the nodes, but its estimate (the coarser members follow
+the edge on their own grids) is 3-5x larger and erratic, so the loop refines once more, and
+each of its runs carries the state across a dozen grid exchanges.
 """
+from dataclasses import dataclass
 import math
 import time
 
@@ -24,6 +37,9 @@ import numpy as np
 from ..discretisation import GridFamily, plan_grid
 from ..discretisation.family import MAX_NODES
 from ..discretisation.plan import safe_spacing
+from ..estimate.refine import Budget, refine_until_met
+from .accuracy import REFINE_RADIUS
+from .result import STOPPED
 
 #: runs (refinements + 1) an adaptive run may make
 MAX_TRIALS = 5
@@ -38,6 +54,13 @@ MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
 REFERENCE_ACCURACY, MIN_BAND_NODES = 1e-3, 48
 #: a feature beyond this fraction of the band radius widens the band
 BAND_FILL = 0.97
+#: a sigma-gap stepping scene whose static member would have more than this many nodes runs
+#: on a band that follows the contact edge instead ([solver.grid] follow,
+#: :class:`~femadh.discretisation.moving.EdgeBand`; None: never, the default: measured not
+#: to pay, see the module docstring)
+FOLLOW_NODES = None
+#: half-width of that band over the static band's radius
+FOLLOW_HALF = 1 / 6
 
 
 def _relative(res):
@@ -62,7 +85,30 @@ def _feature_radius(res, problem_shape, gap):
     return out
 
 
-def _capped(scene, family, spacing):
+def _member(family, spacing, follow):
+    """The family's member of band spacing h (m): the static band, or (``follow``, its
+    half-width in m) the band that follows the edge, as its trace starts (centred on r = 0,
+    as :func:`femadh.scene.build.discretisation_grid` builds it)."""
+    if follow:
+        from ..discretisation.moving import follow_family
+
+        return follow_family(family.radius, follow, family.grading, 0.0).member(spacing)
+    return family.member(spacing)
+
+
+def _follows(scene, family, spacing):
+    """The follow band's half-width (m) for this member, or None (a static band): only a
+    sigma-gap stepping scene follows its edge (:func:`femadh.runner.tracing.trace_steps`),
+    and only where its static member would exceed FOLLOW_NODES."""
+    if FOLLOW_NODES is None or scene.gap is None or scene.continuation == "arclength" or \
+            getattr(scene.gap, "contact_model", "complementarity") != "complementarity":
+        return None
+    if family.count(spacing) <= FOLLOW_NODES:
+        return None
+    return FOLLOW_HALF * family.band
+
+
+def _capped(scene, family, spacing, follow=None):
     """(spacing, operator, problem) with the spacing capped below the trapping-safe one of
     the family (two passes: the ratio is measured on the member itself)."""
     from ..elastic import GreenOperator
@@ -70,7 +116,7 @@ def _capped(scene, family, spacing):
 
     op = problem = None
     for _ in range(3):
-        op = GreenOperator(family.member(spacing), scene.e_star)
+        op = GreenOperator(_member(family, spacing, follow), scene.e_star)
         problem = build_problem(scene, operator=op)
         safe = safe_spacing(problem)
         if spacing <= safe:
@@ -79,11 +125,69 @@ def _capped(scene, family, spacing):
     return spacing, op, problem
 
 
+@dataclass
+class Trial:
+    """One setting of the refine loop: a member of a family, as it is run.
+
+    Attributes
+    ----------
+    family : GridFamily
+    spacing : float
+        The band spacing h (m) the member uses: the one asked for, capped below the
+        trapping-safe spacing (:func:`_capped` may shrink it).
+    asked : float
+        The band spacing (m) asked for, before the cap.
+    nodes : int
+        The member's node count; above the node limit where the member was refused.
+    operator : GreenOperator or None
+        The member's operator until it has been run (then dropped: the loop keeps every
+        setting); None where the member would exceed the family's node limit
+        (:data:`~femadh.discretisation.family.MAX_NODES`).
+    follow : float or None
+        Half-width (m) of a band that follows the contact edge (None: the static band).
+    """
+
+    family: GridFamily
+    spacing: float
+    asked: float
+    nodes: int
+    operator: object = None
+    follow: float | None = None
+
+    def grid(self):
+        """The member's [solver.grid] table (SI)."""
+        out = self.family.as_dict(self.spacing)
+        if self.follow:
+            out["follow"] = self.follow
+        return out
+
+
+def _trial(scene, family, spacing):
+    """The :class:`Trial` of ``family`` at band spacing ``spacing`` (m), capped."""
+    follow = _follows(scene, family, spacing)
+    try:
+        h, op, _ = _capped(scene, family, spacing, follow)
+    except ValueError:          # the member would exceed MAX_NODES
+        return Trial(family, spacing, spacing, max(family.count(spacing), MAX_NODES + 1),
+                     None, follow)
+    return Trial(family, h, spacing, op.grid.n, op, follow)
+
+
+def _too_many_nodes(trial):
+    return (f"the grid would need more than {MAX_NODES} nodes (band spacing "
+            f"{trial.asked * 1e9:.3g} nm over {trial.family.band * 1e6:.3g} um)")
+
+
 def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=False,
                  resume=False, estimate=True):
     """Run ``scene`` on its adaptive grid (see the module docstring) with ``run``
     (:func:`femadh.runner.run.run`); with ``estimate`` not True, one run on the planned
-    member (its accuracy unjudged)."""
+    member (its accuracy unjudged).
+
+    The runs are the attempts of :func:`femadh.estimate.refine.refine_until_met` (budget
+    MAX_TRIALS - 1 refinements, MAX_NODES nodes): each attempt runs one :class:`Trial` and
+    decides from its result what the next would be (:func:`_decide`), the loop's refine
+    step builds that member (capped)."""
     from ..io.progress import phase
     from ..scene import scene_id
     from .estimates import variant
@@ -98,75 +202,54 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     h = min(plan.spacing * (target / REFERENCE_ACCURACY) ** (1.0 / ORDER),
             family.band / MIN_BAND_NODES)
     mode = {"overwrite": overwrite, "resume": resume}
-    steps, res, trial = [], None, None
-    failure = None
-    for i in range(MAX_TRIALS):
-        try:
-            h, op, _ = _capped(scene, family, h)
-        except ValueError:
-            failure = (f"the grid would need more than {MAX_NODES} nodes (band spacing "
-                       f"{h * 1e9:.3g} nm over {family.band * 1e6:.3g} um)")
-            break
-        trial = variant(scene, grid=family.as_dict(h), radius=family.radius)
-        with phase(f"{'refinement ' + str(i) if i else 'grid'} ({op.grid.n} nodes)"):
+    steps = []
+    # what the last attempt decided: the next (family, spacing) asked for, or None with the
+    # failure that ends the request (None: none, e.g. a stop or an unjudged run)
+    ahead = {"next": None, "failure": None, "refused": None, "trial": None}
+
+    def attempt(tr):
+        i = len(steps)
+        trial = variant(scene, grid=tr.grid(), radius=tr.family.radius)
+        ahead["trial"] = trial
+        with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.nodes} nodes)"):
             res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
-                      operator=op, folder_id=scene_id(scene), **mode)
-        mode = {"overwrite": True, "resume": False}      # later trials replace earlier ones
+                      operator=tr.operator, folder_id=scene_id(scene), **mode)
+        tr.operator = None            # run: its dense operator need not outlive it
+        mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
                           else (math.nan, math.nan))
-        steps.append({"nodes": op.grid.n, "spacing_m": h, "band_m": family.band,
-                      "analysis_radius_m": family.radius, "status": res.status,
-                      "grid_rel_error": grid_e, "tail_rel_error": tail_e,
-                      "wall_time_s": res.wall_time})
-        if res.status == "interrupted" or estimate is not True:
-            break
-        if res.status != "converged":
-            err_text = res.error or ""
-            if "analysis radius" in err_text:
-                # the contact reached the disk's edge: a larger disk, the same band spacing
-                family = GridFamily(2 * family.radius, family.band, family.grading)
-            else:
-                # lattice trapping, a stalled continuation, a landing Newton could not polish
-                # after a fold: the discretisation's failures, which a finer member resolves
-                h *= 0.5
-            steps[-1]["refined_after"] = err_text
-            continue
-        edge = _feature_radius(res, trial.sphere.shape, plan.feature_gap)
-        if edge > BAND_FILL * family.band and family.band < family.radius:
-            # the feature left the band: widen it (the spacing stays)
-            family = GridFamily(family.radius, min(family.radius, 1.2 * edge / BAND_FILL),
-                                family.grading)
-            steps[-1]["band_left_m"] = edge
-            continue
-        judged = len(res.grid.get("members", ()))
-        if judged == 0:
-            # no coarser member converged (a stalled landing at a meniscus edge, trapping):
-            # the grid error is unknown, so the result cannot be called converged; a finer
-            # family has finer members
-            steps[-1]["members_failed"] = True
-            h *= MAX_FACTOR
-            continue
-        err = grid_e + tail_e
-        if err <= target:
-            break
-        if tail_e > SAFETY * target:
-            # the force beyond the disk: a finer spacing cannot help, a larger disk can -
-            # unless it would reach the sphere's own size (eq 4's paraboloid is a sphere only
-            # for r << R; a small tip keeps its tail as F_tail and this part of the estimate)
-            cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
-            if 2 * family.radius < cap:
-                family = GridFamily(2 * family.radius, family.band, family.grading)
-                steps[-1]["tail_grew_radius"] = True
-                continue
-            failure = (f"the force beyond the analysis radius alone is {tail_e:.2g} relative "
-                       f"and the radius cannot grow (it would reach the sphere's radius "
-                       f"{scene.sphere.radius * 1e9:.4g} nm); the grid part is {grid_e:.2g}")
-            break
-        factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
-        h *= min(MAX_FACTOR, max(MIN_FACTOR, factor))
-    met = bool(res is not None and res.status == "converged" and estimate is True and steps
-               and not steps[-1].get("members_failed")
-               and steps[-1]["grid_rel_error"] + steps[-1]["tail_rel_error"] <= target)
+        steps.append({"nodes": tr.nodes, "spacing_m": tr.spacing,
+                      "band_m": tr.family.band, "analysis_radius_m": tr.family.radius,
+                      "status": res.status, "grid_rel_error": grid_e,
+                      "tail_rel_error": tail_e, "wall_time_s": res.wall_time})
+        if tr.follow:
+            steps[-1]["follow_m"] = tr.follow
+        why = _decide(scene, tr, res, estimate, steps[-1], plan, target, ahead)
+        return res, (grid_e + tail_e if why is None else math.inf), why
+
+    def refine(tr, res, error, why):
+        if ahead["next"] is None:
+            return None
+        nxt = _trial(scene, *ahead["next"])
+        if nxt.operator is None:
+            ahead["refused"] = nxt
+        return nxt
+
+    out = None
+    first = _trial(scene, family, h)
+    if first.operator is None:
+        failure = _too_many_nodes(first)
+    else:
+        out = refine_until_met(first, attempt, refine, target,
+                               Budget(MAX_TRIALS - 1, MAX_NODES),
+                               nodes=lambda tr, res, nxt: nxt.nodes)
+        # (a failure decided on the last run ends the request even where the budget of
+        # runs ended it as well: it says why more runs would not help)
+        failure = (_too_many_nodes(ahead["refused"]) if out.stop == "nodes"
+                   else ahead["failure"])
+    res = out.result if out is not None else None
+    family = out.setting.family if out is not None else family
+    met = bool(out is not None and out.met and estimate is True)
     if res is None:
         from .result import ContactResult
 
@@ -180,21 +263,23 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                     "wall_time_s": time.perf_counter() - t0}
     if failure and res.status == "converged" or failure and not steps:
         res.status, res.error = "failed", f"accuracy {target:g} not met: {failure}"
+        res.failure_kind = "accuracy"
     elif not met and res.status == "converged" and estimate is True and \
             last.get("members_failed"):
-        res.status = "failed"
+        res.status, res.failure_kind = "failed", "accuracy"
         res.error = (f"accuracy {target:g} not judged: no coarser member of the grid family "
                      f"converged after {len(steps)} runs (last: {last['nodes']} nodes, band "
                      f"spacing {last['spacing_m'] * 1e9:.3g} nm); see the warnings")
     elif not met and res.status == "converged" and estimate is True:
         reached = last["grid_rel_error"] + last["tail_rel_error"]
         need = _nodes_needed(family, last["spacing_m"], reached, target)
-        res.status = "failed"
+        res.status, res.failure_kind = "failed", "accuracy"
         res.error = (f"accuracy {target:g} not met: estimated relative error {reached:.2g} "
                      f"with {last['nodes']} nodes after {len(steps)} runs "
                      f"({res.accuracy['wall_time_s']:.3g} s); the request needs about "
                      f"{need} nodes (budget: {MAX_TRIALS} runs, {MAX_NODES} nodes)")
     res.timings["adaptive_total_s"] = time.perf_counter() - t0
+    trial = ahead["trial"]
     if out_dir is not None and trial is not None:
         from ..io.run_folder import RunFolder
         from .result import contact_summary as summary
@@ -210,6 +295,71 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                     draw_figures(res, folder)
             folder.write_summary(summary(res))
     return res
+
+
+def _decide(scene, tr, res, estimate, step, plan, target, ahead):
+    """Judge one trial's result and decide the next member: sets ``ahead["next"]`` (the
+    (family, band spacing) to run next, or None) and ``ahead["failure"]`` (why the request
+    ends, or None), records the reason in ``step``; returns why the trial is not resolved
+    (None: it is, and its estimate is its error).
+
+    The failure's kind (``res.failure_kind``, its exception's type), never its words, picks
+    the remedy: a contact at the analysis radius doubles the disk, any other failure of the
+    discretisation (a node snapping on its own, a stalled continuation, a landing Newton
+    could not polish after a fold) halves h; a stopped run (signal, time limit) or an
+    unjudged one (``estimate`` not True) ends the loop."""
+    family, h = tr.family, tr.spacing
+    ahead["next"] = ahead["failure"] = None
+    if res.status in STOPPED:
+        return res.status
+    if estimate is not True:
+        return "not estimated"
+    if res.status != "converged":
+        if res.failure_kind == REFINE_RADIUS:
+            # the contact reached the disk's edge: a larger disk, the same band spacing
+            ahead["next"] = (GridFamily(2 * family.radius, family.band, family.grading), h)
+        else:
+            # lattice trapping, a stalled continuation, a landing Newton could not polish
+            # after a fold: the discretisation's failures, which a finer member resolves
+            ahead["next"] = (family, 0.5 * h)
+        step["refined_after"] = res.error or ""
+        step["refined_for"] = res.failure_kind
+        return res.error or res.status
+    edge = _feature_radius(res, scene.sphere.shape, plan.feature_gap)
+    if edge > BAND_FILL * family.band and family.band < family.radius:
+        # the feature left the band: widen it (the spacing stays)
+        ahead["next"] = (GridFamily(family.radius, min(family.radius, 1.2 * edge / BAND_FILL),
+                                    family.grading), h)
+        step["band_left_m"] = edge
+        return "the feature left the band"
+    if len(res.grid.get("members", ())) == 0:
+        # no coarser member converged (a stalled landing at a meniscus edge, trapping):
+        # the grid error is unknown, so the result cannot be called converged; a finer
+        # family has finer members
+        step["members_failed"] = True
+        ahead["next"] = (family, h * MAX_FACTOR)
+        return "no coarser member converged"
+    grid_e, tail_e = step["grid_rel_error"], step["tail_rel_error"]
+    err = grid_e + tail_e
+    if err <= target:
+        return None
+    if tail_e > SAFETY * target:
+        # the force beyond the disk: a finer spacing cannot help, a larger disk can -
+        # unless it would reach the sphere's own size (eq 4's paraboloid is a sphere only
+        # for r << R; a small tip keeps its tail as F_tail and this part of the estimate)
+        cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
+        if 2 * family.radius < cap:
+            ahead["next"] = (GridFamily(2 * family.radius, family.band, family.grading), h)
+            step["tail_grew_radius"] = True
+            return None
+        ahead["failure"] = (f"the force beyond the analysis radius alone is {tail_e:.2g} "
+                            f"relative and the radius cannot grow (it would reach the "
+                            f"sphere's radius {scene.sphere.radius * 1e9:.4g} nm); the grid "
+                            f"part is {grid_e:.2g}")
+        return None
+    factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
+    ahead["next"] = (family, h * min(MAX_FACTOR, max(MIN_FACTOR, factor)))
+    return None
 
 
 def _nodes_needed(family, spacing, reached, target):

@@ -215,7 +215,13 @@ def _finish(scene, res, problem, sink, estimate, run):
             res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
             res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
-        guard_bounds(res, problem)
+        try:
+            guard_bounds(res, problem)
+        except GuardError as exc:
+            # the bounds guard's refusal, typed as such (its kind decides the refinement)
+            from ..estimate.guards import BoundError
+
+            raise BoundError(str(exc)) from None
     res.timings["estimate_s"] = time.perf_counter() - t1
 
 

@@ -53,7 +53,7 @@ from ..estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F4
 #: (observed 3.0-3.6 on layered stacks, validation/results/layered_fe.md; 3.3 homogeneous)
 FE_ORDER = 3
 #: the largest N accuracy mode may choose
-MAX_NODES = 3200
+from ..estimate.refine import UNIFORM_MAX_NODES as MAX_NODES  # noqa: E402 (its one home)
 #: refinements accuracy mode may make
 MAX_REFINEMENTS = 5
 #: the coarser members solve only the states the headline numbers are read at, from the fine

@@ -4,7 +4,8 @@ A run's ``summary.json`` says "running" from the moment its folder is claimed; t
 ends in exactly one status, written last, atomically:
 
 - the work returns: "converged" [1];
-- a solver failure (one of ``failures``): "failed", ``error`` its words;
+- a solver failure (one of ``failures``): "failed", ``error`` its words, ``failure_kind`` its
+  kind by its type (:func:`femadh.estimate.guards.failure_kind`: what the refine loops read);
 - SIGINT / SIGTERM (:class:`~femadh.errors.Interrupted`): "interrupted";
 - the time limit (:class:`~femadh.errors.TimeLimitReached`): "time limit";
 - anything else (a full disk, a bug, a KeyboardInterrupt outside the main thread): "failed",
@@ -32,6 +33,7 @@ import time
 
 from .. import interrupt
 from ..errors import Interrupted
+from ..estimate.guards import failure_kind
 
 
 class Life:
@@ -100,7 +102,7 @@ def lifecycle(result, write=None, *, failures=(), announce=True, t0=None):
             if result.status == "running":
                 result.status = "converged"
         except failures as exc:
-            result.fail(str(exc))
+            result.fail(str(exc), failure_kind(exc))
         except Interrupted as exc:
             result.stop(exc)
             if life.on_stop is not None:

@@ -50,6 +50,11 @@ class RunResult:
     exit_code : int or None
         A stopped run's exit code: 130 (SIGINT), 143 (SIGTERM), 6 (time limit); None for a
         run that converged or failed (the command line exits 0 or 3).
+    failure_kind : str or None
+        What ended a run that did not converge, by the exception's type
+        (:func:`femadh.estimate.guards.failure_kind`: "analysis_radius", "trapping",
+        "bound", "convergence", "time_limit", "interrupted", "error", ...; "accuracy": an
+        accuracy request not met); None for a converged run. The refine loops switch on it.
     """
 
     name: str
@@ -60,6 +65,7 @@ class RunResult:
     out_dir: str | None = None
     headline: dict = field(default_factory=dict)
     exit_code: int | None = None
+    failure_kind: str | None = None
 
     #: the scene kind ("contact", "meniscus")
     kind = None
@@ -72,11 +78,15 @@ class RunResult:
     def stop(self, exc, where=""):
         """The run stopped at a safe point by ``exc`` (an Interrupted or TimeLimitReached):
         its status, error (``where`` appended) and exit code."""
-        self.status, self.error, self.exit_code = exc.status, f"{exc}{where}", exc.exit_code
+        from ..estimate.guards import failure_kind
 
-    def fail(self, error):
-        """The run failed: ``error`` says where and why."""
-        self.status, self.error = "failed", error
+        self.status, self.error, self.exit_code = exc.status, f"{exc}{where}", exc.exit_code
+        self.failure_kind = failure_kind(exc)
+
+    def fail(self, error, kind="error"):
+        """The run failed: ``error`` says where and why, ``kind`` what kind of failure it is
+        (:attr:`failure_kind`)."""
+        self.status, self.error, self.failure_kind = "failed", error, kind
 
     def summary(self, status=None):
         """summary.json of the run as a dict (``status`` overrides the result's)."""
@@ -262,6 +272,7 @@ def contact_summary(res, status=None):
 
     return {"femadh_version": __version__, "scene_file": scene.path,
             "status": status or res.status, "error": res.error,
+            "failure_kind": res.failure_kind,
             # the scene actually run (an adaptive trial's; its rows' checksums are seeded
             # with it)
             "run_id": scene_id(scene),

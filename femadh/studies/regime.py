@@ -72,7 +72,7 @@ R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 #: it within ~0.55 (measured max 0.53-0.74 at mu = 3-20, band 4 ell)
 BAND_LIMIT = 0.9
 #: a contact edge beyond this fraction of the analysis radius is not resolved
-EDGE_LIMIT = 0.8
+from ..estimate.guards import SMOOTH_EDGE_FRACTION as EDGE_LIMIT  # noqa: E402 (its home)
 #: observed order of the spacing error of the headline quantities (measured, see
 #: validation/results/accuracy_regime.md); Richardson divides the coarse-fine change by 2^p - 1
 ORDER = 2.0
@@ -83,7 +83,7 @@ HYSTERESIS_FLOOR = 0.1
 MAX_REFINEMENTS = 4
 #: node budget of a refinement (a dense grid of N nodes costs ~N^2 per Krylov iteration at
 #: every continuation step: 1600 nodes ~ 10x the cost of 500)
-MAX_NODES = 1600
+from ..estimate.refine import CONTINUATION_MAX_NODES as MAX_NODES  # noqa: E402 (its home)
 #: the budget of an accuracy request (:func:`femadh.estimate.refine.refine_until_met`)
 BUDGET = Budget(MAX_REFINEMENTS, MAX_NODES)
 #: the headline quantities and the accuracy they are judged by

@@ -221,8 +221,9 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
 
 
 def _outcome(rec):
-    """Whether a record holds an outcome (not a point still "running" or "interrupted")."""
-    return rec.get("status") in ("converged", "failed")
+    """Whether a record holds an outcome (not a point still "running" or "interrupted"): a
+    point stopped by its own time limit has one ("time limit", run again to continue it)."""
+    return rec.get("status") in ("converged", "failed", "time limit")
 
 
 def _timing(out, result, t0):
