@@ -999,8 +999,8 @@ DEFECTS = [
       "plain GuardError", "femadh/estimate/guards.py",
       (("        raise AnalysisRadiusError(", "        raise GuardError("),)),
     D("bound_untyped", "runner: the bounds guard's refusal not typed as BoundError",
-      "femadh/runner/contact.py",
-      (("            raise BoundError(str(exc)) from None", "            raise"),)),
+      "femadh/runner/estimates.py",
+      (("        raise BoundError(\n", "        raise GuardError(\n"),)),
     D("adaptive_stop_refines", "adaptive grid: a trial stopped by its time limit is refined "
       "and run again", "femadh/runner/adaptive.py",
       (("    if res.status in STOPPED:\n        return res.status",

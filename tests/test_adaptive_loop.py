@@ -219,13 +219,11 @@ def test_a_real_run_carries_its_guards_kind():
 
 
 def test_the_bounds_guard_reaches_the_result_as_its_kind(monkeypatch):
-    """The Derjaguin-Bradley guard's refusal (a GuardError of runner.estimates.guard_bounds)
-    ends the run with kind "bound" (typed by the runner where the bound is checked)."""
+    """The Derjaguin-Bradley guard's refusal (runner.estimates.guard_bounds raises a
+    BoundError) ends the run with kind "bound": the real guard, its bound test forced."""
     from femadh.runner import estimates
 
-    def refuse(res, problem):
-        raise GuardError("the largest adhesion exceeds the bound")
-    monkeypatch.setattr(estimates, "guard_bounds", refuse)
+    monkeypatch.setattr(estimates, "outside_bounds", lambda *a, **k: True)
     sc = femadh.load_scene(FIG3).replace({"solver.nodes": 60, "sweep.stop": "-1 nm"})
     res = femadh.run(sc, progress=False, estimate="peak")
     assert res.status == "failed" and res.failure_kind == "bound" and "bound" in res.error

@@ -25,7 +25,7 @@ from femadh.elastic import GreenOperator, RadialGrid
 from femadh.indenter import Sphere
 from femadh.laws import LennardJones
 from femadh import estimate as est
-from femadh.estimate import (GuardError, TrappingError, check_state, discretisation,
+from femadh.estimate import (BoundError, GuardError, TrappingError, check_state, discretisation,
                              observed_order, richardson)
 from femadh.runner.estimates import coarser_members, guard_bounds, variant
 from femadh.scene import build_problem
@@ -285,7 +285,7 @@ def test_derjaguin_bound_guard_on_both_sides_of_the_bound_plus_the_error():
     guard_bounds(res(0.999 * bound, 0.0), smooth)
     guard_bounds(res(1.01 * bound, 0.011 * bound), smooth)
     for F, err in ((1.01 * bound, 0.009 * bound), (1.001 * bound, 0.0)):
-        with pytest.raises(GuardError, match="Derjaguin"):
+        with pytest.raises(BoundError, match="Derjaguin"):
             guard_bounds(res(F, err), smooth)
     guard_bounds(res(2 * bound, 0.0), SimpleNamespace(contact_model="hertz-closure", gap=None))
 

@@ -44,8 +44,8 @@ from scipy import optimize
 from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
-from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, GuardError,  # noqa: F401
-                               TrappingError, check_state, outside_bounds)
+from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
+                               GuardError, TrappingError, check_state, outside_bounds)
 from ..estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F401
                                    discretisation)
 
@@ -409,7 +409,7 @@ def guard_bounds(res, problem):
         return
     F, bound, err = hl["max_adhesion_N"], hl["dmt_pull_off_N"], hl.get("max_adhesion_N_error", 0)
     if outside_bounds(F, err, upper=bound):
-        raise GuardError(
+        raise BoundError(
             f"the largest adhesion {F:.6g} N (estimated error {err:.2g} N) exceeds the "
             f"Derjaguin-Bradley bound 2 pi R W = {bound:.6g} N of the scene's work of "
             f"adhesion W = {hl['work_of_adhesion_J_per_m2']:.4g} J/m^2: the discretisation is "
