@@ -560,7 +560,7 @@ DEFECTS = [
       "femadh/runner/estimates.py",
       (("np.full(1, _contact_gap(problem))", "np.full(1, 2 * _contact_gap(problem))"),)),
     D("est_peak_bracket", "peak search to 1e-3 of its bracket (resolution 10x coarser)",
-      "femadh/runner/estimates.py",
+      "femadh/runner/peak.py",
       (("xatol = 1e-4 * (hi - lo)", "xatol = 1e-3 * (hi - lo)"),)),
     D("est_uniform_members", "uniform family: members N/2 and N/3 at the ratio 2",
       "femadh/runner/estimates.py",

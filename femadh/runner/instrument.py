@@ -119,13 +119,13 @@ def refine_instrument(scene, res, problem, sink):
     """Sharpen the instrument's numbers: in every interval where the readout interpolates a
     turning point of z (:meth:`~femadh.instrument.InstrumentPath.brackets`), solve fresh
     states between the two
-    computed ones (:func:`femadh.runner.estimates.state_between`), read again; up to
+    computed ones (:func:`femadh.runner.peak.state_between`), read again; up to
     REFINE_ROUNDS rounds. The fresh states feed the readout only (curve.csv keeps the sweep's
     states). Updates ``res.headline`` and ``res.instrument``; returns the fresh states'
     count."""
     from ..contact.forces import state_forces, tail_force
     from ..instrument import read_instrument
-    from .estimates import state_between
+    from .peak import state_between
 
     spring = scene.instrument
     pool = {b: list(v) for b, v in sink.states.items()}

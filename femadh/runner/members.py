@@ -11,7 +11,7 @@ only, each by Newton from the fine run's committed state there carried to the me
 - the deepest separation: one state (F_LJ and F_ex there);
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
-  the fine run's (:func:`femadh.runner.estimates.peak_adhesion`);
+  the fine run's (:func:`femadh.runner.peak.peak_adhesion`);
 - each fold: continued on the fine run's lattice of smallest steps (the stepping's own in
   that grid step) from a few lattice steps before the fine run's fold, with the stepping's
   acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
@@ -163,7 +163,7 @@ class _Member:
 def _peak(m, sink, snaps, d_fine=None):
     """(F, d) of the member's largest adhesion: its grid maximum near the fine run's, then
     the bounded search between the grid states around it."""
-    from .estimates import peak_adhesion
+    from .peak import peak_adhesion
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]

@@ -1,0 +1,69 @@
+"""Fresh states between a branch's grid states, and the peak search that uses them.
+
+A headline number read between two grid states (the largest adhesion; an instrument's
+reading; an estimate member's peak near the fine run's) is solved as a fresh equilibrium
+from the displacements interpolated between the bracketing states, and kept only if it
+stayed on that branch. Used by the error estimate (:mod:`femadh.runner.estimates`), its
+reduced members (:mod:`femadh.runner.members`) and the instrument
+(:mod:`femadh.runner.instrument`).
+"""
+import numpy as np
+from scipy import optimize
+
+
+def state_between(problem, a, b, d, scene, reuse=False):
+    """A fresh equilibrium at separation d between two states a and b of one branch, solved
+    from the displacements interpolated between them, or None unless it converged, is stable
+    and stayed on that branch (every gap within a quarter of the interpolation's). With
+    ``reuse``, the nearer state's factorisation (if it has one) serves the corrector's chord
+    steps, as in a sweep's step (an estimate's member: a third of the fresh factorisations;
+    the fine run's own search keeps its fresh Newton, its bits unchanged)."""
+    from ..contact import solve_state
+
+    t = (d - a.d) / (b.d - a.d)
+    w0, near = (1 - t) * a.w + t * b.w, a if abs(d - a.d) < abs(d - b.d) else b
+    kw = {}
+    if reuse and getattr(near, "lu", None) is not None:
+        kw["factor"] = near.lu
+    if problem.contact_model == "hertz-closure":
+        kw["r_c0"] = near.r_c or None
+    elif problem.sigma is not None:
+        kw["active0"] = near.active | (problem.contour(d) - w0 < problem.sigma)
+    st = solve_state(problem, d, w0, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
+    h_pred = problem.contour(d) - w0
+    if not (st.converged and st.stable) or np.any(
+            np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+        return None
+    return st
+
+
+def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
+    """The largest F_ex of the curve between the grid states around its best grid state
+    ``best``: a bounded search in d on fresh states, each solved from the displacements
+    interpolated between the bracketing grid states and accepted only if it stays on that
+    branch (within a quarter of every gap of the interpolation). The states may be
+    :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
+    hold them. ``within`` = (lo, hi) narrows the search to that part of the bracket (an
+    estimate's member near the fine run's peak: fewer fresh states, the same absolute
+    tolerance in d); ``reuse``: see :func:`state_between`. Returns (F, d, half-width of the
+    final d bracket)."""
+    from ..contact.forces import state_forces
+
+    f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
+    lo, hi = sorted((prev.d, nxt.d))
+    xatol = 1e-4 * (hi - lo)
+    if within is not None:
+        lo, hi = max(lo, within[0]), min(hi, within[1])
+    found = {}
+
+    def neg(d):
+        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
+        st = state_between(problem, a, b, d, scene, reuse)
+        if st is None:
+            return -f_best
+        found[d] = state_forces(problem, st)[2]
+        return -found[d]
+    optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                             options={"xatol": xatol, "maxiter": 40})
+    F, d = max([(f_best, best.d)] + [(v, x) for x, v in found.items()])
+    return float(F), float(d), xatol
