@@ -424,7 +424,7 @@ DEFECTS = [
         "    return (fine - coarse) / (2.0**order - 1.0)"),)),
     D("envelope_dropped", "oscillating members: the finest difference alone (may cancel)",
       "femadh/estimate/richardson.py",
-      (("max(abs(d1), abs(d2) / (ratio2 if uneven else ratio)**p)", "abs(d1)"),)),
+      (("max(abs(d1), abs(d2) * scale)", "abs(d1)"),)),
     D("member_spacing", "estimate members: both at r h instead of r h and r^2 h",
       "femadh/runner/estimates.py", (('h = g["spacing"] * r**k', 'h = g["spacing"] * r'),)),
     D("tail_share", "analysis radius: the tail allowed the whole target, not its share",
@@ -998,6 +998,18 @@ DEFECTS = [
     D("guard_radius_untyped", "contact guard: a contact at the analysis radius raised as a "
       "plain GuardError", "femadh/estimate/guards.py",
       (("        raise AnalysisRadiusError(", "        raise GuardError("),)),
+    D("envelope_uneven_factor", "oscillating members at uneven ratios: the coarser "
+      "difference scaled by 1/r2^p (the model's factor only for even ratios)",
+      "femadh/estimate/richardson.py",
+      (("(ratio**p - 1) / (ratio**p * (ratio2**p - 1)) if uneven", "ratio2**-p if uneven"),)),
+    D("relative_nan_met", "accuracy: a NaN error part dropped by max() (an unknown error "
+      "called met)", "femadh/runner/accuracy.py",
+      (("        if not all(math.isfinite(comp.get(part, 0.0)) for part in (\"total\", \"tail\")):",
+        "        if False:"),)),
+    D("headline_scan_nodal", "headline: the contact-gap scan read as a nodal field",
+      "femadh/contact/problem.py",
+      (('    def pointwise_pressure(self, h):\n        """Sum of the effect pressures (Pa) of every law evaluated pointwise at gaps h (a scan\n        of gaps, whatever its length: never read as a nodal field)."""\n        return self._sum("pressure", h)',
+        '    def pointwise_pressure(self, h):\n        """Sum of the effect pressures (Pa) of every law evaluated pointwise at gaps h (a scan\n        of gaps, whatever its length: never read as a nodal field)."""\n        return self.pressure(h)'),)),
     D("bound_untyped", "runner: the bounds guard's refusal not typed as BoundError",
       "femadh/runner/estimates.py",
       (("        raise BoundError(\n", "        raise GuardError(\n"),)),

@@ -7,6 +7,7 @@ estimate) is given, and what the loop asks next (spacing, band, analysis radius,
 read off the trials it runs. The real runs at the end check that a guard's refusal reaches
 the result with its kind."""
 import copy
+import math
 
 import numpy as np
 import pytest
@@ -269,3 +270,20 @@ def test_the_follow_switch_hands_each_trial_its_follow_band(monkeypatch):
     run, seen = scripted([{"grid": 1e-3}])
     adaptive.run_adaptive(adaptive_scene(accuracy=1e-2), None, run=run)
     assert seen[0][3] is None
+
+
+def test_an_error_part_that_is_not_finite_is_never_met():
+    """A headline number whose estimated error is NaN (a part that could not be estimated):
+    the relative error is infinite, so neither accuracy mode nor the adaptive loop calls the
+    request met (max() dropped the NaN: (1e-4, 0) was returned, below any target)."""
+    from types import SimpleNamespace
+
+    hl = {"max_adhesion_N": 1e-5, "F_ex_deepest_N": -1e-3, "F_LJ_deepest_N": 2e-4}
+    good = {"max_adhesion_N": {"total": 1e-9, "tail": 0.0},
+            "F_ex_deepest_N": {"total": 1e-9, "tail": 0.0}}
+    grid, tail = accuracy._relative(SimpleNamespace(headline=hl, estimates=good))
+    assert grid == pytest.approx(1e-4, rel=1e-12, abs=0) and tail == 0.0
+    for part in ("total", "tail"):
+        bad = {**good, "F_LJ_deepest_N": {"total": 1e-9, "tail": 0.0, part: math.nan}}
+        assert accuracy._relative(SimpleNamespace(headline=hl, estimates=bad)) == \
+            (math.inf, math.inf)

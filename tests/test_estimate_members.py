@@ -12,8 +12,8 @@ import pytest
 
 import femadh
 from femadh.errors import MeshResolutionWarning
-from femadh.estimate.richardson import (MAX_ORDER, ORDER, discretisation, observed_order,
-                                        observed_order_uneven)
+from femadh.estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER, discretisation,
+                                        observed_order, observed_order_uneven)
 from femadh.runner import estimates, members
 from femadh.scene import scene_from_dict
 
@@ -190,6 +190,22 @@ def test_uneven_richardson_recovers_a_known_order(r1, r2, p):
         pytest.approx(observed_order(fine, q[r1], 2.0 + 0.3 * (r1 * r1)**p, r1), rel=1e-9)
     # oscillating members: no order
     assert observed_order_uneven(fine, coarse, 2 * coarse - coarser, r1, r2) is None
+
+
+@pytest.mark.parametrize("r1, r2", [(1.3, 1.5), (1.5, 1.35), (1.414, 1.36)])
+def test_uneven_envelope_scales_the_coarser_difference_by_the_model(r1, r2):
+    """Oscillating members at uneven ratios: the coarser difference d2 = Q(r1 h) - Q(r1 r2 h)
+    enters the envelope as the finest difference it implies under Q = Q* + C h^p,
+    d2 (r1^p - 1) / (r1^p (r2^p - 1)). With d2 of the model's size C r1^p (r2^p - 1) (h = 1)
+    and a smaller finest difference of the other sign, the estimate is C with the finest
+    difference's sign (exact to round-off; 1/r2^p in place of the factor was 0.91-1.08x)."""
+    p, C = ENVELOPE_ORDER, 0.3
+    fine = 2.0 + C
+    coarse = fine + 0.1 * C                          # d1 = -0.1 C
+    coarser = coarse - C * r1**p * (r2**p - 1)       # d2 = +C r1^p (r2^p - 1): oscillating
+    assert observed_order_uneven(fine, coarse, coarser, r1, r2) is None
+    est = discretisation({"x": fine}, {"x": coarse}, {"x": coarser}, ratio=r1, ratio2=r2)["x"]
+    assert est == pytest.approx(-C, rel=1e-12, abs=0)
 
 
 def test_fe_mesh_richardson_is_the_shared_function():

@@ -175,7 +175,8 @@ class EdgeBranch:
         self.n_solves = 0
         self.n_iter = 0
         self.n_factor = 0
-        self._base = ContactProblem(base, sphere, effects, check_laws=False)
+        self._base = ContactProblem(base, sphere, effects, check_laws=False,
+                                    subgrid=False)
         # the laws' own pressure and derivative, called directly in the Newton loop (the
         # problem's sum checks every law's values for NaN at every call: here one check of
         # the residual, which any non-finite pressure makes non-finite, does it per iteration)

@@ -135,6 +135,11 @@ class ContactProblem:
         pointwise (scans, the contact gap)."""
         return bool(self.integrated) and np.shape(h) == (self.grid.n,)
 
+    def pointwise_pressure(self, h):
+        """Sum of the effect pressures (Pa) of every law evaluated pointwise at gaps h (a scan
+        of gaps, whatever its length: never read as a nodal field)."""
+        return self._sum("pressure", h)
+
     def pressure(self, h):
         """Sum of the effect pressures (Pa, attractive positive) at gaps h: at the nodes
         (h of shape (n,)) a sub-grid law's nodal pressure f_k / area_k, else every law

@@ -126,8 +126,11 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
                 # may cancel by chance; the envelope of both at the family's order
                 d1, d2 = v - c, c - cc
                 p = envelope_order
-                out[k] = math.copysign(max(abs(d1), abs(d2) / (ratio2 if uneven else ratio)**p),
-                                       d1) / (ratio**p - 1)
+                # d2 as the finest difference it implies under Q = Q* + C h^p: d1 / d2 =
+                # (r1^p - 1) / (r1^p (r2^p - 1)), 1 / r^p for even ratios
+                scale = ((ratio**p - 1) / (ratio**p * (ratio2**p - 1)) if uneven
+                         else ratio**-p)
+                out[k] = math.copysign(max(abs(d1), abs(d2) * scale), d1) / (ratio**p - 1)
                 continue
             # monotone convergence: the order it shows
             p = min(max_order, max(order, seen))

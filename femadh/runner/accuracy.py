@@ -27,6 +27,10 @@ def _relative(res):
     grid, tail = 0.0, 0.0
     for q in ("max_adhesion_N", "F_ex_deepest_N", "F_LJ_deepest_N"):
         comp = est.get(q, {})
+        if not all(math.isfinite(comp.get(part, 0.0)) for part in ("total", "tail")):
+            # a part that could not be estimated: the error is unknown, never "met" (max()
+            # would drop a NaN silently)
+            return math.inf, math.inf
         ref = max(abs(hl.get(q, 0.0)), 1e-3 * scale)
         grid = max(grid, (comp.get("total", 0.0) - comp.get("tail", 0.0)) / ref)
         tail = max(tail, comp.get("tail", 0.0) / ref)

@@ -19,7 +19,7 @@ def work_of_adhesion(problem):
         h_c = problem.sigma
     else:
         scan = np.logspace(-7, -11, 4000)
-        rep = np.flatnonzero(problem.pressure(scan) < 0)
+        rep = np.flatnonzero(problem.pointwise_pressure(scan) < 0)
         h_c = float(scan[rep[0]]) if rep.size else float(scan[-1])
     return float(-sum(np.asarray(e.energy(np.array([h_c])))[0]
                       for e in problem.effects.values()))
