@@ -528,7 +528,9 @@ def trace_edge_point(setup, tol):
         "pull_off": max(float(np.max(fa)), pull_c), "pull_off_displacement": F(fout),
         "jump_in": fin.d, "jump_out": d_out, "hysteresis": released, "loop_work": loop,
         "trapping": trapping,
-        "edge_ratio": max(s.c / s.problem.grid.radius for s in all_c),
+        # against the point's own analysis radius, as the static trace's: c over the scaled
+        # grid's radius is the same at every state (the grid scales with c)
+        "edge_ratio": max(s.c for s in all_c) / setup.a,
         "nodes": max(app.grid.n, grid.n), "nodes_approach": app.grid.n, "nodes_contact": grid.n,
         "n_points": len(apts) + len(all_c), "n_approach": len(apts),
         "n_branch_solves": branch.n_solves,
