@@ -18,6 +18,35 @@ E_STAR = composite_modulus(IsotropicMaterial(163e9, 0.3), IsotropicMaterial(83e9
 HAMAKER, Z0 = 1e-19, 0.165e-9
 
 
+#: the Fig 4 slider (R = 2 mm, sigma = 0.5 nm) on the uniform disk of delta = 10 nm, and
+#: separations through its jump-in (~1.11 nm) and pull-off (~1.18 nm) in 0.2 nm steps
+FIG4_RADIUS, FIG4_TOL = 2e-3, 1e-19
+FIG4_D_VALUES = np.round(np.arange(1.6, 0.59, -0.2), 10) * 1e-9
+
+
+def fig4_problem(n):
+    """The Fig 4 contact problem (LJ with the sigma = 0.5 nm gap) on n uniform nodes."""
+    import math
+
+    from femadh.contact import AsperityGap, ContactProblem
+    from femadh.elastic import GreenOperator, RadialGrid
+    from femadh.indenter import Sphere
+    from femadh.laws import LennardJones
+
+    a = math.sqrt(2 * FIG4_RADIUS * 10e-9)
+    return ContactProblem(GreenOperator(RadialGrid.uniform(a, n), E_STAR), Sphere(FIG4_RADIUS),
+                          {"lj": LennardJones(HAMAKER, Z0)}, AsperityGap(0.5e-9))
+
+
+def fig4_sweeps(p):
+    """(approach, retract) of ``p`` stepped through FIG4_D_VALUES."""
+    from femadh.contact import trace
+
+    ap = trace(p, FIG4_D_VALUES, branch="approach", tol=FIG4_TOL)
+    re = trace(p, FIG4_D_VALUES[::-1], branch="retract", tol=FIG4_TOL, start=ap.states[-1])
+    return ap, re
+
+
 def hertz_annulus_averages(edges, a, radius, e_star):
     """Annulus averages (Pa) of the Hertz pressure (paper 1 eq 9, p_m = 2 E* a/(pi R)) by
     adaptive quadrature of the judge's pointwise pressure (a test-side load, independent of

@@ -8,45 +8,28 @@ import math
 import numpy as np
 import pytest
 
-from femadh.contact import AsperityGap, ContactProblem, trace
+from femadh.contact import trace
 from femadh.contact import landing, stepping
 from femadh.contact.forces import state_forces
-from femadh.elastic import GreenOperator, RadialGrid
-from femadh.indenter import Sphere
-from femadh.laws import LennardJones
 
-from conftest import E_STAR, HAMAKER, Z0
+from conftest import FIG4_D_VALUES as D_VALUES, FIG4_TOL as TOL
+from conftest import fig4_problem, fig4_sweeps
 
-R2MM, TOL = 2e-3, 1e-19
 #: 100 uniform nodes on the Fig 4 disk (sigma = 0.5 nm): small, and both folds on it
 N = 100
-#: separations through the jump-in (1.1098 nm) and the pull-off (1.1824 nm on this grid)
-D_VALUES = np.round(np.arange(1.6, 0.59, -0.2), 10) * 1e-9
 #: the resolution step (m): MIN_STEP_FRACTION of the 0.2 nm grid step
 H = 0.2e-9 * stepping.MIN_STEP_FRACTION
 
 
-def _problem(n=N):
-    a = math.sqrt(2 * R2MM * 10e-9)
-    return ContactProblem(GreenOperator(RadialGrid.uniform(a, n), E_STAR), Sphere(R2MM),
-                          {"lj": LennardJones(HAMAKER, Z0)}, AsperityGap(0.5e-9))
-
-
-def _sweeps(p):
-    ap = trace(p, D_VALUES, branch="approach", tol=TOL)
-    re = trace(p, D_VALUES[::-1], branch="retract", tol=TOL, start=ap.states[-1])
-    return ap, re
-
-
 @pytest.fixture(scope="module")
 def fig4():
-    p = _problem()
-    return p, _sweeps(p)
+    p = fig4_problem(N)
+    return p, fig4_sweeps(p)
 
 
 def _halving(monkeypatch, p):
     monkeypatch.setattr(stepping, "BRACKETED", False)
-    out = _sweeps(p)
+    out = fig4_sweeps(p)
     monkeypatch.setattr(stepping, "BRACKETED", True)
     return out
 
@@ -119,7 +102,7 @@ def test_the_bisection_fallback_locates_the_same_folds(fig4, monkeypatch):
     at the cost of more solves on the jump-in (measured 4 -> 8)."""
     p, (ap, re) = fig4
     monkeypatch.setattr(stepping._Bracket, "estimate", lambda self: None)
-    ap1, re1 = _sweeps(p)
+    ap1, re1 = fig4_sweeps(p)
     old, new = ap.jumps + re.jumps, ap1.jumps + re1.jumps
     assert len(new) == len(old)
     assert all(abs(a.d_fold - b.d_fold) <= 1e-6 * H for a, b in zip(new, old))
@@ -164,7 +147,7 @@ def test_the_energy_descent_stops_once_settled_at_round_off(monkeypatch):
     state the full descent lands on, to the tolerance."""
     from scipy import linalg as sla
 
-    p = _problem(150)
+    p = fig4_problem(150)
     j = trace(p, D_VALUES, branch="approach", tol=TOL).jumps[0]
     count = [0]
     real = sla.cho_factor
@@ -195,7 +178,7 @@ def test_a_landing_whose_polish_fails_after_the_settled_descent_runs_the_whole_d
     """The round-off stop is a shortcut, never a new failure: when the Newton polish from the
     settled descent does not reach a stable state (forced here on the first polish), the
     landing runs the whole descent to its cap as before and lands on the same state."""
-    p = _problem(150)
+    p = fig4_problem(150)
     j = trace(p, D_VALUES, branch="approach", tol=TOL).jumps[0]
     real = landing.solve_complementarity
     calls = []

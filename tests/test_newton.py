@@ -8,42 +8,23 @@ import math
 import numpy as np
 import pytest
 
-from femadh.contact import AsperityGap, ContactProblem, trace
 from femadh.contact import complementarity as cm
 from femadh.contact import stepping
 from femadh.contact.complementarity import solve_complementarity
 from femadh.contact.linalg import TrailingCholesky, gmres
 from femadh.contact.stepping import step_energy, total_force
-from femadh.elastic import GreenOperator, RadialGrid
-from femadh.indenter import Sphere
-from femadh.laws import LennardJones
 
-from conftest import E_STAR, HAMAKER, Z0
+from conftest import FIG4_TOL as TOL, fig4_problem, fig4_sweeps
 
-R2MM, TOL = 2e-3, 1e-19
 #: 240 uniform nodes on the Fig 4 disk (sigma = 0.5 nm): more than KRYLOV_MIN_FREE free nodes
 #: around both folds, so the Krylov path takes the steps
 N = 240
-#: separations through the jump-in (1.1098 nm) and the pull-off (1.1803 nm)
-D_VALUES = np.round(np.arange(1.6, 0.59, -0.2), 10) * 1e-9
-
-
-def _problem(n):
-    a = math.sqrt(2 * R2MM * 10e-9)
-    return ContactProblem(GreenOperator(RadialGrid.uniform(a, n), E_STAR), Sphere(R2MM),
-                          {"lj": LennardJones(HAMAKER, Z0)}, AsperityGap(0.5e-9))
-
-
-def _sweeps(p):
-    ap = trace(p, D_VALUES, branch="approach", tol=TOL)
-    re = trace(p, D_VALUES[::-1], branch="retract", tol=TOL, start=ap.states[-1])
-    return ap, re
 
 
 @pytest.fixture(scope="module")
 def fig4():
-    p = _problem(N)
-    return p, _sweeps(p)
+    p = fig4_problem(N)
+    return p, fig4_sweeps(p)
 
 
 def test_krylov_steps_reproduce_the_lu_path(fig4, monkeypatch):
@@ -56,7 +37,7 @@ def test_krylov_steps_reproduce_the_lu_path(fig4, monkeypatch):
     assert ap.work["solves"] and ap.work["factorisations"] < ap.work["iterations"]
     monkeypatch.setattr(cm, "KRYLOV", False)
     monkeypatch.setattr(stepping, "STALL_ITER", None)
-    ap0, re0 = _sweeps(p)
+    ap0, re0 = fig4_sweeps(p)
     assert ap0.work["stagnated"] == re0.work["stagnated"] == 0
     for new, old in ((ap, ap0), (re, re0)):
         assert [s.d for s in new.states] == [s.d for s in old.states]
@@ -132,19 +113,19 @@ def test_lattice_snaps_are_stepped_over_and_contact_snaps_stay_jumps(monkeypatch
     step's work (measured 0.026 at N = 240) next to the pull-off's ~140x; with it every
     reported jump releases more than 10x its step's work and the lattice snap is counted,
     not reported."""
-    p = _problem(180)
+    p = fig4_problem(180)
 
     def released(j):
         r, _, w, _ = step_energy(p, j.before, j.after, total_force(p, j.before),
                                  total_force(p, j.after))
         return r / w
-    ap, re = _sweeps(p)
+    ap, re = fig4_sweeps(p)
     assert len(ap.jumps) == len(re.jumps) == 1
     assert all(released(j) > 10 for j in ap.jumps + re.jumps)
     snaps = ap.work.get("lattice_snaps", 0) + re.work.get("lattice_snaps", 0)
     assert snaps >= 1
     monkeypatch.setattr(stepping, "lattice_snap", lambda *a: False)
-    ap1, re1 = _sweeps(p)
+    ap1, re1 = fig4_sweeps(p)
     small = [released(j) for j in ap1.jumps + re1.jumps if released(j) <= 10]
     assert len(small) == snaps and all(x < stepping.FOLD_ENERGY_SHARE_MIN_STEP for x in small)
     big = [j.d_fold for j in ap1.jumps + re1.jumps if released(j) > 10]
@@ -198,7 +179,7 @@ def test_the_stagnation_exit_turns_down_no_step_the_whole_budget_accepts(monkeyp
     sweep: it either ran to max_iter or converged across the fold, to the other branch); and
     the solve that decides each fold - the last one at its landing separation - had the whole
     budget."""
-    p = _problem(N)
+    p = fig4_problem(N)
     calls = []
     real = stepping.solve_complementarity
 
@@ -207,7 +188,7 @@ def test_the_stagnation_exit_turns_down_no_step_the_whole_budget_accepts(monkeyp
         calls.append((d, np.array(w0), kw, st))
         return st
     monkeypatch.setattr(stepping, "solve_complementarity", solve)
-    ap, re = _sweeps(p)
+    ap, re = fig4_sweeps(p)
     stalled = [c for c in calls if "stagnated" in c[3].diagnostics]
     assert stalled
     for d, w0, kw, st in stalled:
