@@ -212,13 +212,6 @@ class SubgridStep:
 
 # -- the law Jacobian J = dP/dh of ContactProblem.law_jacobian: a vector (collocated laws,
 # diagonal) or a dense matrix (a sub-grid law, tridiagonal); what the solvers do with it --
-def jacobian_block(J, idx):
-    """J restricted to the nodes ``idx`` (index array or slice) as a dense matrix."""
-    if J.ndim == 1:
-        return np.diag(J[idx])
-    return J[idx][:, idx] if not isinstance(idx, slice) else J[idx, idx]
-
-
 def add_jacobian(M, J, idx):
     """M += J[idx, idx] in place (M the free block of K, rows and columns ``idx``)."""
     if J.ndim == 1:

@@ -62,11 +62,6 @@ class GridFamily:
                              + self.grading / spacing * (math.log1p(far / self.grading)
                                                          + math.log1p(lo / self.grading))))
 
-    def spacing_for(self, nodes):
-        """The band spacing h (m) of the member with about ``nodes`` nodes."""
-        far = max(self.radius - self.band, 0.0)
-        return (self.band + self.grading * math.log1p(far / self.grading)) / nodes
-
     def as_dict(self, spacing):
         """The [solver.grid] table of a member (SI, for scenes and summary.json)."""
         return {"spacing": spacing, "band": self.band, "grading": self.grading}
