@@ -1118,6 +1118,10 @@ def main(argv=None):
                     help="run only these test files on each defect (a quick check of new "
                          "code; a defect they catch is caught by the whole suite too)")
     args = ap.parse_args(argv)
+    missing = [t for t in args.tests if not (ROOT / t.split("::")[0]).exists()]
+    if missing:
+        # pytest's usage error would read as "suite passed": every defect reported missed
+        ap.error(f"--tests: no such test file {', '.join(missing)}")
     wanted = [w for w in (args.only or "").split(",") if w]
     todo = [d for d in DEFECTS if not wanted or any(w in d.name for w in wanted)]
     if args.list:
