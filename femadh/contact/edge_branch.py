@@ -29,7 +29,7 @@ d(c), not turning points of c), so the branch is traced by plain Newton in c, fo
 the jump-out fold is the root of dd/dc (from the linearised system), the load-controlled
 pull-off the largest tension, the landing after the jump-in the root of d(c) = d_in.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import copy
 import functools
 import math
@@ -138,19 +138,161 @@ class ScaledOperator:
 @dataclass
 class EdgeState:
     """A state of the contact branch: edge radius c (m), separation d (m), displacements w (m)
-    on the grid scaled to c, Newton iterations and residual (m)."""
+    on the grid scaled to c (lam = c / r_k^0), Newton iterations and residual (m), and the
+    gaps h (m) and pressures P (Pa) of the converged iterate. ``problem`` (the
+    :class:`ContactProblem` of the scaled grid) is built when first asked for: a trace needs
+    it for a few states only (the landing's stability), the rest reads h, P and lam."""
 
     c: float
     d: float
     w: np.ndarray
     n_iter: int
     residual: float
-    problem: ContactProblem = None
+    lam: float = 1.0
+    h: np.ndarray = None
+    P: np.ndarray = None
     dd_dc: float = math.nan
     force: float | None = None    # the caller's force of this state (N), once computed
+    make_problem: object = field(default=None, repr=False)
+    _problem: object = field(default=None, repr=False)
+
+    @property
+    def problem(self):
+        if self._problem is None:
+            self._problem = self.make_problem(self.c)
+        return self._problem
 
 
-class EdgeBranch:
+class _Newton:
+    """Newton on K w - P(h) = 0, h_k = g (the pinned gap on node k) in the unknowns (w, d),
+    on a grid scaled by lam from a reference grid (C = lam C0, K = K0 / lam): the shared
+    solver of the contact branch (k the edge node, lam = c / r_k^0) and the approach branch
+    (k = 0, lam = 1).
+
+    The system is solved with its first n rows multiplied by lam,
+
+        [K0 + lam diag(D), -lam D; -e_k^T, 1] dx = [lam P - K0 w; g - h_k],   D = P'(h),
+
+    whose matrix changes along the branch only through lam D (the law's stiffness in the
+    cohesive zone, which sits on the same nodes at every state of the scaled grid): the last
+    factorisation is kept and serves the next solve as a chord Jacobian while it contracts
+    the residual CHORD_RATE-fold per step (the slope's factorisation, at the converged state,
+    is the best chord Jacobian for a nearby state). A step on a factorisation from another
+    state that does not reduce the residual is taken back and the Jacobian factorised where
+    it started.
+    """
+
+    def _setup(self, C0, K0, shape0, nodes0, k, tol):
+        self.C0, self.K0, self.shape0, self.nodes0 = C0, K0, shape0, nodes0
+        self.k, self.tol = k, tol
+        self.n = n = K0.shape[0]
+        self.n_solves = 0
+        self.n_iter = 0
+        self.n_factor = 0
+        # the Jacobian's fixed part: K0 and the pinned gap's row
+        J0 = np.zeros((n + 1, n + 1))
+        J0[:n, :n] = K0
+        J0[n, k] = -1.0
+        J0[n, n] = 1.0
+        self._J0 = J0
+        self._diag = np.arange(n) * (n + 2)     # flat indices of J's first n diagonal entries
+        self._lu = None                         # the last factorisation (lu, piv)
+
+    def _pressure(self, h):
+        P = self._laws[0].pressure(h)
+        for law in self._laws[1:]:
+            P = P + law.pressure(h)
+        return P
+
+    def _dpressure(self, h):
+        D = self._laws[0].dpressure(h)
+        for law in self._laws[1:]:
+            D = D + law.dpressure(h)
+        return D
+
+    def _factorise(self, lam, D):
+        """Factorise the scaled Jacobian at law stiffness D (Pa/m); False if singular."""
+        J = self._J0.copy()
+        lD = lam * D
+        J.ravel()[self._diag] += lD
+        J[:self.n, self.n] = -lD
+        lu, piv, info = lapack.dgetrf(J, overwrite_a=True)
+        self.n_factor += 1
+        if info > 0:
+            self._lu = None
+            return False
+        self._lu = (lu, piv)
+        return True
+
+    def _exact_solve(self, lam, D, b):
+        """x with (scaled Jacobian at D) x = b: a fresh factorisation (at these sizes, ~30 us,
+        cheaper than the ~6 corrections iterative refinement on a nearby state's would take to
+        reach round-off), kept for the next solve."""
+        if not self._factorise(lam, D):
+            raise ConvergenceError("edge branch: singular Jacobian", residual=math.nan,
+                                   n_iter=0)
+        return lapack.dgetrs(*self._lu, b)[0]
+
+    def _newton(self, lam, contour, c, w0, d0, ge):
+        """Newton on K w - P(h) = 0, h_k = ge with h = contour + d - w (contour: the shape on
+        the scaled grid's nodes) from (w0, d0), steps limited so that no gap closes by more
+        than GAP_CLOSURE of itself; the state is labelled by the parameter c. Returns an
+        EdgeState or None if Newton did not converge in MAX_ITER iterations."""
+        n, k = self.n, self.k
+        C0, K0 = self.C0, self.K0
+        w, d = np.array(w0, float), float(d0)
+        self.n_solves += 1
+        rhs = np.empty(n + 1)
+        fresh = False           # the factorisation in hand is this solve's
+        last = math.inf         # the residual before the last step
+        prev = None             # the iterate before the last step
+        n_lu = self.n_factor
+        for it in range(1, MAX_ITER + 1):
+            safe_point()
+            h = (contour + d) - w
+            if h.min() <= 0:
+                return None
+            P = self._pressure(h)
+            res = float(np.abs(w - lam * (C0 @ P)).max())
+            if not math.isfinite(res):
+                raise ConvergenceError(f"edge branch: the law's pressure is not finite at "
+                                       f"c = {c:.6g} m (smallest gap {h.min():.6g} m)",
+                                       d=d, residual=res, n_iter=it - 1)
+            g = h[k] - ge
+            if res <= self.tol and abs(g) <= 1e-9 * ge:
+                self.n_iter += it - 1
+                n_lu = self.n_factor - n_lu
+                return EdgeState(c, d, w, n_lu + (it - 1 - n_lu) // CHORD_PER_FACTOR,
+                                 res, lam, h, P, make_problem=self.problem)
+            r = max(res, abs(g))
+            # chord: a factorisation serves while it contracts the residual by CHORD_RATE
+            # per step (a solve with it costs ~1/30 of a factorisation)
+            refactor = self._lu is None or r > CHORD_RATE * last
+            if refactor and not fresh and prev is not None and r > last:
+                # a step on another state's factorisation that made things worse: back
+                w, d, h, P, r = prev
+                g = h[k] - ge
+            if refactor:
+                if not self._factorise(lam, self._dpressure(h)):
+                    return None
+                fresh = True
+            rhs[:n] = lam * P - K0 @ w
+            rhs[n] = -g
+            prev = (w, d, h, P, r)
+            last = r
+            dx = lapack.dgetrs(*self._lu, rhs)[0]
+            if not math.isfinite(float(np.add.reduce(dx))):
+                return None
+            closing = dx[:n] - dx[n]        # dh = dd - dw: gaps close where dw > dd
+            worst = float((closing / h).max())
+            alpha = 1.0 if worst <= GAP_CLOSURE else GAP_CLOSURE / worst
+            w = w + alpha * dx[:n]
+            d = d + alpha * dx[n]
+        self.n_iter += MAX_ITER
+        return None
+
+
+class EdgeBranch(_Newton):
     """Solves of the contact branch at given edge radii.
 
     Parameters
@@ -168,33 +310,18 @@ class EdgeBranch:
     """
 
     def __init__(self, base, k, sphere, effects, edge_gap, tol):
-        self.base, self.k, self.sphere, self.effects = base, k, sphere, effects
-        self.edge_gap, self.tol = edge_gap, tol
+        self.base, self.sphere, self.effects = base, sphere, effects
+        self.edge_gap = edge_gap
         self.r0 = float(base.grid.nodes[k])
-        self.n = base.grid.n
-        self.n_solves = 0
-        self.n_iter = 0
-        self.n_factor = 0
-        self._base = ContactProblem(base, sphere, effects, check_laws=False,
-                                    subgrid=False)
         # the laws' own pressure and derivative, called directly in the Newton loop (the
         # problem's sum checks every law's values for NaN at every call: here one check of
         # the residual, which any non-finite pressure makes non-finite, does it per iteration)
         self._laws = tuple(effects.values())
-        idx = np.arange(self.n)
-        self._diag = idx * (self.n + 2)         # flat indices of J's first n diagonal entries
-
-    def _pressure(self, h):
-        P = self._laws[0].pressure(h)
-        for law in self._laws[1:]:
-            P = P + law.pressure(h)
-        return P
-
-    def _dpressure(self, h):
-        D = self._laws[0].dpressure(h)
-        for law in self._laws[1:]:
-            D = D + law.dpressure(h)
-        return D
+        self._base = ContactProblem(base, sphere, effects, check_laws=False,
+                                    subgrid=False)
+        self._setup(base.compliance, base.stiffness, None, base.grid.nodes, k, tol)
+        self._areas0 = base.grid.areas
+        self._kdiag0 = np.diag(self.K0).copy()
 
     def problem(self, c):
         """The problem on the grid whose node k sits at c (m): the reference problem with its
@@ -216,96 +343,42 @@ class EdgeBranch:
         _, _, soft, _ = self._base.surface_force_stiffness()
         return soft / float(self._base.K[self.k, self.k])
 
-    def _jacobian(self, pb, D):
-        n, k = self.n, self.k
-        J = np.empty((n + 1, n + 1))
-        J[:n, :n] = pb.K
-        J.ravel()[self._diag] += D
-        J[:n, n] = -D
-        J[n, :] = 0.0
-        J[n, k] = -1.0
-        J[n, n] = 1.0
-        return J
+    def node_softening_ratio(self, st):
+        """max_i -P'(h_i) / K_ii at a state (its scaled grid: K = K0 / lam), as
+        :meth:`ContactProblem.node_softening_ratio` without a gap constraint."""
+        return float((-self._dpressure(st.h) * st.lam / self._kdiag0).max())
+
+    def grid_force(self, st):
+        """The force (N) of a state's pressure on the analysis disk of its scaled grid (the
+        annuli's areas scale like lam^2)."""
+        return st.lam * st.lam * float(self._areas0 @ st.P)
+
+    def radius(self, st):
+        """The analysis radius (m) of a state's scaled grid."""
+        return st.lam * self.base.grid.radius
 
     def solve(self, c, w0, d0):
         """The state with its edge at c (m) from the guess (w0, d0) (Newton, steps limited so
         that no gap closes by more than GAP_CLOSURE of itself). Returns an EdgeState, or
         None if Newton did not converge in MAX_ITER iterations."""
-        return self._newton(self.problem(c), c, w0, d0, self.edge_gap)
-
-    def _newton(self, pb, c, w0, d0, ge):
-        """Newton on K w - P(h) = 0, h_k = ge on the problem pb from (w0, d0); the state is
-        labelled by the parameter c. Returns an EdgeState or None."""
-        n, k = self.n, self.k
-        w, d = np.array(w0, float), float(d0)
-        self.n_solves += 1
-        contour, C, K = pb.shape + 0.0, pb.C, pb.K
-        rhs = np.empty(n + 1)
-        lu = None
-        last = math.inf         # the residual before the last step
-        n_lu = 0
-        for it in range(1, MAX_ITER + 1):
-            safe_point()
-            h = (contour + d) - w
-            if h.min() <= 0:
-                return None
-            P = self._pressure(h)
-            res = float(np.abs(w - C @ P).max())
-            if not math.isfinite(res):
-                raise ConvergenceError(f"edge branch: the law's pressure is not finite at "
-                                       f"c = {c:.6g} m (smallest gap {h.min():.6g} m)",
-                                       d=d, residual=res, n_iter=it - 1)
-            g = h[k] - ge
-            if res <= self.tol and abs(g) <= 1e-9 * ge:
-                self.n_iter += it - 1
-                self.n_factor += n_lu
-                return EdgeState(c, d, w, n_lu + (it - 1 - n_lu) // CHORD_PER_FACTOR,
-                                 res, pb)
-            r = max(res, abs(g))
-            rhs[:n] = P - K @ w
-            rhs[n] = -g
-            # chord: the last factorisation serves while it contracts the residual by
-            # CHORD_RATE per step (a solve with it costs ~1/10 of a factorisation)
-            if lu is None or r > CHORD_RATE * last:
-                lu, piv, info = lapack.dgetrf(self._jacobian(pb, self._dpressure(h)),
-                                              overwrite_a=True)
-                n_lu += 1
-                if info > 0:
-                    return None
-            last = r
-            dx = lapack.dgetrs(lu, piv, rhs)[0]
-            if not np.all(np.isfinite(dx)):
-                return None
-            closing = dx[:n] - dx[n]        # dh = dd - dw: gaps close where dw > dd
-            alpha = 1.0
-            if closing.max() > 0:
-                pos = closing > 0
-                alpha = min(1.0, float(np.min(GAP_CLOSURE * h[pos] / closing[pos])))
-            w = w + alpha * dx[:n]
-            d = d + alpha * dx[n]
-        self.n_factor += n_lu
-        self.n_iter += MAX_ITER
-        return None
+        lam = c / self.r0
+        return self._newton(lam, self.sphere.shape(lam * self.nodes0), c, w0, d0,
+                            self.edge_gap)
 
     def slope(self, st):
         """dd/dc (-) along the branch at a state: J dx/dc = -dF/dc with K = K^0 r_k^0 / c and
         the contour's shape on nodes that move with c."""
-        pb, n, k = st.problem, self.n, self.k
-        h = pb.contour(st.d) - st.w
-        D = pb.dpressure(h)
-        r = pb.grid.nodes
+        n, k, lam = self.n, self.k, st.lam
+        r = lam * self.nodes0
         dshape = self.sphere.slope(r) * r / st.c          # d shape(r_i(c)) / dc
-        rhs = np.empty(n + 1)
-        rhs[:n] = (pb.K @ st.w) / st.c + D * dshape
+        D = self._dpressure(st.h)
+        rhs = np.empty(n + 1)          # (the first n rows times lam, as the Jacobian's)
+        rhs[:n] = (self.K0 @ st.w) / st.c + lam * D * dshape
         rhs[n] = -dshape[k]
-        lu, piv, info = lapack.dgetrf(self._jacobian(pb, D), overwrite_a=True)
-        if info > 0:
-            raise ConvergenceError("edge branch: singular Jacobian", d=st.d,
-                                   residual=st.residual, n_iter=0)
-        return float(lapack.dgetrs(lu, piv, rhs)[0][n])
+        return float(self._exact_solve(lam, D, rhs)[n])
 
 
-class CentreGapBranch(EdgeBranch):
+class CentreGapBranch(_Newton):
     """Solves of the approach branch (no contact yet) at given centre gaps, on one grid.
 
     Before the jump-in the surface bulges towards the sphere and the gap at r = 0,
@@ -325,13 +398,10 @@ class CentreGapBranch(EdgeBranch):
     def __init__(self, problem, tol):
         if problem.grid.nodes[0] != 0.0:
             raise ValueError("centre-gap branch: the grid needs a node at r = 0")
-        self.pb, self.k, self.n, self.tol = problem, 0, problem.grid.n, tol
+        self.pb = problem
         self.sphere, self.effects = problem.sphere, problem.effects
-        self.n_solves = 0
-        self.n_iter = 0
-        self.n_factor = 0
         self._laws = tuple(problem.effects.values())
-        self._diag = np.arange(self.n) * (self.n + 2)
+        self._setup(problem.C, problem.K, problem.shape, problem.grid.nodes, 0, tol)
 
     def problem(self, g):
         return self.pb
@@ -339,7 +409,7 @@ class CentreGapBranch(EdgeBranch):
     def solve(self, g, w0, d0):
         """The approach state of centre gap g (m) from the guess (w0, d0); an EdgeState
         (``c`` = g) or None if Newton did not converge."""
-        return self._newton(self.pb, g, w0, d0, g)
+        return self._newton(1.0, self.shape0, g, w0, d0, g)
 
     def at_separation(self, d, w0):
         """The approach state at separation d (m) from the guess w0 (interpolated between
@@ -365,7 +435,8 @@ class CentreGapBranch(EdgeBranch):
             if res <= self.tol:
                 self.n_iter += it - 1
                 self.n_factor += n_lu
-                return EdgeState(float(h[0]), d, w, it - 1, res, pb)
+                return EdgeState(float(h[0]), d, w, it - 1, res, 1.0, h, P,
+                                 make_problem=self.problem)
             if lu is None or res > CHORD_RATE * last:
                 J = K.copy()
                 J.ravel()[np.arange(n) * (n + 1)] += self._dpressure(h)
@@ -386,17 +457,15 @@ class CentreGapBranch(EdgeBranch):
         self.n_factor += n_lu
         return None
 
+    def node_softening_ratio(self, st):
+        """max_i -P'(h_i) / K_ii at a state."""
+        return float((-self._dpressure(st.h) / np.diag(self.K0)).max())
+
     def slope(self, st):
         """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
-        h = self.pb.contour(st.d) - st.w
         rhs = np.zeros(self.n + 1)
         rhs[self.n] = 1.0
-        lu, piv, info = lapack.dgetrf(self._jacobian(self.pb, self._dpressure(h)),
-                                      overwrite_a=True)
-        if info > 0:
-            raise ConvergenceError("centre-gap branch: singular Jacobian", d=st.d,
-                                   residual=st.residual, n_iter=0)
-        return float(lapack.dgetrs(lu, piv, rhs)[0][self.n])
+        return float(self._exact_solve(1.0, self._dpressure(st.h), rhs)[self.n])
 
 
 @functools.lru_cache(maxsize=8)

@@ -61,9 +61,9 @@ from ..reference.maugis import lj_dugdale_lambda, maugis_fixed_grip_pull_off, ma
 # the smooth-sphere problem of one point (re-exported: the map's public names)
 from .smooth_sphere import (ANALYSIS_RADIUS, BAND, BAND_MU, DS_MAX,  # noqa: F401
                             EDGE_GAP, EDGE_GRADING, GRADING, SPACING,  # noqa: F401
-                            TRACE_CORRECTION, PointSetup,  # noqa: F401
-                            Resolution, e_star_length, lateral_length, lj_force, trace_edge_point,
-                            trace_point)
+                            TRACE_CORRECTION, COMPUTE, PointSetup,  # noqa: F401
+                            Resolution, e_star_length, lateral_length, lj_force, md_fixed_grip,
+                            trace_edge_point, trace_point)
 
 R_DEFAULT, A_DEFAULT, Z0_DEFAULT = 1e-6, 1e-19, 0.165e-9
 
@@ -249,7 +249,7 @@ def _check_bounds(mu, q, errors):
                               f"tension on the curve {p:.6f}")
 
 
-def solve_point(mu, radius, law, res, tol, progress):
+def solve_point(mu, radius, law, res, tol, progress, fixed_grip=COMPUTE):
     """One map point at one resolution, without an error estimate: the traced curve's
     headline quantities and diagnostics (dict; ``setup`` holds its :class:`PointSetup`).
 
@@ -266,8 +266,11 @@ def solve_point(mu, radius, law, res, tol, progress):
     tol : float
         Residual tolerance (m).
     progress : callable or None
+    fixed_grip : optional
+        Maugis-Dugdale's fixed-grip solution at this mu (:func:`md_fixed_grip`) if the caller
+        has it.
     """
-    setup = PointSetup(mu, radius, law, res)
+    setup = PointSetup(mu, radius, law, res, fixed_grip)
     if setup.follows_edge:
         return _read_edge(setup, trace_edge_point(setup, tol))
     curve = trace_point(setup, tol, progress)
@@ -305,7 +308,7 @@ def _read_edge(setup, e):
     }
 
 
-def _coarse_member(mu, radius, law, res, tol, edge):
+def _coarse_member(mu, radius, law, res, tol, edge, fixed_grip=COMPUTE):
     """The coarser member for the estimate: spacing x COARSE_RATIO (x 2 if that one cannot be
     traced; where the grid follows the edge (``edge``) x COARSE_RATIO_EDGE, else x
     COARSE_RATIO). Returns (result, ratio)."""
@@ -313,7 +316,8 @@ def _coarse_member(mu, radius, law, res, tol, edge):
     why = None
     for ratio in ratios:
         try:
-            return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio
+            return (solve_point(mu, radius, law, res.coarser(ratio), tol, None, fixed_grip),
+                    ratio)
         except (ConvergenceError, ValueError) as exc:
             why = str(exc)
             continue
@@ -322,7 +326,7 @@ def _coarse_member(mu, radius, law, res, tol, edge):
                           f"no error estimate; lower spacing")
 
 
-def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=1e-19,
+def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=None, tol=None,
               accuracy=None, resolution=None, spacing=None, stiffness_target=None,
               min_nodes=None, ds_max=None, progress=None, judged=QUANTITIES):
     """One regime-map point: trace the curve at Tabor parameter mu and read it.
@@ -336,8 +340,10 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     law : gap law, optional
         Instead of LennardJones(hamaker, z0): any law with ``work_of_adhesion`` (J/m^2) and
         ``z0`` (m), e.g. :class:`femadh.laws.Lj82`.
-    tol : float
-        Residual of eq (6) every traced state meets (m).
+    tol : float, optional
+        Residual of eq (6) every traced state meets (m). Default TOL; where an accuracy is
+        requested and the grid follows the edge, TOL_PER_ACCURACY x accuracy x z0 (at least
+        TOL): the states are converged to what the request needs (:func:`state_tolerance`).
     accuracy : float, optional
         Requested relative accuracy of the headline quantities (pull-offs, jump separations,
         hysteresis relative to max(value, HYSTERESIS_FLOOR)). The spacing starts from the
@@ -372,7 +378,11 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
     over = {k: v for k, v in (("spacing", spacing), ("stiffness_target", stiffness_target),
                               ("min_nodes", min_nodes), ("ds_max", ds_max)) if v is not None}
     res = replace(res, **over)
-    edge = PointSetup(mu, radius, law, res).follows_edge
+    lam = lj_dugdale_lambda(mu)
+    fg = md_fixed_grip(mu)          # (once for the point: every member's setup uses it)
+    edge = PointSetup(mu, radius, law, res, fg).follows_edge
+    if tol is None:
+        tol = state_tolerance(accuracy if edge else None, law.z0)
     if accuracy is not None:
         if not accuracy > 0:
             raise ValueError(f"accuracy must be > 0, got {accuracy}")
@@ -393,10 +403,10 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                 g = pull_off_grading(accuracy, res.spacing)
                 res = replace(res, grading=g, edge_grading=g)
     member = {}
-    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol, edge)
+    member["coarse"], member["ratio"] = _coarse_member(mu, radius, law, res, tol, edge, fg)
 
     def attempt(res):
-        fine = solve_point(mu, radius, law, res, tol, progress)
+        fine = solve_point(mu, radius, law, res, tol, progress, fg)
         errors = estimate_errors(fine, member["coarse"], member["ratio"])
         fine["errors"], fine["worst"] = errors, _worst(fine, errors, judged)
         return fine, fine["worst"][1], _unresolved(fine["setup"], fine)
@@ -437,8 +447,6 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
                       f"of the lattice-trapping limit {TRAPPING_LIMIT}", MeshResolutionWarning,
                       stacklevel=2)
     setup = fine["setup"]
-    lam = lj_dugdale_lambda(mu)
-    fg = maugis_fixed_grip_pull_off(lam)
     return RegimePoint(
         mu, setup.e_star, fine["pull_off"], fine["pull_off_displacement"],
         maugis_pull_off(lam), fg[0] if fg else None, fine["jump_in"], fine["jump_out"],
@@ -446,6 +454,25 @@ def lj_sphere(mu, *, radius=R_DEFAULT, hamaker=A_DEFAULT, z0=Z0_DEFAULT, law=Non
         fine["n_points"], fine["n_solves"], fine["nodes"], time.perf_counter() - t0,
         fine["curves"], errors, res, setup.spacing, setup.ell, setup.a, fine["edge_ratio"],
         fine["n_grids"], accuracy, band_offset=fine["band_offset"], judged=tuple(judged))
+
+
+#: residual of eq (6) (m) every traced state meets by default
+TOL = 1e-19
+#: where an accuracy is requested of an edge-following point, its states meet the residual
+#: TOL_PER_ACCURACY x accuracy x z0 (at least TOL): measured on the peer's Lj82 (mu = 1, 3)
+#: and LJ (mu = 2, 20) points at spacing 0.1-0.133 ell, a residual of 1e-6 z0 instead of
+#: 6e-10-1e-10 z0 moves no headline quantity by more than 1.7e-7 relative (1e-5 z0: by up to
+#: 4.8e-5, the mu = 1 hysteresis), so at 1e-4 x accuracy x z0 the states' convergence error
+#: is ~1e-4 of the request; it saves a third of the Newton iterations
+TOL_PER_ACCURACY = 1e-4
+
+
+def state_tolerance(accuracy, z0):
+    """The residual (m) the traced states of a point meet: TOL without an accuracy request,
+    else TOL_PER_ACCURACY x accuracy x z0 (never below TOL)."""
+    if accuracy is None:
+        return TOL
+    return max(TOL, TOL_PER_ACCURACY * accuracy * z0)
 
 
 def initial_spacing(accuracy, cap=None):

@@ -104,10 +104,16 @@ def lj_force(problem, lj, d, w):
     over the analysis disk plus the tail beyond it, where the surface is undeformed and the
     paraboloid's force is exactly -2 pi R U(b(a; d)) (Derjaguin is exact for a paraboloid:
     2 pi r dr = 2 pi R dh)."""
-    a, radius = problem.grid.radius, problem.sphere.radius
     h = problem.contour(d) - w
-    tail = -2 * math.pi * radius * float(lj.energy(d + a * a / (2 * radius)))
-    return problem.grid.force(problem.pressure(h)) + tail
+    return problem.grid.force(problem.pressure(h)) + tail_force(lj, problem.sphere.radius, d,
+                                                                 problem.grid.radius)
+
+
+def tail_force(law, radius, d, a):
+    """The force (N, attractive positive) beyond the analysis radius a (m) of a paraboloid of
+    radius R at separation d (m), where the surface is undeformed: -2 pi R U(d + a^2 / 2R)
+    (Derjaguin, exact for a paraboloid)."""
+    return -2 * math.pi * radius * float(law.energy(d + a * a / (2 * radius)))
 
 
 #: analysis radius in units of Maugis' a_unit = (pi dg R^2 / K)^(1/3) (the rigid-LJ tail beyond
@@ -212,10 +218,23 @@ def _remember(law):
         pass
 
 
-class PointSetup:
-    """Physical problem of one map point and the grids of one resolution."""
+#: PointSetup's ``fixed_grip`` when the caller has not solved Maugis-Dugdale for this mu
+COMPUTE = object()
 
-    def __init__(self, mu, radius, law, res):
+
+def md_fixed_grip(mu):
+    """Maugis-Dugdale's fixed-grip pull-off (-P, D) at the lambda of Tabor parameter mu
+    (:func:`~femadh.reference.maugis.maugis_fixed_grip_pull_off`; None below lambda 0.938):
+    a scan of its curve, ~0.4 ms, solved once per map point and handed to its members'
+    :class:`PointSetup`."""
+    return maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
+
+
+class PointSetup:
+    """Physical problem of one map point and the grids of one resolution. ``fixed_grip``:
+    :func:`md_fixed_grip` of this mu if the caller has it (solved here otherwise)."""
+
+    def __init__(self, mu, radius, law, res, fixed_grip=COMPUTE):
         self.mu, self.radius, self.law, self.res = mu, radius, law, res
         dg, z0 = law.work_of_adhesion, law.z0
         self.dg, self.z0 = dg, z0
@@ -237,7 +256,7 @@ class PointSetup:
         self.d_end = deepest_separation(mu, radius, self.e_star, law)
         # start beyond the jump-out (Maugis-Dugdale's fixed-grip approach + margin), so that
         # its landing on the approach branch is on the curve
-        fg = maugis_fixed_grip_pull_off(lj_dugdale_lambda(mu))
+        fg = md_fixed_grip(mu) if fixed_grip is COMPUTE else fixed_grip
         d_out = z0 - (fg[1] * d_unit if fg else 0.0)
         self.d_start = max(12 * z0, 1.5 * d_out)
         self.d_out_md = d_out
@@ -334,11 +353,6 @@ EDGE_GRADING = 2.0
 #: radius stays above ~1.4 of the point's (measured: 3 -> 4 moves no quantity by more than
 #: 4e-6 relative at mu = 3 and 20; 2 moves the fixed-grip pull-off by 4.5e-4 at mu = 2.7)
 EDGE_RADIUS_MARGIN = 3.0
-#: the approach branch is traced from this multiple of Maugis-Dugdale's jump-out separation
-#: (at least one z0 beyond it), with steps up to APPROACH_DS of the start separation: far out
-#: the surface barely deforms and the predictor is near exact
-APPROACH_START = 1.2
-APPROACH_DS = 0.05
 #: first relative step in the centre gap of the approach branch (the branch starts beyond the
 #: jump-out, where the surface barely deforms and the secant predictor is near exact)
 APPROACH_STEP0 = 0.08
@@ -394,28 +408,6 @@ def trace_edge_point(setup, tol):
     def force(pb, d, w):
         return lj_force(pb, law, d, w)
 
-    # approach branch: the centre band of the point's family, traced in its centre gap g
-    # (d(g) is smooth through the jump-in fold, its minimum) up to the fold
-    app = setup.problem(0.0)
-    # (from beyond Maugis-Dugdale's jump-out: the approach state at the traced jump-out is
-    # found there, or solved on its own if the traced one lies further out)
-    d_app = min(setup.d_start, max(APPROACH_START * setup.d_out_md, setup.d_out_md + z0))
-    abranch = CentreGapBranch(app, tol)
-    atr = BranchTrace(abranch)
-    g_app = d_app + float(app.shape[0])
-    first = abranch.solve(g_app, np.zeros(app.grid.n), d_app)
-    if first is None:
-        raise ConvergenceError(f"edge trace: no approach state at d = {d_app / z0:.4g} z0",
-                               d=d_app)
-    atr.states.append(first)
-    g_floor = z0     # below it the centre is in repulsive contact: no jump-in before
-    arun = atr.march(first, -1, lambda run: (len(run) >= 3 and run[-1].d > run[-2].d)
-                     or run[-1].c < g_floor, step0=APPROACH_STEP0)
-    if arun[-1].c < g_floor or len(arun) < 3:
-        raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
-                               f"the centre gap {arun[-1].c / z0:.4g} z0", d=arun[-1].d)
-    fin = atr.fold(arun[-1].c, arun[-3].c)
-    apts = sorted([s for s in atr.states if s.c > fin.c], key=lambda s: -s.c)
     # contact branch: reference grid fine around its node k at JKR's load-controlled
     # pull-off radius (9 pi dg R^2 / 8 E*)^(1/3), where it starts (the
     # largest tension is near, the fold (JKR: 0.48 of it) and the landing on either side)
@@ -442,8 +434,15 @@ def trace_edge_point(setup, tol):
     tr.states.append(start)
 
     def F(st):
+        # the grid's force from the state's own pressures, and the exact tail
         if st.force is None:
-            st.force = force(st.problem, st.d, st.w)
+            st.force = branch.grid_force(st) + tail_force(law, R, st.d, branch.radius(st))
+        return st.force
+
+    def Fa(st):
+        """The force (N) of an approach state (as lj_force, from its own pressures)."""
+        if st.force is None:
+            st.force = app.grid.force(st.P) + tail_force(law, R, st.d, app.grid.radius)
         return st.force
 
     # down in c past the jump-out fold (d(c) has its largest value there) and past the
@@ -453,6 +452,28 @@ def trace_edge_point(setup, tol):
                     and F(run[-1]) < F(run[-2]))
     i_fold = next(i for i in range(2, len(down)) if down[i].d < down[i - 1].d)
     fout = tr.fold(down[i_fold].c, down[i_fold - 2].c)
+    # approach branch: the centre band of the point's family, traced in its centre gap g
+    # (d(g) is smooth through the jump-in fold, its minimum) up to the fold, from the centre
+    # gap g = d_out (its separation d = g + w(0) lies beyond the jump-out: the approach
+    # state at d_out is between traced states). Before d_out nothing is read off the branch
+    app = setup.problem(0.0)
+    abranch = CentreGapBranch(app, tol)
+    atr = BranchTrace(abranch)
+    d_out = fout.d
+    g_app = d_out + float(app.shape[0])
+    first = abranch.solve(g_app, np.zeros(app.grid.n), d_out)
+    if first is None:
+        raise ConvergenceError(f"edge trace: no approach state of centre gap {g_app / z0:.4g} "
+                               "z0 (the jump-out separation)", d=d_out)
+    atr.states.append(first)
+    g_floor = z0     # below it the centre is in repulsive contact: no jump-in before
+    arun = atr.march(first, -1, lambda run: (len(run) >= 3 and run[-1].d > run[-2].d)
+                     or run[-1].c < g_floor, step0=APPROACH_STEP0)
+    if arun[-1].c < g_floor or len(arun) < 3:
+        raise ConvergenceError("edge trace: the approach branch has no jump-in fold before "
+                               f"the centre gap {arun[-1].c / z0:.4g} z0", d=arun[-1].d)
+    fin = atr.fold(arun[-1].c, arun[-3].c)
+    apts = sorted([s for s in atr.states if s.c > fin.c], key=lambda s: -s.c)
     # up in c past the jump-in landing (d below the jump-in fold's) and the largest tension
     tr.march(start, +1, lambda run: run[-1].d < fin.d and (
         len(run) >= 2 and F(run[-1]) < F(run[-2])))
@@ -470,7 +491,6 @@ def trace_edge_point(setup, tol):
         raise ConvergenceError(f"edge trace: the jump-in landing at d = {fin.d / z0:.4g} z0 "
                                "is not stable", d=fin.d)
     # the retract path leaves the contact at the fold and lands on the approach branch
-    d_out = fout.d
     pba = app
     ia = next((i for i in range(len(apts) - 1)
                if (apts[i].d - d_out) * (apts[i + 1].d - d_out) <= 0), None)
@@ -509,21 +529,20 @@ def trace_edge_point(setup, tol):
                      + tail_energy_change(law, R, pba.grid.radius, fin.d, d_out))
     released = approach_work - contact_work
     # the paths (for the loop integral and the figures)
-    fa = np.array([force(pba, p.d, p.w) for p in apts])
+    fa = np.array([Fa(p) for p in apts])
     da = np.array([p.d for p in apts])
     cs = sorted([s for s in tr.states if s.c >= land.c] + [land], key=lambda s: s.c)
     rs = sorted([s for s in tr.states if s.c >= fout.c] + [fout], key=lambda s: -s.c)
     app_d = np.r_[da, fin.d, [s.d for s in cs]]
-    app_F = np.r_[fa, force(pba, fin.d, fin.w), [F(s) for s in cs]]
+    app_F = np.r_[fa, Fa(fin), [F(s) for s in cs]]
     keep = da >= d_out
     ret_d = np.r_[[s.d for s in rs], d_out, da[keep][::-1]]
     ret_F = np.r_[[F(s) for s in rs], force(pba, d_out, w_out), fa[keep][::-1]]
     trap = getattr(np, "trapezoid", None) or np.trapz
     loop = trap(ret_F, ret_d) + trap(app_F, app_d)
     all_c = tr.states
-    trapping = max([pba.node_softening_ratio(pba.contour(p.d) - p.w) for p in apts]
-                   + [s.problem.node_softening_ratio(s.problem.contour(s.d) - s.w)
-                      for s in all_c])
+    trapping = max([abranch.node_softening_ratio(p) for p in apts]
+                   + [branch.node_softening_ratio(s) for s in all_c])
     return {
         "pull_off": max(float(np.max(fa)), pull_c), "pull_off_displacement": F(fout),
         "jump_in": fin.d, "jump_out": d_out, "hysteresis": released, "loop_work": loop,
@@ -538,7 +557,7 @@ def trace_edge_point(setup, tol):
         "n_newton": abranch.n_iter + branch.n_iter,
         "n_folds": 2,
         "curve_d": np.r_[da, fin.d, [s.d for s in all_c]],
-        "curve_F": np.r_[fa, force(pba, fin.d, fin.w), [F(s) for s in all_c]],
+        "curve_F": np.r_[fa, Fa(fin), [F(s) for s in all_c]],
         "curve_stable": np.r_[np.ones(len(apts), bool), False, [s.c > fout.c for s in all_c]],
         "approach": (app_d, app_F), "retract": (ret_d, ret_F),
         "n_factor": abranch.n_factor + branch.n_factor, "n_krylov": 0,
