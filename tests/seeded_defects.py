@@ -647,8 +647,10 @@ DEFECTS = [
         "return spacing * (1.0 + x / grading)"),)),
     D("edge_coarse_ratio", "regime: the coarser member's spacing ratio reported as 1.5 "
       "whatever it was", "femadh/studies/regime.py",
-      (("return solve_point(mu, radius, law, res.coarser(ratio), tol, None), ratio",
-        "return solve_point(mu, radius, law, res.coarser(ratio), tol, None), 1.5"),)),
+      (("            return (solve_point(mu, radius, law, res.coarser(ratio), tol, None, fixed_grip),\n"
+        "                    ratio)",
+        "            return (solve_point(mu, radius, law, res.coarser(ratio), tol, None, fixed_grip),\n"
+        "                    1.5)"),)),
     D("edge_radius_margin", "edge trace: the reference grid's radius equal to the point's "
       "(the grid shrinks below it at the fold)", "femadh/studies/smooth_sphere.py",
       (("EDGE_RADIUS_MARGIN = 3.0", "EDGE_RADIUS_MARGIN = 1.0"),)),
@@ -674,6 +676,38 @@ DEFECTS = [
     D("peer_grading_contact", "regime: the pull-off's grading applied to the approach grid "
       "only", "femadh/studies/regime.py",
       (("res = replace(res, grading=g, edge_grading=g)", "res = replace(res, grading=g)"),)),
+    # -- the peer problem under 20 ms: factorisations kept across states, the states'
+    #    forces from their own pressures, the residual tied to the request, the predictor
+    D("peer_predictor_weight", "edge branch: the march's Lagrange predictor with a wrong "
+      "weight", "femadh/contact/edge_branch.py",
+      (("                li *= (c - cj) / (cs[i] - cj)",
+        "                li *= (c - cj) / (cs[i] + cj)"),)),
+    D("peer_force_area_scaling", "edge branch: a state's grid force with the annuli scaled "
+      "by lam, not lam^2", "femadh/contact/edge_branch.py",
+      (("return st.lam * st.lam * float(self._areas0 @ st.P)",
+        "return st.lam * float(self._areas0 @ st.P)"),)),
+    D("peer_softening_scaling", "edge branch: a state's node softening against the "
+      "reference grid's stiffness (K0, not K0 / lam)", "femadh/contact/edge_branch.py",
+      (("return float((-self._dpressure(st.h) * st.lam / self._kdiag0).max())",
+        "return float((-self._dpressure(st.h) / self._kdiag0).max())"),)),
+    D("peer_reuse_span", "edge branch: the last factorisation dropped for a nearby state and "
+      "kept for a far one", "femadh/contact/edge_branch.py",
+      (("if self._lu is not None and abs(c - self._lu_at) > REUSE_SPAN * abs(c):",
+        "if self._lu is not None and abs(c - self._lu_at) < REUSE_SPAN * abs(c):"),)),
+    D("peer_scaled_jacobian", "edge branch: the scaled Jacobian's law stiffness not scaled "
+      "by lam", "femadh/contact/edge_branch.py",
+      (("        lD = lam * D\n", "        lD = D\n"),)),
+    D("peer_tolerance_request", "regime: the states' residual not scaled by the accuracy "
+      "request", "femadh/studies/regime.py",
+      (("return max(TOL, TOL_PER_ACCURACY * accuracy * z0)",
+        "return max(TOL, TOL_PER_ACCURACY * z0)"),)),
+    D("peer_approach_tail", "edge trace: an approach state's force without the tail beyond "
+      "the analysis radius", "femadh/studies/smooth_sphere.py",
+      (("st.force = app.grid.force(st.P) + tail_force(law, R, st.d, app.grid.radius)",
+        "st.force = app.grid.force(st.P)"),)),
+    D("peer_md_once", "regime: the point's Maugis-Dugdale fixed grip solved at the wrong mu",
+      "femadh/studies/regime.py",
+      (("    fg = md_fixed_grip(mu)          # (once", "    fg = md_fixed_grip(2 * mu)          # (once"),)),
     # -- fold accounting
     D("closure_jump_resolution", "closure: a fold's resolution reported as the grid step",
       "femadh/contact/closure/trace.py",

@@ -58,6 +58,10 @@ TARGET_ITER = 4
 #: fraction of the previous one (chord steps), and refactorises otherwise
 CHORD_RATE = 0.1
 CHORD_PER_FACTOR = 3
+#: a solve starts on the last factorisation if its state's parameter (c, or the centre gap)
+#: lies within this fraction of the new one (the root searches' solves; a march step of a
+#: few per cent moves the Jacobian too far for a chord step to gain a decade)
+REUSE_SPAN = 0.01
 #: relative accuracy in c of the fold and of the landing (root finding: the fold's tension and
 #: the landing's work move by ~this relative to themselves)
 C_XTOL = 1e-8
@@ -66,6 +70,8 @@ C_XTOL = 1e-8
 MAX_XTOL = 1e-4
 #: solves the maximum search may take (a smooth maximum: 2-4)
 MAX_PARABOLA = 30
+#: states the march's predictor extrapolates from (2: the secant, 3: a parabola)
+PREDICTOR_POINTS = 3
 #: the branch ends after this many states (a cap: a healthy branch takes 30-80)
 MAX_STATES = 2000
 
@@ -175,11 +181,10 @@ class _Newton:
 
     whose matrix changes along the branch only through lam D (the law's stiffness in the
     cohesive zone, which sits on the same nodes at every state of the scaled grid): the last
-    factorisation is kept and serves the next solve as a chord Jacobian while it contracts
-    the residual CHORD_RATE-fold per step (the slope's factorisation, at the converged state,
-    is the best chord Jacobian for a nearby state). A step on a factorisation from another
-    state that does not reduce the residual is taken back and the Jacobian factorised where
-    it started.
+    factorisation is kept and serves the next solve, if its state lies within REUSE_SPAN in
+    the parameter (the root searches' solves), as a chord Jacobian while it contracts the
+    residual CHORD_RATE-fold per step (the slope's factorisation, at a converged state, is
+    the best chord Jacobian for a nearby one).
     """
 
     def _setup(self, C0, K0, shape0, nodes0, k, tol):
@@ -197,6 +202,7 @@ class _Newton:
         self._J0 = J0
         self._diag = np.arange(n) * (n + 2)     # flat indices of J's first n diagonal entries
         self._lu = None                         # the last factorisation (lu, piv)
+        self._lu_at = math.nan                  # the parameter c of its state
 
     def _pressure(self, h):
         P = self._laws[0].pressure(h)
@@ -224,13 +230,15 @@ class _Newton:
         self._lu = (lu, piv)
         return True
 
-    def _exact_solve(self, lam, D, b):
-        """x with (scaled Jacobian at D) x = b: a fresh factorisation (at these sizes, ~30 us,
-        cheaper than the ~6 corrections iterative refinement on a nearby state's would take to
-        reach round-off), kept for the next solve."""
+    def _exact_solve(self, lam, D, b, c):
+        """x with (scaled Jacobian at D) x = b, on a fresh factorisation at the state of
+        parameter c, kept for the next solve. (At these sizes a factorisation, ~30 us, costs
+        less than the ~6 corrections that iterative refinement on a nearby state's takes to
+        reach round-off: measured.)"""
         if not self._factorise(lam, D):
             raise ConvergenceError("edge branch: singular Jacobian", residual=math.nan,
                                    n_iter=0)
+        self._lu_at = c
         return lapack.dgetrs(*self._lu, b)[0]
 
     def _newton(self, lam, contour, c, w0, d0, ge):
@@ -243,9 +251,9 @@ class _Newton:
         w, d = np.array(w0, float), float(d0)
         self.n_solves += 1
         rhs = np.empty(n + 1)
-        fresh = False           # the factorisation in hand is this solve's
+        if self._lu is not None and abs(c - self._lu_at) > REUSE_SPAN * abs(c):
+            self._lu = None     # another state's Jacobian, too far away to be a chord
         last = math.inf         # the residual before the last step
-        prev = None             # the iterate before the last step
         n_lu = self.n_factor
         for it in range(1, MAX_ITER + 1):
             safe_point()
@@ -266,19 +274,13 @@ class _Newton:
                                  res, lam, h, P, make_problem=self.problem)
             r = max(res, abs(g))
             # chord: a factorisation serves while it contracts the residual by CHORD_RATE
-            # per step (a solve with it costs ~1/30 of a factorisation)
-            refactor = self._lu is None or r > CHORD_RATE * last
-            if refactor and not fresh and prev is not None and r > last:
-                # a step on another state's factorisation that made things worse: back
-                w, d, h, P, r = prev
-                g = h[k] - ge
-            if refactor:
+            # per step (a solve with it costs a tenth of a factorisation)
+            if self._lu is None or r > CHORD_RATE * last:
                 if not self._factorise(lam, self._dpressure(h)):
                     return None
-                fresh = True
+                self._lu_at = c
             rhs[:n] = lam * P - K0 @ w
             rhs[n] = -g
-            prev = (w, d, h, P, r)
             last = r
             dx = lapack.dgetrs(*self._lu, rhs)[0]
             if not math.isfinite(float(np.add.reduce(dx))):
@@ -375,7 +377,7 @@ class EdgeBranch(_Newton):
         rhs = np.empty(n + 1)          # (the first n rows times lam, as the Jacobian's)
         rhs[:n] = (self.K0 @ st.w) / st.c + lam * D * dshape
         rhs[n] = -dshape[k]
-        return float(self._exact_solve(lam, D, rhs)[n])
+        return float(self._exact_solve(lam, D, rhs, st.c)[n])
 
 
 class CentreGapBranch(_Newton):
@@ -465,7 +467,7 @@ class CentreGapBranch(_Newton):
         """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
         rhs = np.zeros(self.n + 1)
         rhs[self.n] = 1.0
-        return float(self._exact_solve(1.0, self._dpressure(st.h), rhs)[self.n])
+        return float(self._exact_solve(1.0, self._dpressure(st.h), rhs, st.c)[self.n])
 
 
 @functools.lru_cache(maxsize=8)
@@ -487,6 +489,22 @@ def tail_energy_change(law, radius, a, d1, d2):
     x, wq = gauss_legendre(16)
     h = 0.5 * (b1 + b2) + 0.5 * (b2 - b1) * x
     return 2 * math.pi * radius * 0.5 * (b2 - b1) * float(wq @ law.energy(h))
+
+
+def extrapolate(states, c):
+    """(w, d) at c (m) by the Lagrange polynomial through the given states (in c): the
+    march's predictor (the state on the scaled grid is a smooth function of c; with three
+    states the error falls like step^3 instead of the secant's step^2)."""
+    cs = [s.c for s in states]
+    w, d = 0.0, 0.0
+    for i, si in enumerate(states):
+        li = 1.0
+        for j, cj in enumerate(cs):
+            if j != i:
+                li *= (c - cj) / (cs[i] - cj)
+        w = w + li * si.w
+        d = d + li * si.d
+    return w, d
 
 
 class BranchTrace:
@@ -532,12 +550,7 @@ class BranchTrace:
                                        d=run[-1].d, residual=math.nan, n_iter=0)
             p = run[-1]
             c = p.c * (1 + direction * step)
-            if len(run) >= 2:
-                q = run[-2]
-                t = (c - q.c) / (p.c - q.c)
-                w0, d0 = q.w + t * (p.w - q.w), q.d + t * (p.d - q.d)
-            else:
-                w0, d0 = p.w, p.d
+            w0, d0 = extrapolate(run[-PREDICTOR_POINTS:], c)
             st = self.branch.solve(c, w0, d0)
             if st is None:
                 step *= 0.5
