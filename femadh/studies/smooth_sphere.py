@@ -364,8 +364,8 @@ EDGE_GRADING = 2.0
 #: radius stays above ~1.4 of the point's (measured: 3 -> 4 moves no quantity by more than
 #: 4e-6 relative at mu = 3 and 20; 2 moves the fixed-grip pull-off by 4.5e-4 at mu = 2.7)
 EDGE_RADIUS_MARGIN = 3.0
-#: first relative step in the centre gap of the approach branch (the branch starts beyond the
-#: jump-out, where the surface barely deforms and the secant predictor is near exact)
+#: first relative step in the centre gap of the approach branch (from g = d_out, where the
+#: surface bulges by a fraction of the gap and the branch is smooth)
 APPROACH_STEP0 = 0.08
 #: Gauss-Legendre nodes of the contact branch's work between the landing and the fold (F d'(c)
 #: is smooth in c: 6, 8 and 12 nodes agree to 1e-9 relative at mu = 1, 3, 20; 4 nodes move
@@ -396,13 +396,15 @@ def jkr_start(branch, setup, c):
 def trace_edge_point(setup, tol):
     """One bistable map point traced with the grid following the contact edge.
 
-    The approach branch (no contact yet) is traced by Newton in its centre gap g on the band at
-    the centre (:class:`~femadh.contact.edge_branch.CentreGapBranch`: d(g) is smooth through
-    the jump-in fold, its minimum) up to the jump-in fold; the contact branch by Newton in its
-    edge radius c on a grid that moves with the edge (:mod:`femadh.contact.edge_branch`), from
-    JKR's pull-off radius down through the largest tension to the jump-out fold and up past the
-    landing of the jump-in. The unstable branch between the folds is not traced: no headline
-    quantity is read off it.
+    The contact branch is traced by Newton in its edge radius c on a grid that moves with the
+    edge (:mod:`femadh.contact.edge_branch`), from JKR's pull-off radius down through the
+    largest tension to the jump-out fold; the approach branch (no contact yet) by Newton in
+    its centre gap g on the band at the centre (:class:`~femadh.contact.edge_branch.
+    CentreGapBranch`: d(g) is smooth through the jump-in fold, its minimum) from g = d_out,
+    the jump-out separation (so that its separations start beyond d_out, where the retract
+    path lands), to the jump-in fold; then the contact branch up past the landing of the
+    jump-in. The unstable branch between the folds is not traced: no headline quantity is
+    read off it. Every state's residual is ``tol`` (m).
 
     Returns
     -------
