@@ -352,3 +352,44 @@ def test_approach_grid_is_the_centre_band_on_the_dmt_side():
         floor = max(abs(ref.hysteresis), 0.1) if k == "hysteresis" else abs(getattr(ref, k))
         true = abs(getattr(p, k) - getattr(ref, k)) / floor
         assert 0.5 <= p.relative_error(k) / true <= 5, k
+
+
+def test_approach_path_forces_are_the_law_force_with_its_tail():
+    """The approach path's forces (read off the approach states' own pressures) are the
+    law's force of those states on the approach grid plus the exact rigid tail beyond the
+    analysis radius (lj_force): the first approach state, solved again at its separation
+    from the undeformed surface, has the path's first force (measured 3.9e-12 relative, both
+    states meeting the residual 1e-19 m; asserted 1e-9; the tail is 1.2e-3 of it, asserted
+    above 1e-4)."""
+    from femadh.contact.edge_branch import CentreGapBranch
+    from femadh.studies.smooth_sphere import (PointSetup, Resolution, lj_force, tail_force,
+                                              trace_edge_point)
+
+    law = LennardJones(HAMAKER, Z0)
+    setup = PointSetup(3.0, R, law, Resolution(spacing=0.133))
+    e = trace_edge_point(setup, 1e-19)
+    da, fa = e["approach"]
+    app = setup.approach_problem()
+    st = CentreGapBranch(app, 1e-19).at_separation(float(da[0]), np.zeros(app.grid.n))
+    assert st is not None
+    f = lj_force(app, law, st.d, st.w)
+    assert fa[0] == pytest.approx(f, rel=1e-9, abs=0)
+    assert abs(tail_force(law, R, st.d, app.grid.radius)) > 1e-4 * abs(f)
+
+
+def test_point_reports_maugis_dugdale_at_its_own_lambda():
+    """Maugis-Dugdale's solution, solved once per point and handed to its members, is the one
+    at the point's lambda = 1.157 mu: the reported load- and displacement-controlled
+    pull-offs equal maugis_pull_off and maugis_fixed_grip_pull_off there (identical), and
+    the point is bistable (mu = 3 > 0.81)."""
+    from femadh.laws import Lj82
+    from femadh.reference.maugis import (lj_dugdale_lambda, maugis_fixed_grip_pull_off,
+                                         maugis_pull_off)
+    from femadh.studies.regime import lj_sphere
+
+    p = lj_sphere(3.0, radius=100e-9, law=Lj82(0.05, 1e-9), accuracy=3e-3,
+                  judged=("pull_off",))
+    lam = lj_dugdale_lambda(3.0)
+    assert p.maugis == maugis_pull_off(lam)
+    assert p.maugis_displacement == maugis_fixed_grip_pull_off(lam)[0]
+    assert p.n_grids == 2 and p.jump_out is not None

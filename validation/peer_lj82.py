@@ -24,7 +24,7 @@ GOALS = {(1.0, 3e-3): 0.020, (3.0, 3e-3): 0.25, (1.0, 1e-4): 0.3, (3.0, 1e-4): 1
 #: quantities are reported by lj_sphere with their estimates, not judged)
 JUDGED = ("pull_off",)
 #: timings per row (the median is reported)
-REPEATS = 5
+REPEATS = 21
 PEER = {1.0: "36 s for +0.30 %, 187 s for -0.12 %", 3.0: "513 s for +2.7 %"}
 
 
@@ -86,24 +86,29 @@ calls (median), less sensitive to the load.
 
 On a loaded machine the times scale with the load; the ratio of a row's time to the 1e-4 row
 of the same μ in this run is not: {ratios}. The counts are the numbers: every row is
-traced with the grid following the contact edge (both μ are bistable): the approach branch by
-Newton in its centre gap up to the jump-in fold, the contact branch by Newton in its edge
-radius on a grid whose nodes move with the edge (femadh.studies.smooth_sphere.trace_edge_point),
-both with chord steps on the last factorisation while it contracts the residual tenfold.
-3e-3 starts at the edge family's cap 0.133 ell (its coarser member at 0.167: beyond ~0.15 ell
-the pull-off leaves the spacing^2 line, 1.3e-3 off at 0.25 and 4.8e-3 at 0.3 for μ = 3) and,
-the accuracy being asked of the pull-off alone, with both grids' grading length from the
-pull-off's measured error model C spacing^2 (2 ell / G)^1.5 at half the request
-(femadh.studies.regime.pull_off_grading): 0.77 ell at 3e-3 (2 ell at 1e-4, where the band
-spacing sets the error).
+traced with the grid following the contact edge (both μ are bistable): the contact branch by
+Newton in its edge radius on a grid whose nodes move with the edge
+(femadh.studies.smooth_sphere.trace_edge_point) down to the jump-out fold, the approach branch
+by Newton in its centre gap from the jump-out separation to the jump-in fold, then the
+contact branch up past the landing. Both branches keep their last LU factorisation for the
+next solve within 1 % of its state (chord steps while it contracts the residual tenfold),
+the march predicts each state by a parabola through the last three, and the states meet the
+residual 1e-4 x accuracy x z0 (3e-16 m at 3e-3: no headline quantity moves by more than
+3e-8 relative against 1e-19 m). 3e-3 starts at the edge family's cap 0.133 ell (its coarser
+member at 0.167: beyond ~0.15 ell the pull-off leaves the spacing^2 line, 1.3e-3 off at 0.25
+and 4.8e-3 at 0.3 for μ = 3) and, the accuracy being asked of the pull-off alone, with both
+grids' grading length from the pull-off's measured error model C spacing^2 (2 ell / G)^1.5
+at half the request (femadh.studies.regime.pull_off_grading): 0.77 ell at 3e-3 (2 ell at
+1e-4, where the band spacing sets the error). The approach branch runs on the centre band
+[0, 4 ell] also at μ = 1 (on the DMT side of bistability, where the arclength trace's band
+is fixed over the contact edge's travel): 65 nodes instead of 82.
 
-Before this change (main at 449d272): μ = 1 at 3e-3 54 ms on a quiet machine (99 nodes,
-achieved 3.0e-4 = a tenth of the request); the fine member's counts 66 solves and 167 LU
-factorisations at μ = 1, 66 and 198 at μ = 3 (41 contact-branch solves and an arclength
-approach branch). Now 49 solves and 52 factorisations at μ = 1, 49 and 69 at μ = 3. Back to
-back at load 5.2 (one core free, wall = cpu), median of 9: μ = 1 63 -> 27.5 ms, μ = 3 87 ->
-32 ms; 1e-4 (pull-offs unchanged in their 6 printed digits): 0.224 s and 1.027 s before,
-quiet.
+Before this change (main at ca75e7c; both members of one 3e-3 request, all LU
+factorisations counted): μ = 1: 98 solves, 139 factorisations, 391 Newton iterations; μ = 3:
+98, 172, 470. Now μ = 1: 90, 107, 211; μ = 3: 93, 128, 244. Back to back in one process
+(interleaved, median of 21 each, load ~5, cpu time): μ = 1 29.4 -> 16.7 ms (0.54 x), μ = 3
+33.1 -> 20.4 ms; the coordinator's quiet-machine 28 ms at μ = 1 before. Earlier (main at
+449d272): μ = 1 54 ms quiet (99 nodes, achieved 3.0e-4).
 
 Peer (ContactMechanics/Adhesion, our earlier run, not re-run here): μ = 1: {PEER[1.0]};
 μ = 3: {PEER[3.0]}.

@@ -143,10 +143,12 @@ negative load; fixed grip: vertical tangent of P(D), none below lambda = 0.938).
 
 Bistable points (μ > 0.81, where Maugis-Dugdale has a fixed-grip pull-off) are traced with
 the grid following the contact edge (`femadh.studies.smooth_sphere.trace_edge_point`): the
-approach branch by arclength to the jump-in fold, the contact branch by Newton in its edge
-radius c on a grid whose nodes move with the edge (the Green operator scaled exactly, C =
-λ C0), the folds as extrema of d(c); two grids per point, two folds traced (the unstable
-branch between them, with its two further folds at μ ≥ 5, is not). The others by arclength
+contact branch by Newton in its edge radius c on a grid whose nodes move with the edge (the
+Green operator scaled exactly, C = λ C0), the approach branch by Newton in its centre gap
+on the centre band, from the jump-out separation to the jump-in fold, the folds as extrema
+of d(c) and d(g); two grids per point, two folds traced (the unstable branch between them,
+with its two further folds at μ ≥ 5, is not); with accuracy = 1e-3 the states meet the
+residual 1e-4 x accuracy x z0. The others by arclength
 on the static band (`trace_point`). "grids": grids of the trace.
 
 {map_table(pts)}
