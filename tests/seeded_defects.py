@@ -1031,6 +1031,16 @@ DEFECTS = [
       "spacing asked for, not the capped one it ran", "femadh/runner/adaptive.py",
       (("    return Trial(family, h, spacing, op.grid.n, op, follow)",
         "    return Trial(family, spacing, spacing, op.grid.n, op, follow)"),)),
+    D("adaptive_any_valueerror_budget", "adaptive grid: any ValueError of a member read as the "
+      "node budget's refusal", "femadh/runner/adaptive.py",
+      (("    except NodeBudgetError:     # the member would exceed MAX_NODES",
+        "    except ValueError:     # the member would exceed MAX_NODES"),)),
+    D("adaptive_tail_short_as_nodes", "adaptive grid: a request the tail keeps short asks for "
+      "more nodes", "femadh/runner/adaptive.py",
+      (('        if last["tail_rel_error"] > SAFETY * target:', "        if False:"),)),
+    D("adaptive_radius_need_power", "adaptive grid: the radius needed from the tail's decay "
+      "with the power p, not 1/p", "femadh/runner/adaptive.py",
+      (("a1 * (t1 / tail_target) ** (1 / p) * 1e6", "a1 * (t1 / tail_target) ** p * 1e6"),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',
