@@ -1041,6 +1041,10 @@ DEFECTS = [
     D("adaptive_radius_need_power", "adaptive grid: the radius needed from the tail's decay "
       "with the power p, not 1/p", "femadh/runner/adaptive.py",
       (("a1 * (t1 / tail_target) ** (1 / p) * 1e6", "a1 * (t1 / tail_target) ** p * 1e6"),)),
+    D("mem_fold_solves_uncounted", "reduced member: a fold search that falls back leaves its "
+      "corrector solves uncounted", "femadh/runner/members.py",
+      (("        solves, m.solves = solves + 1, m.solves + 1     # counted as made",
+        "        solves = solves + 1     # counted as made"),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',
