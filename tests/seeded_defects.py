@@ -1045,6 +1045,10 @@ DEFECTS = [
       "corrector solves uncounted", "femadh/runner/members.py",
       (("        solves, m.solves = solves + 1, m.solves + 1     # counted as made",
         "        solves = solves + 1     # counted as made"),)),
+    D("roughness_interrupt_ignored", "validation/roughness.py: a run stopped by a signal does "
+      "not stop the script (its loops go on)", "validation/roughness.py",
+      (('    if res.status == "interrupted":\n        raise Interrupted(res.exit_code - 128)',
+        '    if False:\n        raise Interrupted(res.exit_code - 128)'),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',

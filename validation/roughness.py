@@ -9,6 +9,7 @@ import argparse
 import copy
 import math
 from pathlib import Path
+import sys
 import time
 import warnings
 
@@ -19,9 +20,11 @@ try:
 except ModuleNotFoundError:
     import tomli as tomllib
 
+from femadh.errors import Interrupted
+from femadh.interrupt import interruptible
 from femadh.io.atomic import save_atomic
 from femadh.reference.gw import mean_plane_dominance_bound, paper1_table2_roughness
-from femadh.runner.run import run
+from femadh.runner.run import run as runner_run
 from femadh.scene import scene_from_dict
 
 from .paper1 import (HEAD, _fmt, closure_sweeps, complementarity_sweeps, curve, jumps,
@@ -33,6 +36,16 @@ E_STAR = 58.48e9
 DG_ASPERITY = 0.06   # paper 1 sec 6
 Z0 = 0.165e-9
 PAPER_FIG8 = {0: 0.022, 100: 0.05, 179: 0.151}  # min -F_ex (mN), paper Fig 8(b)
+
+
+def run(scene, **kw):
+    """femadh's runner (:func:`femadh.runner.run.run`), except that a run stopped by SIGINT or
+    SIGTERM stops this script: the runner returns such a run ("interrupted", its states kept)
+    as it does for the command line, and the loops below would go on to their next run."""
+    res = runner_run(scene, **kw)
+    if res.status == "interrupted":
+        raise Interrupted(res.exit_code - 128)
+    return res
 
 
 def _plt():
@@ -248,14 +261,23 @@ def gw_models():
 
 
 def main(argv=None):
+    """Write results/roughness.md; 0, or 130 / 143 with one line on stderr where SIGINT /
+    SIGTERM stopped it (the signals only set a flag, read at the solvers' safe points, for the
+    whole script: the direct traces of Fig 8 stop at their next iteration as the runs do)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)
     t0 = time.perf_counter()
-    f7, ms, bounds, r = fig7()
-    f8, _, a_eq19 = fig8()
-    lim = eq20_limit()
-    gw = gw_models()
+    try:
+        with interruptible():
+            f7, ms, bounds, r = fig7()
+            f8, _, a_eq19 = fig8()
+            lim = eq20_limit()
+            gw = gw_models()
+    except Interrupted as exc:
+        print(f"validation.roughness: {exc} after {time.perf_counter() - t0:.0f} s: stopped, "
+              f"{RESULTS / 'roughness.md'} not written", file=sys.stderr)
+        return exc.exit_code
     dg_table1 = 1e-19 / (16 * math.pi * Z0**2)
     text = "\n".join([
         "# Paper 1 sec 5.2-6: asperities (validation/roughness.py)", "",
@@ -276,7 +298,8 @@ def main(argv=None):
         "## The continuous alternative: GW asperity laws instead of the hard σ-gap", "", gw, ""])
     (RESULTS / "roughness.md").write_text(text + "\n")
     print(text)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
