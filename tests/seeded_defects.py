@@ -1049,6 +1049,14 @@ DEFECTS = [
       "not stop the script (its loops go on)", "validation/roughness.py",
       (('    if res.status == "interrupted":\n        raise Interrupted(res.exit_code - 128)',
         '    if False:\n        raise Interrupted(res.exit_code - 128)'),)),
+    D("overwrite_keeps_vtk", "--overwrite leaves the previous run's vtk folder",
+      "femadh/io/run_folder.py",
+      (('           "vtk", "approach.pvd", "retract.pvd",', '           "approach.pvd", '
+        '"retract.pvd",'),)),
+    D("resume_of_a_finished_run", "--resume of a converged run runs it again instead of saying "
+      "there is nothing to resume", "femadh/io/run_folder.py",
+      (('            if prev.get("status") == "converged" and not prev.get("trial"):',
+        "            if False:"),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',
