@@ -76,21 +76,22 @@ def csvrows(path):
 @pytest.mark.slow
 def test_signals_and_kill_9_stop_cleanly_and_three_resumes_complete(tmp_path):
     """One run of the long Fig 3 scene (702 states), by the CLI in a subprocess, stopped three
-    times - SIGINT after 20 rows, SIGTERM after 60 (in the first --resume), kill -9 after 100
-    (in the second) - then resumed to its end. (One test, not one per stop: the checks share
-    the run, and pytest-xdist would run a shared fixture once per worker.)
+    times - kill -9 after 20 rows (the fresh run: its own "running" summary), SIGINT after 60
+    (in the first --resume, which had no checkpoint: the last state re-solved from
+    fields.csv), SIGTERM after 100 (in the second) - then resumed to its end. (One test, not
+    one per stop: the checks share the run, and pytest-xdist would run a shared fixture once
+    per worker.)
 
+    - kill -9: summary still "running", no torn row;
     - SIGINT and SIGTERM: exit 128 + the signal, one error line naming --resume, summary
       "interrupted", every committed state in every file;
-    - kill -9: summary still "running", no torn row;
-    - the last --resume (from the kill: no checkpoint, the last state re-solved from
-      fields.csv) ends "converged" with every state complete in every file and the curve of
-      an uninterrupted run."""
+    - the last --resume ends "converged" with every state complete in every file and the
+      curve of an uninterrupted run."""
     from validation.fault_matrix import cli
 
     scene, out = long_scene(tmp_path), tmp_path / "out"
-    for k, (how, code, rows) in enumerate((("SIGINT", 130, 20), ("SIGTERM", 143, 60),
-                                           ("kill -9", -signal.SIGKILL, 100))):
+    for k, (how, code, rows) in enumerate((("kill -9", -signal.SIGKILL, 20), ("SIGINT", 130, 60),
+                                           ("SIGTERM", 143, 100))):
         p = start(scene, out, *(("--resume",) if k else ()))
         wait_rows(out, rows, p)
         if how == "kill -9":
