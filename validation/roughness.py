@@ -239,7 +239,34 @@ def eq20_limit(rho=179, A="1e-19 J"):
     return lines
 
 
+def _snake(res):
+    """What a failed arclength trace covered (its streamed points): (points, folds - sign
+    changes of dd/ds -, smallest and largest d in nm), or None."""
+    ec = res.equilibrium_curve or {}
+    td, d = np.asarray(ec.get("dd_ds", ())), np.asarray(ec.get("d_m", ()))
+    if not d.size:
+        return None
+    return d.size, int(np.sum(np.sign(td[1:]) * np.sign(td[:-1]) < 0)), d.min() * 1e9, \
+        d.max() * 1e9
+
+
 def gw_models():
+    """The continuous GW laws on the slider (N = 200) by stepping and by arclength.
+
+    At rho = 31.3 um^-2 both fail, and not for their budgets: the GW laws soften at 3.05x the
+    stiffness of one surface node (the scene's own MeshResolutionWarning: nodes >= 1220), so
+    the N = 200 discretisation is lattice-trapped. Stepping cannot polish its landing after
+    the jump-in (d = 0.786 nm, Newton 200 iterations). Arclength follows the discrete curve
+    faithfully - 1.2 corrector solves per point, no step collapse - but that curve is a snake
+    with one pair of folds per node that snaps (the resolved curve has two folds): its lower
+    folds lie at 0.79-1.77 nm, its upper ones at 0.84-2.92 nm, 110-135 points apart. Measured with
+    trace_curve on this scene: 45 folds in the row's 5000 points, 111 folds in 15 000 points
+    (d back down to 1.40 nm on the contact branch, ~26 legs from its end at 0.6 nm by the
+    lower folds' pace), so the discrete curve needs some 20 000 points or more: a budget that
+    cannot be met usefully, for a mesh-dependent answer. The fix is the mesh the warning
+    asks for (N >= 1220: Krylov correctors at N > 250, a run at N = 1300 had not ended after
+    6 CPU-min), not the point budget or the step control; the row stays, failing, with what
+    its trace covered."""
     rows = ["| Greenwood-Williamson (continuous), Δγ_a = 0.06 | A (J) | ρ (µm⁻²) | status | "
             "max adhesion, mN |", "|---|---|---|---|---|"]
     for rho in (31.3, 100, 179):
@@ -254,6 +281,11 @@ def gw_models():
         trap = [w for w in caught if "snap" in str(w.message)]
         note = (f"; {len(res.jumps)} jumps, mesh-dependent (node stiffness below the law's "
                 "softening)" if trap else f"; {len(res.jumps)} jumps")
+        covered = _snake(res) if res.status == "failed" else None
+        if covered:
+            note += (f"; its {covered[0]} points snake through {covered[1]} folds between "
+                     f"d = {covered[2]:.3g} and {covered[3]:.3g} nm (one pair per node that "
+                     "snaps: see gw_models' docstring)")
         rows.append(f"| arclength to {stop} | 1e-19 | {rho} | {res.status}{note} "
                     f"({time.perf_counter() - t0:.0f} s) | "
                     f"{res.headline.get('max_adhesion_N', math.nan) * 1e3:.4f} |")
