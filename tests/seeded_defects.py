@@ -1065,6 +1065,32 @@ DEFECTS = [
       "spacing asked for, not the capped one it ran", "femadh/runner/adaptive.py",
       (("    return Trial(family, h, spacing, op.grid.n, op, follow)",
         "    return Trial(family, spacing, spacing, op.grid.n, op, follow)"),)),
+    D("adaptive_any_valueerror_budget", "adaptive grid: any ValueError of a member read as the "
+      "node budget's refusal", "femadh/runner/adaptive.py",
+      (("    except NodeBudgetError:     # the member would exceed MAX_NODES",
+        "    except ValueError:     # the member would exceed MAX_NODES"),)),
+    D("adaptive_tail_short_as_nodes", "adaptive grid: a request the tail keeps short asks for "
+      "more nodes", "femadh/runner/adaptive.py",
+      (('        if last["tail_rel_error"] > SAFETY * target:', "        if False:"),)),
+    D("adaptive_radius_need_power", "adaptive grid: the radius needed from the tail's decay "
+      "with the power p, not 1/p", "femadh/runner/adaptive.py",
+      (("a1 * (t1 / tail_target) ** (1 / p) * 1e6", "a1 * (t1 / tail_target) ** p * 1e6"),)),
+    D("mem_fold_solves_uncounted", "reduced member: a fold search that falls back leaves its "
+      "corrector solves uncounted", "femadh/runner/members.py",
+      (("        solves, m.solves = solves + 1, m.solves + 1     # counted as made",
+        "        solves = solves + 1     # counted as made"),)),
+    D("roughness_interrupt_ignored", "validation/roughness.py: a run stopped by a signal does "
+      "not stop the script (its loops go on)", "validation/roughness.py",
+      (('    if res.status == "interrupted":\n        raise Interrupted(res.exit_code - 128)',
+        '    if False:\n        raise Interrupted(res.exit_code - 128)'),)),
+    D("overwrite_keeps_vtk", "--overwrite leaves the previous run's vtk folder",
+      "femadh/io/run_folder.py",
+      (('           "vtk", "approach.pvd", "retract.pvd",', '           "approach.pvd", '
+        '"retract.pvd",'),)),
+    D("resume_of_a_finished_run", "--resume of a converged run runs it again instead of saying "
+      "there is nothing to resume", "femadh/io/run_folder.py",
+      (('            if prev.get("status") == "converged" and not prev.get("trial"):',
+        "            if False:"),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',

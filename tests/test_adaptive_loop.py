@@ -173,6 +173,46 @@ def test_a_member_beyond_the_node_limit_ends_the_request_in_one_line(monkeypatch
     assert all(s["nodes"] <= 400 for s in res.accuracy["steps"])
 
 
+def test_a_tail_that_falls_short_names_the_analysis_radius_not_a_node_count(monkeypatch):
+    """The force beyond the disk stays above SAFETY of the target through every run (it falls
+    as a^-2 while each run doubles the disk): the budget of runs ends the request, and the
+    line names the tail and the analysis radius it needs - from the tail's observed decay
+    over the last doubling, a_last (t_last / (SAFETY target))^(1/2) - never a node count (a
+    finer spacing would not help). With one run only there is no decay to read: "a larger
+    analysis radius"."""
+    sc = adaptive_scene(accuracy=1e-2)
+    script = [{"grid": 1e-3, "tail": 4.0 * 4.0**-k} for k in range(adaptive.MAX_TRIALS)]
+    run, seen = scripted(script)
+    res = adaptive.run_adaptive(sc, None, run=run)
+    assert len(seen) == adaptive.MAX_TRIALS
+    for (h, b, a, _), (h_next, b_next, a_next, _) in zip(seen, seen[1:]):
+        assert (h_next, b_next, a_next) == (h, b, 2 * a)
+    last, t_last = res.accuracy["steps"][-1], script[-1]["tail"]
+    assert res.status == "failed" and res.failure_kind == "accuracy"
+    a_need = last["analysis_radius_m"] * (t_last / (adaptive.SAFETY * 1e-2)) ** 0.5
+    assert f"{t_last:.2g} of it the force beyond the analysis radius " \
+        f"{last['analysis_radius_m'] * 1e6:.4g} um" in res.error
+    assert f"needs an analysis radius of about {a_need * 1e6:.3g} um" in res.error
+    assert "a^-2 " in res.error and "needs about" not in res.error, res.error
+    monkeypatch.setattr(adaptive, "MAX_TRIALS", 1)
+    run, seen = scripted(script)
+    res = adaptive.run_adaptive(sc, None, run=run)
+    assert len(seen) == 1 and "needs a larger analysis radius" in res.error, res.error
+
+
+def test_only_the_node_budget_reads_as_too_many_nodes(monkeypatch):
+    """A ValueError of a member other than the node budget's (here from its problem's
+    trapping-safe spacing) keeps its own words - the step and the value - instead of
+    reading "the grid would need more than 4000 nodes"."""
+    def broken(problem):
+        raise ValueError("law 'lj': stiffness at gap step 3 is nan")
+    monkeypatch.setattr(adaptive, "safe_spacing", broken)
+    run, seen = scripted([{"grid": 1e-3}])
+    with pytest.raises(ValueError, match="stiffness at gap step 3 is nan"):
+        adaptive.run_adaptive(adaptive_scene(accuracy=1e-2), None, run=run)
+    assert seen == []
+
+
 def test_accuracy_mode_refines_by_the_failure_kind():
     """Uniform accuracy mode: "analysis_radius" doubles N and quadruples delta (the disk
     doubles, the spacing stays); "trapping" and "bound" double N; a stalled continuation

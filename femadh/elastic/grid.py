@@ -5,6 +5,11 @@ import math
 import numpy as np
 
 
+class NodeBudgetError(ValueError):
+    """A grid refused for needing more nodes than its budget (``max_nodes``): the one refusal
+    a caller may answer by a coarser request; any other ValueError of a grid is an error."""
+
+
 @dataclass(frozen=True, eq=False)
 class RadialGrid:
     """Collocation nodes r_k and the annuli [e_k, e_{k+1}] that carry their pressure.
@@ -103,7 +108,7 @@ class RadialGrid:
         grading : float
             Length (m) over which the spacing grows by ``spacing`` (> 0).
         max_nodes : int
-            Budget: a ValueError beyond it (spacing too fine for the domain).
+            Budget: a :class:`NodeBudgetError` beyond it (spacing too fine for the domain).
         """
         lo, hi = max(0.0, float(band[0])), min(radius, float(band[1]))
         if not (spacing > 0 and grading > 0 and lo <= hi):
@@ -122,8 +127,8 @@ class RadialGrid:
                 break
             nodes.append(r + step)
             if len(nodes) > max_nodes:
-                raise ValueError(f"banded grid needs more than {max_nodes} nodes (spacing "
-                                 f"{spacing:.3g} m on a radius of {radius:.3g} m)")
+                raise NodeBudgetError(f"banded grid needs more than {max_nodes} nodes "
+                                      f"(spacing {spacing:.3g} m on a radius of {radius:.3g} m)")
         if len(nodes) < 2:
             raise ValueError("the spacing does not fit inside the analysis radius")
         return cls.from_nodes(np.array(nodes), radius, fine_radius=hi)

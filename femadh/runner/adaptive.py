@@ -19,7 +19,8 @@ stopped by a signal or its time limit ends the loop. The runs are the attempts o
 shared refine-until-met loop (:func:`femadh.estimate.refine.refine_until_met`), one
 :class:`Trial` each. The result says what was chosen and every trial
 (``result.accuracy``), or fails naming the accuracy reached, the nodes it used, the time and
-about how many nodes the request would need.
+about how many nodes the request would need (where the force beyond the analysis radius is
+what falls short: about what radius it would need).
 
 The band is static by default: a band that follows the contact edge
 (``[solver.grid] follow``, FOLLOW_NODES) was measured against it on the Fig 3, Fig 4 and
@@ -37,6 +38,7 @@ import numpy as np
 from ..discretisation import GridFamily, plan_grid
 from ..discretisation.family import MAX_NODES
 from ..discretisation.plan import safe_spacing
+from ..elastic.grid import NodeBudgetError
 from ..estimate.refine import Budget, refine_until_met
 from .accuracy import REFINE_RADIUS
 from .result import STOPPED
@@ -167,7 +169,8 @@ def _trial(scene, family, spacing):
     follow = _follows(scene, family, spacing)
     try:
         h, op, _ = _capped(scene, family, spacing, follow)
-    except ValueError:          # the member would exceed MAX_NODES
+    except NodeBudgetError:     # the member would exceed MAX_NODES (only that refusal: any
+        # other ValueError of the member, its operator or its problem is raised as it is)
         return Trial(family, spacing, spacing, max(family.count(spacing), MAX_NODES + 1),
                      None, follow)
     return Trial(family, h, spacing, op.grid.n, op, follow)
@@ -272,12 +275,21 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                      f"spacing {last['spacing_m'] * 1e9:.3g} nm); see the warnings")
     elif not met and res.status == "converged" and estimate is True:
         reached = last["grid_rel_error"] + last["tail_rel_error"]
-        need = _nodes_needed(family, last["spacing_m"], reached, target)
         res.status, res.failure_kind = "failed", "accuracy"
-        res.error = (f"accuracy {target:g} not met: estimated relative error {reached:.2g} "
-                     f"with {last['nodes']} nodes after {len(steps)} runs "
-                     f"({res.accuracy['wall_time_s']:.3g} s); the request needs about "
-                     f"{need} nodes (budget: {MAX_TRIALS} runs, {MAX_NODES} nodes)")
+        said = (f"accuracy {target:g} not met: estimated relative error {reached:.2g} "
+                f"with {last['nodes']} nodes after {len(steps)} runs "
+                f"({res.accuracy['wall_time_s']:.3g} s)")
+        if last["tail_rel_error"] > SAFETY * target:
+            # the force beyond the analysis radius is what falls short (the loop was growing
+            # the disk, _decide): a finer spacing would not help, a count of nodes misleads
+            res.error = (f"{said}, {last['tail_rel_error']:.2g} of it the force beyond the "
+                         f"analysis radius {last['analysis_radius_m'] * 1e6:.4g} um; the "
+                         f"request needs {_radius_needed(steps, SAFETY * target)} (budget: "
+                         f"{MAX_TRIALS} runs)")
+        else:
+            need = _nodes_needed(family, last["spacing_m"], reached, target)
+            res.error = (f"{said}; the request needs about {need} nodes (budget: "
+                         f"{MAX_TRIALS} runs, {MAX_NODES} nodes)")
     res.timings["adaptive_total_s"] = time.perf_counter() - t0
     trial = ahead["trial"]
     if out_dir is not None and trial is not None:
@@ -360,6 +372,22 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead):
     factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
     ahead["next"] = (family, h * min(MAX_FACTOR, max(MIN_FACTOR, factor)))
     return None
+
+
+def _radius_needed(steps, tail_target):
+    """What analysis radius brings the tail's relative error to ``tail_target``: from its
+    observed decay over the last two runs on different radii (tail ~ a^-p), "an analysis
+    radius of about X um"; without two such runs or with a tail that did not fall, "a larger
+    analysis radius"."""
+    last = steps[-1]
+    a1, t1 = last["analysis_radius_m"], last["tail_rel_error"]
+    for prev in reversed(steps[:-1]):
+        a0, t0 = prev.get("analysis_radius_m"), prev.get("tail_rel_error", math.nan)
+        if a0 and a0 < a1 and t0 > t1 > 0 and math.isfinite(t0):
+            p = math.log(t0 / t1) / math.log(a1 / a0)
+            return (f"an analysis radius of about {a1 * (t1 / tail_target) ** (1 / p) * 1e6:.3g}"
+                    f" um (the tail fell as a^-{p:.2g} over the last runs)")
+    return "a larger analysis radius"
 
 
 def _nodes_needed(family, spacing, reached, target):

@@ -281,7 +281,7 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         new = solve_complementarity(p, d, w, tol=sc.tolerance, max_iter=sc.max_iter,
                                     factor=state.lu, stall_iter=None if step == 1 else STALL_ITER,
                                     **kw)
-        solves += 1
+        solves, m.solves = solves + 1, m.solves + 1     # counted as made (a fallback's too)
         ok = new.converged and new.stable and bool(np.all(
             np.abs(new.w - w) <= MAX_CORRECTION_FRACTION * np.maximum(new.h + (new.w - w), 0)
             + 1e-15))
@@ -296,7 +296,7 @@ def _lattice_fold(m, d_fold, d_land, before, after):
             step //= 2
             continue
         landed = land(p, d, state.w, tol=sc.tolerance, max_iter=sc.max_iter)
-        solves += 1
+        solves, m.solves = solves + 1, m.solves + 1
         if not (landed.converged and landed.stable):
             # as in a whole trace, whose failure there is the member's (a lattice-trapped
             # member's landing that does not polish: the adaptive run refines): traced whole
@@ -314,7 +314,6 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         if np.any(np.abs(landed.w - w0) > 0.25 * np.maximum(p.contour(d) - w0, 0) + 1e-15):
             raise _NotReduced(f"the member lands elsewhere than the fine run after its fold at "
                               f"d = {state.d * 1e9:.6g} nm")
-        m.solves += solves
         return state.d, m.released(state, landed, d)
 
 
