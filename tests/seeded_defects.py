@@ -934,7 +934,28 @@ DEFECTS = [
       (("    f = x - math.floor(x)", "    f = 0.0"),)),
     D("lock_first_state", "members placed by the edge of the sweep's first state",
       "femadh/runner/members.py",
-      (('    snap = sink.committed["approach"][-1]', '    snap = sink.committed["approach"][0]'),)),
+      (("    snap = snaps[-1]", "    snap = snaps[0]"),)),
+    D("lock_uniform_off", "a uniform grid's deepest state: the N/2, N/4 members (across the "
+      "edge's node-crossing sawtooth), not members placed by the edge",
+      "femadh/runner/members.py",
+      (('        if why and not why.startswith("a uniform grid"):', "        if why:"),)),
+    D("lock_uniform_spacing", "a uniform grid's edge-placed members on the analysis radius "
+      "at N/2, N/4 nodes (the fraction of a spacing not kept)", "femadh/runner/members.py",
+      (('        member = variant(scene, grid={**g, "spacing": h})',
+        '        member = (variant(scene, nodes=int(round(problem.grid.n * h0 / h)))\n'
+        '                  if getattr(scene, "grid", None) is None else\n'
+        '                  variant(scene, grid={**g, "spacing": h}))'),
+       ("    spacings = locked_spacings(problem, contact_edge(problem, snap), g.get(\"band\"), ratio)",
+        "    spacings = locked_spacings(problem, contact_edge(problem, snap), g.get(\"band\"), ratio)\n"
+        "    h0 = float(problem.grid.nodes[1])"))),
+    D("fold_side_swapped", "a fold's resolution taken on the side the sweep came from",
+      "femadh/runner/estimates.py",
+      (('                                         j["d_land_m"] - j["d_fold_m"])',
+        '                                         j["d_fold_m"] - j["d_land_m"])'),)),
+    D("fold_side_bound", "a fold's one-sided bound max(|g|, |g - r|)",
+      "femadh/runner/estimates.py",
+      (("    return max(abs(grid), abs(grid + beyond))",
+        "    return max(abs(grid), abs(grid - beyond))"),)),
     D("lock_ratio_swap", "uneven Richardson: the two ratios swapped",
       "femadh/runner/estimates.py",
       (("ratio=h1 / h0, ratio2=h2 / h1).items():", "ratio=h2 / h1, ratio2=h1 / h0).items():"),)),
