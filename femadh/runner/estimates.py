@@ -16,15 +16,13 @@ Each headline number gets an a-posteriori estimate made of
   those spacings;
 - **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
   the grid separations by a bounded scalar search on fresh states (its bracket is its error);
-  a fold is located to 2^-10 of the grid step (the jump's resolution), on the side the sweep
-  goes: combined with the grid part by their signs (:func:`fold_error`);
+  a fold is located to 2^-10 of the grid step (the jump's resolution);
 - **truncation at the analysis radius**: the force the laws exert beyond it on the undeformed
   far field, -2 pi R U(b(a; d)) per law (exact for the paraboloid), reported as ``F_tail``;
 - **solver tolerance**: the force a change of the displacements by the tolerance makes,
   sum_k area_k |P'(h_k)| tol.
 The total is the sum of their magnitudes (each is a bound or a conservative estimate of its
-part; the signed parts are kept in the breakdown), but for a fold's one-sided resolution,
-which is combined with the grid part by their signs.
+part; the signed parts are kept in the breakdown).
 
 Guards (a state or a result that would be garbage is refused, not reported "converged"):
 - the contact reaches the analysis radius (the disk is too small for the load);
@@ -236,16 +234,12 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             parts.setdefault(k, {})["grid"] = v
         res.grid["deepest_member_spacings_m"] = [h1, h2]
         res.grid["deepest_members"] = [lv1, lv2]
-    # folds: located to the jump's resolution, on the side the sweep goes (the reported
-    # separation is the last stable state before the fold, the fold lies beyond it)
-    beyond = {}
+    # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
         js = [j for j in res.jumps if j["branch"] == branch]
         if js and name in hl:
-            j = js[0 if branch == "approach" else -1]
-            parts.setdefault(name, {})["resolution"] = float(j["resolution_m"])
-            beyond[name] = math.copysign(float(j["resolution_m"]),
-                                         j["d_land_m"] - j["d_fold_m"])
+            parts.setdefault(name, {})["resolution"] = float(js[0 if branch == "approach"
+                                                                else -1]["resolution_m"])
     # truncation at the analysis radius and the solver tolerance, for the forces
     for name, d_key in (("max_adhesion_N", "d_at_max_adhesion_m"),
                         ("F_ex_deepest_N", "d_deepest_m"), ("F_LJ_deepest_N", "d_deepest_m")):
@@ -266,30 +260,11 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # (resolution, tolerance); they are added in magnitude: the grid and tail estimates
         # can cancel where the true errors do not, so the total is an upper estimate
         comp["total"] = float(sum(abs(v) for v in comp.values()))
-        if k in beyond and "grid" in comp:
-            # the fold's resolution is one-sided: its part and the grid's are combined by
-            # their signs (where they oppose, the larger of the two, not their sum)
-            comp["total"] += (fold_error(comp["grid"], beyond[k]) - abs(comp["grid"])
-                              - abs(comp["resolution"]))
         hl[f"{k}_error"] = comp["total"]
     # the error estimate alone (the members, the tail, ...): estimate_s also holds the peak
     # search, which locates the headline's largest adhesion itself
     res.timings["error_estimate_s"] = time.perf_counter() - t0
     return parts
-
-
-def fold_error(grid, beyond):
-    """Bound (m) on the error of a fold separation read at the last stable state before the
-    fold: Q* - Q = g + u, g the grid part's signed estimate (``grid``) and u the fold's
-    offset from that state, between 0 and one lattice step on the side the sweep goes
-    (``beyond``, signed: the stepping accepts no state past the fold, and the first state
-    it rejects is one step on, :mod:`femadh.contact.stepping`). |g + u| <= max(|g|, |g +
-    beyond|): |g| + |beyond| where they have one sign, the larger of the two where they
-    oppose. Measured on the Fig 4 scene at accuracy 3e-3: grid part -7.28e-4 of the
-    pull-off separation (the members' folds beyond the fine run's), the resolution +1.66e-4
-    (the retract sweep goes out): 7.28e-4 in place of 8.94e-4, against an error of 1.26e-4
-    (the reference's fold bisected below its lattice, validation/effectivity_folds.py)."""
-    return max(abs(grid), abs(grid + beyond))
 
 
 def fe_against_green(fe, green):
