@@ -136,8 +136,12 @@ def deepest_reference(name, h_ref, radius_factor=2.0):
     sc = variant(base, grid={"spacing": h_ref, "band": fam["band"], "grading": fam["grading"]},
                  radius=radius_factor * fam["a"])
     res, got = capture(sc)
-    (h1, h2), (lv1, lv2) = deepest_locked(got["scene"], got["problem"], got["sink"],
-                                          2**-0.5, variant)
+    locked = deepest_locked(got["scene"], got["problem"], got["sink"], 2**-0.5, variant)
+    if locked is None:
+        raise SystemExit(f"{name}: no members placed by the reference's deepest edge at "
+                         f"{h_ref / 2**0.5:.3g} and {h_ref / 2:.3g} m (no edge the members can "
+                         "be placed by, or a member that did not solve)")
+    (h1, h2), (lv1, lv2) = locked
     q = [res.headline["F_LJ_deepest_N"], lv1["F_LJ_deepest_N"], lv2["F_LJ_deepest_N"]]
     # the finest member first: spacings h2 < h1 < h_ref
     p = observed_order_uneven(q[2], q[1], q[0], h1 / h2, h_ref / h1)
