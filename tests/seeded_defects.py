@@ -934,7 +934,8 @@ DEFECTS = [
       (("    f = x - math.floor(x)", "    f = 0.0"),)),
     D("lock_first_state", "members placed by the edge of the sweep's first state",
       "femadh/runner/members.py",
-      (("    snap = snaps[-1]", "    snap = snaps[0]"),)),
+      (('    snap = (getattr(sink, "last", None) or {}).get("approach")',
+        '    snap = sink.committed["approach"][0]'),)),
     D("lock_uniform_off", "a uniform grid's deepest state: the N/2, N/4 members (across the "
       "edge's node-crossing sawtooth), not members placed by the edge",
       "femadh/runner/members.py",

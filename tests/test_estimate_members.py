@@ -254,14 +254,17 @@ def test_uniform_grid_gets_members_placed_by_the_deepest_edge():
 
     def keep(scene, problem, sink, *a, **k):
         got.update(problem=problem, state=sink.committed["approach"][-1])
-        return orig(scene, problem, sink, *a, **k)
+        got["locked"] = orig(scene, problem, sink, *a, **k)
+        return got["locked"]
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(estimates, "deepest_locked", keep)
         res = _run(sc)
     assert res.status == "converged"
-    assert res.grid["kind"] == "uniform" and "deepest_member_spacings_m" in res.grid
+    assert res.grid["kind"] == "uniform" and res.grid.get("deepest_members_placed")
+    # the uniform grid's record stays the scene's (no state-dependent spacings in it)
+    assert "deepest_member_spacings_m" not in res.grid
     h = float(got["problem"].grid.nodes[1])
-    assert res.grid["deepest_member_spacings_m"][0] == pytest.approx(2 * h, rel=0.02, abs=0)
+    assert got["locked"][0][0] == pytest.approx(2 * h, rel=0.02, abs=0)
     fine, st = got["problem"], got["state"]
     ref = build_problem(estimates.variant(sc, nodes=1600))
     w0, act = interpolate_state(fine, ref, st.d, st.w)

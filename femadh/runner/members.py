@@ -503,11 +503,13 @@ def deepest_locked(scene, problem, sink, ratio, variant):
             return None
     elif g.get("follow") or eligible(scene, problem, sink):
         return None
-    snaps = (getattr(sink, "committed", None) or {}).get("approach") or []
-    if scene.method != "green" or not snaps or snaps[-1].w is None or \
-            np.shape(snaps[-1].w) != (problem.grid.n,):
+    # the deepest state: the approach branch's last (a resumed run reads it back from its
+    # fields, the same bits, where the other committed states are not in memory)
+    snap = (getattr(sink, "last", None) or {}).get("approach")
+    if scene.method != "green" or snap is None or snap.w is None or \
+            np.shape(snap.w) != (problem.grid.n,):
         return None
-    snap = snaps[-1]
+    snaps = [snap]
     spacings = locked_spacings(problem, contact_edge(problem, snap), g.get("band"), ratio)
     if spacings is None:
         return None
@@ -516,8 +518,7 @@ def deepest_locked(scene, problem, sink, ratio, variant):
         member = variant(scene, grid={**g, "spacing": h})
         try:
             m = _Member(member, problem, member, build_problem(member))
-            st = m.state("approach", sink.committed["approach"],
-                         len(sink.committed["approach"]) - 1)
+            st = m.state("approach", snaps, 0)
         except (_NotReduced, FemadhError, ValueError):
             return None
         f_lj, _, f_ex = state_forces(m.problem, st)
