@@ -968,7 +968,21 @@ DEFECTS = [
       (("    f = x - math.floor(x)", "    f = 0.0"),)),
     D("lock_first_state", "members placed by the edge of the sweep's first state",
       "femadh/runner/members.py",
-      (('    snap = sink.committed["approach"][-1]', '    snap = sink.committed["approach"][0]'),)),
+      (('    snap = (getattr(sink, "last", None) or {}).get("approach")',
+        '    snap = sink.committed["approach"][0]'),)),
+    D("lock_uniform_off", "a uniform grid's deepest state: the N/2, N/4 members (across the "
+      "edge's node-crossing sawtooth), not members placed by the edge",
+      "femadh/runner/members.py",
+      (('        if why and not why.startswith("a uniform grid"):', "        if why:"),)),
+    D("lock_uniform_spacing", "a uniform grid's edge-placed members on the analysis radius "
+      "at N/2, N/4 nodes (the fraction of a spacing not kept)", "femadh/runner/members.py",
+      (('        member = variant(scene, grid={**g, "spacing": h})',
+        '        member = (variant(scene, nodes=int(round(problem.grid.n * h0 / h)))\n'
+        '                  if getattr(scene, "grid", None) is None else\n'
+        '                  variant(scene, grid={**g, "spacing": h}))'),
+       ("    spacings = locked_spacings(problem, contact_edge(problem, snap), g.get(\"band\"), ratio)",
+        "    spacings = locked_spacings(problem, contact_edge(problem, snap), g.get(\"band\"), ratio)\n"
+        "    h0 = float(problem.grid.nodes[1])"))),
     D("lock_ratio_swap", "uneven Richardson: the two ratios swapped",
       "femadh/runner/estimates.py",
       (("ratio=h1 / h0, ratio2=h2 / h1).items():", "ratio=h2 / h1, ratio2=h1 / h0).items():"),)),

@@ -221,3 +221,58 @@ def test_fe_mesh_richardson_is_the_shared_function():
         assert got[k] == (fine[k] - coarse[k]) / (r**estimates.FE_ORDER - 1)
     green = estimates.fe_against_green(fine, coarse)
     assert green == {"a": coarse["a"] - fine["a"], "b": coarse["b"] - fine["b"]}
+
+
+def _slider_uniform(nodes):
+    """The slider meniscus scene on an explicit uniform grid, swept 1 -> -5 nm in 0.5 nm
+    (its deepest state: the contact edge at 3.7 um, F_LJ there 2.97e-4 N)."""
+    base = femadh.load_scene(f"{SCENES}/paper1_slider_meniscus.toml")
+    raw = copy.deepcopy(base.raw)
+    raw["solver"].pop("accuracy", None)
+    raw["solver"]["nodes"] = nodes
+    raw["sweep"].update(start="1 nm", stop="-5 nm", step="0.5 nm")
+    return scene_from_dict(raw, base.path, bare_numbers=False)
+
+
+def test_uniform_grid_gets_members_placed_by_the_deepest_edge():
+    """A uniform grid's F_LJ at the deepest separation: its N/2 and N/4 members put the
+    contact edge at other fractions of a spacing (the slider scene's N = 100, 200, 400 err
+    +1.6e-3, -4.0e-4, -2.6e-5 there: a sawtooth, not a convergence), so its grid part comes
+    from members uniform to the analysis radius at the spacings that keep the fine grid's
+    fraction. Against N = 1600 on the same disk (one Newton solve from the fine state; its
+    own error ~5e-6 of the force, from N = 800's 1.7e-5 at order 2): measured grid part
+    -1.84e-8 N against an error of -9.56e-9 N, effectivity 1.92; the N/2, N/4 members gave
+    -1.16e-7 N (effectivity 12.1)."""
+    from femadh.contact.complementarity import solve_complementarity
+    from femadh.contact.forces import state_forces
+    from femadh.discretisation.moving import interpolate_state
+    from femadh.scene import build_problem
+
+    sc = _slider_uniform(400)
+    got = {}
+    orig = estimates.deepest_locked
+
+    def keep(scene, problem, sink, *a, **k):
+        got.update(problem=problem, state=sink.committed["approach"][-1])
+        got["locked"] = orig(scene, problem, sink, *a, **k)
+        return got["locked"]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(estimates, "deepest_locked", keep)
+        res = _run(sc)
+    assert res.status == "converged"
+    assert res.grid["kind"] == "uniform" and res.grid.get("deepest_members_placed")
+    # the uniform grid's record stays the scene's (no state-dependent spacings in it)
+    assert "deepest_member_spacings_m" not in res.grid
+    h = float(got["problem"].grid.nodes[1])
+    assert got["locked"][0][0] == pytest.approx(2 * h, rel=0.02, abs=0)
+    fine, st = got["problem"], got["state"]
+    ref = build_problem(estimates.variant(sc, nodes=1600))
+    w0, act = interpolate_state(fine, ref, st.d, st.w)
+    sr = solve_complementarity(ref, st.d, w0, tol=sc.tolerance, max_iter=sc.max_iter,
+                               active0=act)
+    assert sr.converged and sr.stable
+    true = state_forces(ref, sr)[0] - res.headline["F_LJ_deepest_N"]
+    est = res.estimates["F_LJ_deepest_N"]["grid"]
+    assert est * true > 0                       # the side the error is on
+    assert 0.5 <= est / true <= 5.0, (est, true)
+

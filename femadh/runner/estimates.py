@@ -12,7 +12,8 @@ Each headline number gets an a-posteriori estimate made of
   banded member is solved only at the states its numbers are read at, from the fine run's
   (:mod:`femadh.runner.members`); the forces at the deepest separation take members placed
   so that the contact edge sits at the fine grid's fraction of a spacing (Richardson over
-  their uneven ratios);
+  their uneven ratios) - on a uniform grid too, members uniform to the analysis radius at
+  those spacings;
 - **resolution in d**: the largest adhesion is the peak of the curve F_ex(d), located between
   the grid separations by a bounded scalar search on fresh states (its bracket is its error);
   a fold is located to 2^-10 of the grid step (the jump's resolution);
@@ -231,8 +232,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
                                    ratio=h1 / h0, ratio2=h2 / h1).items():
             parts.setdefault(k, {})["grid"] = v
-        res.grid["deepest_member_spacings_m"] = [h1, h2]
-        res.grid["deepest_members"] = [lv1, lv2]
+        if scene.grid is not None:
+            res.grid["deepest_member_spacings_m"] = [h1, h2]
+            res.grid["deepest_members"] = [lv1, lv2]
+        else:
+            # a uniform grid's record is the scene's N, state-free: the placed members follow
+            # the deepest state (a resume re-solves it to the tolerance), so only that they
+            # were used is recorded
+            res.grid["deepest_members_placed"] = True
     # folds: located to the jump's resolution
     for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
         js = [j for j in res.jumps if j["branch"] == branch]

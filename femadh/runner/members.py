@@ -487,10 +487,28 @@ def deepest_locked(scene, problem, sink, ratio, variant):
     from ..scene import build_problem
 
     g = getattr(scene, "grid", None)
-    if g is None or g.get("follow") or scene.method != "green" or \
-            eligible(scene, problem, sink):
+    if g is None:
+        # a uniform grid: members uniform to the analysis radius at the locked spacings (a
+        # band over the whole disk). The deepest state is the one contact state at that
+        # separation, so a member solved there from the fine run's stands in for its whole
+        # trace (the folds a coarse uniform member may add are elsewhere on the sweep): the
+        # slider meniscus scene's N = 100, 200, 400 err +1.6e-3, -4e-4, -2.6e-5 in F_LJ
+        # there - the edge hopping between nodes - and its N/2 member made N = 400's
+        # estimate 15x the error
+        a = float(problem.grid.radius)
+        g = {"spacing": float(problem.grid.nodes[1]), "band": a, "grading": a}
+        why = eligible(scene, problem, sink)
+        if why and not why.startswith("a uniform grid"):
+            return None
+    elif g.get("follow") or eligible(scene, problem, sink):
         return None
-    snap = sink.committed["approach"][-1]
+    # the deepest state: the approach branch's last (a resumed run reads it back from its
+    # fields, the same bits, where the other committed states are not in memory)
+    snap = (getattr(sink, "last", None) or {}).get("approach")
+    if scene.method != "green" or snap is None or snap.w is None or \
+            np.shape(snap.w) != (problem.grid.n,):
+        return None
+    snaps = [snap]
     spacings = locked_spacings(problem, contact_edge(problem, snap), g.get("band"), ratio)
     if spacings is None:
         return None
@@ -499,8 +517,7 @@ def deepest_locked(scene, problem, sink, ratio, variant):
         member = variant(scene, grid={**g, "spacing": h})
         try:
             m = _Member(member, problem, member, build_problem(member))
-            st = m.state("approach", sink.committed["approach"],
-                         len(sink.committed["approach"]) - 1)
+            st = m.state("approach", snaps, 0)
         except (_NotReduced, FemadhError, ValueError):
             return None
         f_lj, _, f_ex = state_forces(m.problem, st)
