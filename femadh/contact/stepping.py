@@ -115,7 +115,7 @@ class Sweep:
     d_current: float = math.nan     # separation of the solve under way (for error messages)
 
 
-def _accept(new, pred_w, d, problem=None, active=None):
+def _accept(new, pred_w, d, problem=None, active=None, released=False):
     """True if ``new`` converged to a stable state within MAX_CORRECTION_FRACTION of every
     predicted gap (else it may have left the branch).
 
@@ -133,7 +133,16 @@ def _accept(new, pred_w, d, problem=None, active=None):
     # gaps of the prediction; the sphere moves by d but b - w_pred is what was predicted
     h_pred = new.h + (new.w - pred_w)
     change = np.abs(new.w - pred_w)
-    return bool(np.all(change <= MAX_CORRECTION_FRACTION * np.maximum(h_pred, 0) + 1e-15))
+    ref = np.maximum(h_pred, 0)
+    if released and active is not None:
+        # a node of the predicted contact that the corrector released: measured against the
+        # gap it opened to (it was predicted on the floor, so any opening beyond a quarter
+        # of sigma turned a healthy step down: 8 of the 631-node retract's steps, each then
+        # halved into 3 solves for the same states); a snap off the contact opens its nodes
+        # to several sigma and stays turned down
+        out = active & ~new.active
+        ref[out] = np.maximum(ref[out], new.h[out])
+    return bool(np.all(change <= MAX_CORRECTION_FRACTION * ref + 1e-15))
 
 
 def _projected(problem, w, d, active):
@@ -220,6 +229,19 @@ MAX_INDICATOR_TRIALS = 12
 #: an indicator trial must have at least halved the bracket over the last two trials, else the
 #: next one bisects (the safeguard of a regula falsi that keeps landing on one side)
 MIN_SHRINK_PER_TWO = 0.5
+#: corrector iterations a trial step larger than the smallest may take (None: the scene's
+#: max_iter); the smallest step, which decides a fold, keeps the whole budget. A trial that
+#: has not converged by then lies across a fold or too far for the predictor, and is halved
+#: or bracketed as any unconverged trial: on the Fig 4 scene's 631-node retract the trials
+#: that converged took at most 14 iterations, while two trial steps across the pull-off ran
+#: to the budget of 40 as the contact unzipped node by node in the corrector (the stagnation
+#: exit counts a steadily moving edge as progress), 0.2 s each (517 -> 461 iterations over
+#: that retract). At 20 the coarse Fig 4 disk of 100 nodes bracketed trials that would have
+#: converged in 21-25 iterations (its pull-off's fold solves 24 -> 49); at 25, 23
+TRIAL_MAX_ITER = 30
+#: a healthy step's released contact nodes are measured against the gap they opened to
+#: (:func:`_accept`); never a fold's trial or decision
+RELEASED_ACCEPT = True
 #: the acceptance measures the prediction with its contact nodes on the floor (:func:`_accept`)
 PROJECTED_ACCEPT = True
 #: the contact set of a step outside a fold's bracket extrapolated from the last two states
@@ -354,12 +376,12 @@ def _predict(problem, state, d, t=None, prev=None):
 
     With ``prev`` (the accepted state before ``state`` on the same piece of the branch; the
     caller passes it only for a step outside a fold's bracket, never for a decision solve)
-    the contact set is the disk whose edge is extrapolated from the two states
+    a growing contact's set is the disk whose edge is extrapolated from the two states
     (:func:`edge_set`), and the prediction's nodes in it are put on the floor: the edge
-    moves by 5-23 nodes per grid step on the Fig 4 scene's 631-node member, which a tangent
-    with a frozen set cannot see, and the corrector spent 2-4 iterations finding the set
-    (measured there with the set known in advance: 186 -> 157 iterations over the approach's
-    grid steps, 277 -> 222 over the retract's)."""
+    advances by 5-23 nodes per grid step on the Fig 4 scene's 631-node member, which a
+    tangent with a frozen set cannot see, and the corrector spent 2-4 iterations finding
+    the set (measured there: 186 -> 112 iterations over the approach's grid steps, with the
+    acceptance of :func:`_accept`)."""
     if t is None and state.lu is not None:
         t = tangent(problem, state)
     if t is not None:
@@ -373,40 +395,39 @@ def _predict(problem, state, d, t=None, prev=None):
     act = edge_set(state, prev, d) if prev is not None else None
     if act is None:
         return w, grown
-    m_new, m_old = int(act.sum()), int(state.active.sum())
-    s = m_old - m_new
-    if s > 0:
-        # a shrinking contact: the edge zone's profile moves inward with the edge by s nodes
-        # (the cohesive zone keeps its width), so the ring the contact releases and as many
-        # nodes beyond it take the tangent's gaps of the nodes s further out; the tangent
-        # of the frozen set keeps them on the floor, and a released node that opened by more
-        # than a quarter of sigma turned the step down (Fig 4's 631-node retract: 213 -> 173
-        # iterations over its grid steps, 6 -> 1 steps turned down, the one across the fold)
-        i = np.arange(m_new, min(m_old + s, w.size - s))
-        w[i] = b[i] - np.maximum(b[i + s] - w[i + s], problem.sigma)
     w[act] = b[act] - problem.sigma
     return w, act
 
 
 def edge_set(state, prev, d):
     """The contact disk at separation d (m) with its edge extrapolated linearly in d from two
-    accepted disk-shaped states ``prev`` and ``state`` of one branch piece, as a mask; None
-    where either is not a disk, either has no contact, or their separations coincide (no
-    rate), and where the edge moved by fewer than EDGE_MIN_NODES nodes between them (a coarse
-grid, whose edge moves node by node: there the rounded extrapolation put a node into the set
-that the corrector then opened by more than a quarter of sigma, and the step was turned down,
-on the Fig 4 disk at 100 nodes 10 of 38 steps). The edge node count m(d) = m_s + (m_s - m_p) (d - d_s) / (d_s - d_p), rounded, at
-    least 1 and at most every node; extrapolation only (d beyond state.d as seen from prev)."""
+    accepted disk-shaped states ``prev`` and ``state`` of one branch piece, as a mask: the
+    edge node count m(d) = m_s + (m_s - m_p) min(x, EDGE_MAX_RATIO), x = (d - d_s) /
+    (d_s - d_p) > 0, rounded, at most every node.
+
+    None where either state is not a disk or has no contact, their separations coincide,
+    the contact did not grow by at least EDGE_MIN_NODES nodes between them, or d does not
+    lie beyond ``state`` as seen from ``prev``. A coarse grid's edge moves node by node:
+    there the rounded extrapolation put a node into the set that the corrector then opened
+    by more than a quarter of sigma, and the step was turned down (the Fig 4 disk at 100
+    nodes: 10 of 38 steps). A shrinking contact keeps the last state's set: near the
+    pull-off a contact is stable with and without the node at its edge over a range of d (it
+    unzips node by node), and the state the sweep follows keeps its nodes until they must
+    go - the corrector's own release from the last set. Released in advance by the
+    extrapolated edge (with the edge zone's profile shifted inward: 213 -> 173 corrector
+    iterations over the 631-node retract's grid steps), the sweep reached the pull-off one
+    resolution step earlier on a 60-nm member of the Fig 4 family
+    (tests/test_estimate_members.py): another state of the branch."""
     if prev is None or state.d == prev.d or state.active.shape != prev.active.shape:
         return None
     m_s, m_p = disk_size(state.active), disk_size(prev.active)
-    if not m_s or not m_p or abs(m_s - m_p) < EDGE_MIN_NODES:
+    if not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:
         return None
     x = (d - state.d) / (state.d - prev.d)
     if not x > 0:
         return None
     n = state.active.size
-    m = int(min(n, max(1, round(m_s + (m_s - m_p) * min(x, EDGE_MAX_RATIO)))))
+    m = int(min(n, round(m_s + (m_s - m_p) * min(x, EDGE_MAX_RATIO))))
     out = np.zeros(n, bool)
     out[:m] = True
     return out
@@ -542,15 +563,17 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             # keep the set of the last state (the fold must not hang on the predictor), and
             # a lattice-trapped grid keeps the path it always took
             edge = EDGE_PREDICTOR and not halving and fold.far is None and not smallest \
-                and prev_state is not None and not edge_off
+                and not edge_off and edge_set(state, prev_state, d_try) is not None
             w_pred, act = _predict(problem, state, d_try, t_state,
                                    prev_state if edge else None)
             if fold.far is not None and fold.located(state):
                 new = None          # decided already: straight to the landing
             else:
                 stall = None if smallest or trapped else STALL_ITER
+                budget = max_iter if smallest or trapped or TRIAL_MAX_ITER is None \
+                    else min(max_iter, TRIAL_MAX_ITER)
                 new = solve_complementarity(problem, d_try, w_pred, tol=tol,
-                                            max_iter=max_iter, active0=act, factor=state.lu,
+                                            max_iter=budget, active0=act, factor=state.lu,
                                             stall_iter=stall, stats=sweep.work)
                 sweep.n_solves += 1
                 if edge and not _accept(new, w_pred, d_try, problem, act):
@@ -566,7 +589,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 if fold.far is not None:
                     sweep.work["fold_solves"] = sweep.work.get("fold_solves", 0) + 1
             accepted, why = False, None
-            if new is not None and _accept(new, w_pred, d_try, problem, act):
+            healthy = RELEASED_ACCEPT and not halving and fold.far is None and not smallest
+            if new is not None and _accept(new, w_pred, d_try, problem, act, healthy):
                 g_new = total_force(problem, new)
                 share = FOLD_ENERGY_SHARE_MIN_STEP if smallest else FOLD_ENERGY_SHARE
                 accepted = not crossed_fold(problem, state, new, g_state, g_new, share)
