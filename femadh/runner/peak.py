@@ -47,6 +47,14 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
     return st
 
 
+#: the bounded search's tolerance in d as a fraction of the grid bracket (the half-width of
+#: its final bracket, the d resolution part of d_at_max_adhesion's estimate). Near the peak
+#: F_ex(d) is flat to second order: a resolution of 1e-3 of a 0.4-nm bracket (0.4 pm) moves F
+#: by ~F'' (0.4 pm)^2 / 2, below 1e-9 of it on the Fig 3 and Fig 4 scenes, and d by far less
+#: than its grid part (~1e-11 m); 1e-4 took ~5 more fresh states per search
+PEAK_XTOL_FRACTION = 1e-3
+
+
 def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
     """The largest F_ex of the curve between the grid states around its best grid state
     ``best``: a bounded search in d on fresh states, each solved from the displacements
@@ -61,7 +69,7 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
 
     f_best = best.f_ex if hasattr(best, "f_ex") else state_forces(problem, best)[2]
     lo, hi = sorted((prev.d, nxt.d))
-    xatol = 1e-4 * (hi - lo)
+    xatol = PEAK_XTOL_FRACTION * (hi - lo)
     if within is not None:
         lo, hi = max(lo, within[0]), min(hi, within[1])
     found, fresh = {}, []
