@@ -1,8 +1,12 @@
 """Continuation in the separation d: approach and retract branches, fold detection and jumps.
 
 Each grid step is taken with a predictor (the tangent dw/dd of the last state, its active set
-frozen; computed once per state) and the semismooth Newton corrector. A step is accepted only
-if the corrector converges to a *stable* state close to the prediction. A step turned down
+frozen; computed once per state; on a healthy step of a growing contact the set is the disk
+whose edge is extrapolated from the last two states, :func:`edge_set`) and the semismooth
+Newton corrector. A step is accepted only if the corrector converges to a *stable* state
+close to the prediction - measured from where the corrector starts, the predicted contact on
+the floor (:func:`_accept`). A trial step larger than the smallest gets TRIAL_MAX_ITER
+corrector iterations. A step turned down
 because its stable state lies farther from the prediction than the corrector may go, with no
 energy lost beyond one branch's bound (most likely the same branch: the predictor's reach), is
 halved. Any other turned-down step
