@@ -834,8 +834,8 @@ DEFECTS = [
         "m = int(min(n, round(m_s + (m_s - m_p) * max(x, EDGE_MAX_RATIO))))"),)),
     D("predictor_edge_shrinks", "edge predictor: a shrinking contact released in advance",
       "femadh/contact/stepping.py",
-      (("if not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:",
-        "if not m_s or not m_p or abs(m_s - m_p) < EDGE_MIN_NODES:"),)),
+      (("if state.d == d_p or not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:",
+        "if state.d == d_p or not m_s or not m_p or abs(m_s - m_p) < EDGE_MIN_NODES:"),)),
     D("accept_projection_above_floor", "acceptance: the predicted contact projected to "
       "h = 2 sigma instead of the floor", "femadh/contact/stepping.py",
       (("    out[active] = problem.contour(d)[active] - problem.sigma",

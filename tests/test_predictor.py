@@ -61,24 +61,26 @@ def _disk(n, m):
 def test_the_edge_is_extrapolated_from_two_growing_disks():
     """m(d) = m_s + (m_s - m_p) min(x, EDGE_MAX_RATIO), x = (d - d_s)/(d_s - d_p): exact for
     an edge advancing by whole nodes at a steady rate; nothing where the contact shrinks,
-    moves by less than EDGE_MIN_NODES, is not a disk, or d is not beyond the last state."""
+    moves by less than EDGE_MIN_NODES, is not a disk, d is not beyond the last state, or the
+    state has no second point (the first of a branch piece)."""
     n = 50
 
-    def st(d, m):
-        return SimpleNamespace(d=d, active=_disk(n, m))
-    prev, state = st(1.0e-9, 10), st(0.8e-9, 14)
-    assert stepping.edge_set(state, prev, 0.6e-9).sum() == 18
-    assert stepping.edge_set(state, prev, 0.7e-9).sum() == 16
-    assert np.array_equal(stepping.edge_set(state, prev, 0.6e-9), _disk(n, 18))
+    def st(d, m, prev=(1.0e-9, 10)):
+        return SimpleNamespace(d=d, active=_disk(n, m), edge_from=prev)
+    state = st(0.8e-9, 14)
+    assert stepping.edge_set(state, 0.6e-9).sum() == 18
+    assert stepping.edge_set(state, 0.7e-9).sum() == 16
+    assert np.array_equal(stepping.edge_set(state, 0.6e-9), _disk(n, 18))
     # a longer reach is capped at the distance between the two states
-    assert stepping.edge_set(state, prev, 0.2e-9).sum() == 14 + 4 * stepping.EDGE_MAX_RATIO
-    assert stepping.edge_set(st(0.8e-9, 10), st(1.0e-9, 14), 0.6e-9) is None   # shrinking
-    assert stepping.edge_set(st(0.8e-9, 11), st(1.0e-9, 10), 0.6e-9) is None   # one node
-    assert stepping.edge_set(state, prev, 0.9e-9) is None                      # not beyond
+    assert stepping.edge_set(state, 0.2e-9).sum() == 14 + 4 * stepping.EDGE_MAX_RATIO
+    assert stepping.edge_set(st(0.8e-9, 10, (1.0e-9, 14)), 0.6e-9) is None   # shrinking
+    assert stepping.edge_set(st(0.8e-9, 11), 0.6e-9) is None                 # one node
+    assert stepping.edge_set(state, 0.9e-9) is None                          # not beyond
+    assert stepping.edge_set(st(0.8e-9, 14, None), 0.6e-9) is None          # no second
     ring = st(0.8e-9, 14)
     ring.active[0] = False
-    assert stepping.edge_set(ring, prev, 0.6e-9) is None                       # no disk
-    assert stepping.edge_set(st(0.8e-9, 48), prev, 0.6e-9).sum() == n          # all nodes
+    assert stepping.edge_set(ring, 0.6e-9) is None                           # no disk
+    assert stepping.edge_set(st(0.8e-9, 48), 0.6e-9).sum() == n              # all nodes
 
 
 def test_the_acceptance_measures_from_the_projected_start():

@@ -369,7 +369,7 @@ def _tangent(problem, state, sweep):
     return tangent(problem, state)
 
 
-def _predict(problem, state, d, t=None, prev=None):
+def _predict(problem, state, d, t=None, edge=False):
     """Predicted displacements at d (tangent of the last state) and the active set they imply.
 
     (A release of the contact ring predicted from the tangent of the contact pressure,
@@ -378,9 +378,8 @@ def _predict(problem, state, d, t=None, prev=None):
     state the gap-only prediction finds, and moved the fold by one resolution step; the
     fold's decision must not depend on the predictor, so the set only grows here.)
 
-    With ``prev`` (the accepted state before ``state`` on the same piece of the branch; the
-    caller passes it only for a step outside a fold's bracket, never for a decision solve)
-    a growing contact's set is the disk whose edge is extrapolated from the two states
+    With ``edge`` (the caller asks for it only on a step outside a fold's bracket, never for
+    a decision solve) a growing contact's set is the disk whose edge is extrapolated from the two states
     (:func:`edge_set`), and the prediction's nodes in it are put on the floor: the edge
     advances by 5-23 nodes per grid step on the Fig 4 scene's 631-node member, which a
     tangent with a frozen set cannot see, and the corrector spent 2-4 iterations finding
@@ -396,16 +395,18 @@ def _predict(problem, state, d, t=None, prev=None):
         return w, state.active
     b = problem.contour(d)
     grown = state.active | (b - w < problem.sigma)
-    act = edge_set(state, prev, d) if prev is not None else None
+    act = edge_set(state, d) if edge else None
     if act is None:
         return w, grown
     w[act] = b[act] - problem.sigma
     return w, act
 
 
-def edge_set(state, prev, d):
+def edge_set(state, d):
     """The contact disk at separation d (m) with its edge extrapolated linearly in d from two
-    accepted disk-shaped states ``prev`` and ``state`` of one branch piece, as a mask: the
+    accepted disk-shaped states of one branch piece - ``state`` and the one before it,
+    ``state.edge_from`` = (d_p, m_p), kept on the state (and in a checkpoint: a resumed sweep
+    predicts as the uninterrupted one) - as a mask: the
     edge node count m(d) = m_s + (m_s - m_p) min(x, EDGE_MAX_RATIO), x = (d - d_s) /
     (d_s - d_p) > 0, rounded, at most every node.
 
@@ -422,12 +423,13 @@ def edge_set(state, prev, d):
     iterations over the 631-node retract's grid steps), the sweep reached the pull-off one
     resolution step earlier on a 60-nm member of the Fig 4 family
     (tests/test_estimate_members.py): another state of the branch."""
-    if prev is None or state.d == prev.d or state.active.shape != prev.active.shape:
+    if getattr(state, "edge_from", None) is None:
         return None
-    m_s, m_p = disk_size(state.active), disk_size(prev.active)
-    if not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:
+    d_p, m_p = state.edge_from
+    m_s = disk_size(state.active)
+    if state.d == d_p or not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:
         return None
-    x = (d - state.d) / (state.d - prev.d)
+    x = (d - state.d) / (state.d - d_p)
     if not x > 0:
         return None
     n = state.active.size
@@ -507,9 +509,6 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
     t_state = _tangent(problem, state, sweep)
-    # the accepted state before ``state`` on this piece of the branch (None after a landing):
-    # the edge predictor's second point
-    prev_state = None
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -521,7 +520,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         # the plain halving (no bracket): on a lattice-trapped grid, and as the fallback of a
         # grid step whose bracketed fold's landing did not polish (restarted from its start)
         halving = trapped or not BRACKETED
-        start_here = (state, g_state, t_state, prev_state)
+        start_here = (state, g_state, t_state)
         edge_off = False    # an edge-predicted step of this grid step was turned down
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
@@ -567,9 +566,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             # keep the set of the last state (the fold must not hang on the predictor), and
             # a lattice-trapped grid keeps the path it always took
             edge = EDGE_PREDICTOR and not halving and fold.far is None and not smallest \
-                and not edge_off and edge_set(state, prev_state, d_try) is not None
+                and not edge_off and edge_set(state, d_try) is not None
             w_pred, act = _predict(problem, state, d_try, t_state,
-                                   prev_state if edge else None)
+                                   edge)
             if fold.far is not None and fold.located(state):
                 new = None          # decided already: straight to the landing
             else:
@@ -617,7 +616,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 sweep.work[why] = sweep.work.get(why, 0) + 1
             if accepted:
                 last = abs(step if halving else d_try - state.d)
-                prev_state, state, g_state = state, new, g_new
+                # the edge predictor's second point (None after a landing: a new piece)
+                new.edge_from = (state.d, disk_size(state.active))
+                state, g_state = new, g_new
                 t_state = _tangent(problem, state, sweep)
                 fold.see(state, t_state, problem)
                 step = math.copysign(min(2 * last, abs(grid_step)), grid_step)
@@ -661,7 +662,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # step was passed on yet: no jump, no state)
                 sweep.work["fold_fallbacks"] = sweep.work.get("fold_fallbacks", 0) + 1
                 halving, beyond = True, None
-                state, g_state, t_state, prev_state = start_here
+                state, g_state, t_state = start_here
                 fold.restart(state, t_state, problem)
                 step = grid_step
                 continue
@@ -672,7 +673,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 step = math.copysign(min_step, grid_step)
             if lattice_snap(problem, state, landed, g_state, g_landed):
                 sweep.work["lattice_snaps"] = sweep.work.get("lattice_snaps", 0) + 1
-                state, g_state, beyond, prev_state = landed, g_landed, None, None
+                state, g_state, beyond = landed, g_landed, None
                 t_state = _tangent(problem, state, sweep)
                 fold.restart(state, t_state, problem)
                 continue
@@ -687,7 +688,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # fold after fold at the smallest step: not a physical snap but a branch the
                 # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
                 solves_here = MAX_SOLVES_PER_STEP * (1 + jumps_here)
-            state, g_state, prev_state = landed, g_landed, None
+            state, g_state = landed, g_landed
             t_state = _tangent(problem, state, sweep)
             fold.restart(state, t_state, problem)
         sweep.states.append(state)
