@@ -844,8 +844,8 @@ DEFECTS = [
       "femadh/contact/complementarity.py", (("GMRES_RTOL = 1e-6", "GMRES_RTOL = 1e-1"),)),
     D("newton_cholesky_transpose", "trailing Cholesky: U^-1 U^-1 for U^-1 U^-T",
       "femadh/contact/linalg.py",
-      (("return self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ rhs)",
-        "return self.uinv[-k:, -k:] @ (self.uinv[-k:, -k:] @ rhs)"),)),
+      (("return np.asarray(self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ r), dtype=float)",
+        "return np.asarray(self.uinv[-k:, -k:] @ (self.uinv[-k:, -k:] @ r), dtype=float)"),)),
     D("newton_givens_rotation", "GMRES: the earlier Givens rotations applied transposed",
       "femadh/contact/linalg.py",
       (("col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c",
@@ -857,6 +857,38 @@ DEFECTS = [
       "stagnation exit", "femadh/contact/stepping.py",
       (("stall = None if smallest or trapped else STALL_ITER",
         "stall = None if trapped else STALL_ITER"),)),
+    # -- the predictor, the acceptance, the peak's warm starts, the member's fold walk
+    D("predictor_edge_sign", "edge predictor: the contact edge extrapolated backwards",
+      "femadh/contact/stepping.py",
+      (("m = int(min(n, round(m_s + (m_s - m_p) * min(x, EDGE_MAX_RATIO))))",
+        "m = int(min(n, round(m_s - (m_s - m_p) * min(x, EDGE_MAX_RATIO))))"),)),
+    D("predictor_edge_uncapped", "edge predictor: reach not capped at the states' distance",
+      "femadh/contact/stepping.py",
+      (("m = int(min(n, round(m_s + (m_s - m_p) * min(x, EDGE_MAX_RATIO))))",
+        "m = int(min(n, round(m_s + (m_s - m_p) * max(x, EDGE_MAX_RATIO))))"),)),
+    D("predictor_edge_shrinks", "edge predictor: a shrinking contact released in advance",
+      "femadh/contact/stepping.py",
+      (("if state.d == d_p or not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:",
+        "if state.d == d_p or not m_s or not m_p or abs(m_s - m_p) < EDGE_MIN_NODES:"),)),
+    D("accept_projection_above_floor", "acceptance: the predicted contact projected to "
+      "h = 2 sigma instead of the floor", "femadh/contact/stepping.py",
+      (("    out[active] = problem.contour(d)[active] - problem.sigma",
+        "    out[active] = problem.contour(d)[active] - 2 * problem.sigma"),)),
+    D("accept_released_everywhere", "acceptance: every free node measured against the gap it "
+      "reached, not only the released contact", "femadh/contact/stepping.py",
+      (("        out = active & ~new.active", "        out = ~new.active"),)),
+    D("peak_warm_slope_sign", "peak search: the warm start extrapolated the wrong way",
+      "femadh/runner/peak.py",
+      (("        w_start = near.w + slope * (d - near.d)",
+        "        w_start = near.w - slope * (d - near.d)"),)),
+    D("peak_warm_other_branch", "peak search: warm start from a fresh state outside the "
+      "bracketing grid states", "femadh/runner/peak.py",
+      (("    inside = sorted((s for s in fresh if lo <= s.d <= hi), key=lambda s: abs(s.d - d))",
+        "    inside = sorted(fresh, key=lambda s: abs(s.d - d))"),)),
+    D("members_walk_sign", "member fold walk: the step toward the fine run's fold taken "
+      "away from it", "femadh/runner/members.py",
+      (("step = min(2 * step, -j) if j < 0 else 1 if j == 0 else 2 * step",
+        "step = min(2 * step, j) if j < 0 else 1 if j == 0 else 2 * step"),)),
     D("newton_stall_on_trapped_grid", "stepping: the stagnation exit also where nodes snap "
       "on their own (a lattice-trapped grid)", "femadh/contact/stepping.py",
       (("trapped = problem.surface_force_stiffness()[0] >= 1.0", "trapped = False"),)),
@@ -937,7 +969,7 @@ DEFECTS = [
         "                                      (n - 1) * h)\n"),)),
     D("fold_predictor_brackets", "fold search: a step turned down for the predictor's reach "
       "brackets a fold", "femadh/contact/stepping.py",
-      (('if why == "rejected_predictor" and k > 1:', "if False:"),)),
+      (('if (why == "rejected_predictor" or edge) and k > 1:', "if False:"),)),
     D("fold_no_halving_fallback", "fold search: a landing that does not polish is an error, "
       "no halving fallback", "femadh/contact/stepping.py",
       (("if not (landed.converged and landed.stable) and not halving and jumps_here == 0:",

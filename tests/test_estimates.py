@@ -212,10 +212,13 @@ def test_tolerance_part_is_what_the_tolerance_moves_on_the_disk(wide_disk):
 
 def test_resolution_part_is_the_peak_searchs_bracket(wide_disk):
     """The peak is searched between the grid states either side of the best one (two sweep
-    steps, 0.4 nm) to 1e-4 of that bracket: its resolution part is 4e-14 m."""
+    steps, 0.4 nm) to PEAK_XTOL_FRACTION (1e-4) of that bracket: its resolution part is
+    4e-14 m."""
     res, _ = wide_disk
+    from femadh.runner.peak import PEAK_XTOL_FRACTION
+
     assert res.estimates["d_at_max_adhesion_m"]["resolution"] == pytest.approx(
-        1e-4 * 2 * 0.2e-9, rel=1e-6, abs=0)
+        PEAK_XTOL_FRACTION * 2 * 0.2e-9, rel=1e-6, abs=0)
 
 
 def test_total_is_the_sum_of_the_parts_magnitudes(wide_disk):

@@ -103,15 +103,22 @@ def test_condensed_solution_satisfies_full_fe_system(fe_fig3):
     r = op.K_full[free] @ u - f[free]
     # direct sparse solve: residual at round-off of ||K|| ||u|| (measured 2.9e-13)
     assert np.max(np.abs(r)) <= 3e-12 * np.max(np.abs(f))
-    # the surface of the reconstructed field is the condensed w (measured 6e-15 of max |w|) ...
+    # the surface of the reconstructed field is the condensed w: C p_total to round-off
+    # (measured 6e-15 of max |w|), and the state's w is C p_total to its Newton residual
+    # (<= TOL; measured 3.8e-22 m here, 1e-4 of TOL, with the stepping predictor of the
+    # branch fig4fast, whose last Newton step ends elsewhere below TOL than before) ...
     w_u = u[op.basis.nodal_dofs[1, op.surface_vertices]]
-    assert np.max(np.abs(w_u - s.w)) <= 5e-14 * np.max(np.abs(s.w))
+    assert np.max(np.abs(w_u - s.w)) <= s.residual + 5e-14 * np.max(np.abs(s.w))
+    assert s.residual <= TOL
     # ... and the traction it implies is the one applied: LJ at the gap of that surface
     h_u = p_fe.contour(s.d) - w_u
     inactive = ~s.active
     p_lj = p_fe.effects["lj"].pressure(h_u)
-    # measured 7e-14 relative
-    assert np.max(np.abs(p_lj[inactive] / s.p_effects["lj"][inactive] - 1)) <= 1e-12
+    # measured 7e-14 relative, beyond what the gaps' difference (the state's residual, above)
+    # moves the law: 1.05e-12 at the steepest free node with the residual of 3.8e-22 m
+    slack = np.abs(p_fe.effects["lj"].dpressure(h_u)) * np.max(np.abs(w_u - s.w))
+    assert np.all(np.abs(p_lj - s.p_effects["lj"])[inactive] <=
+                  slack[inactive] + 1e-12 * np.abs(s.p_effects["lj"][inactive]))
 
 
 def test_fe_matches_green_and_converges_under_refinement():
@@ -161,7 +168,9 @@ def test_vtk_output_opens_in_pyvista(tmp_path):
     assert np.array_equal(surf["w"], w)
     # displacement at the surface vertex on the axis equals the state's w(0)
     i0 = int(np.argmin(np.hypot(vol.points[:, 0], vol.points[:, 1])))
-    assert vol["displacement"][i0, 1] == pytest.approx(w[0], rel=1e-12, abs=0)  # float64 copy
+    # (the volume field is the FE solve of the state's pressure: its surface is the state's
+    # w to the Newton residual, at most the scene's tolerance 1e-19 m; measured 6.4e-21 m)
+    assert vol["displacement"][i0, 1] == pytest.approx(w[0], rel=0, abs=sc.tolerance)
     assert "timestep" in (tmp_path / "approach.pvd").read_text()
 
 

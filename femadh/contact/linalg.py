@@ -63,6 +63,14 @@ def disk_size(A):
     return m if A[:m].all() else None
 
 
+#: precision of :class:`TrailingCholesky`'s kept inverse factor: single halves the memory the
+#: two products of each preconditioner solve read (the solve is bound by memory: 187 -> 69 us
+#: at 450 of 631 nodes, one thread), and a preconditioner of GMRES with its directions kept
+#: (``x = Z y``, the residual of the exact product) needs no more than its ~7 digits: the
+#: Krylov steps still reach GMRES_RTOL = 1e-6 of the exact Jacobian
+PRECONDITIONER_DTYPE = np.float32
+
+
 class TrailingCholesky:
     """One Cholesky factorisation that preconditions every trailing block from m >= m0.
 
@@ -73,7 +81,8 @@ class TrailingCholesky:
     positive definite near a stable state; where it is not, ``k_valid`` is the largest leading
     block that is (LAPACK potrf's info), and blocks beyond it are not covered. The inverse of
     U is kept (the leading block of the inverse of a triangular matrix is the inverse of its
-    leading block), so a solve is two products with views of it: no copy per block.
+    leading block), so a solve is two products with views of it: no copy per block; it is
+    kept in PRECONDITIONER_DTYPE (single precision).
 
     It differs from the area-scaled collocation Jacobian diag(area)(K + D) by the
     antisymmetric part of S (measured 1.4 % of its norm on the Fig 4 scene's 285-node grid)
@@ -92,31 +101,69 @@ class TrailingCholesky:
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
         self.n, self.m0 = n, m0
         self.k_valid = n - m0 if info == 0 else int(info) - 1
-        k = self.k_valid
-        self.uinv = self.uinv_t = np.zeros((0, 0))
-        if k > 0:
-            ui, info = lapack.dtrtri(np.asfortranarray(u[:k, :k]), lower=False)
-            if info != 0:       # a zero pivot in U: nothing beyond it is covered
-                self.k_valid = 0
-            else:
-                # kept in natural node order (the reversed order's leading blocks are its
-                # trailing blocks), with the transpose as its own contiguous copy: both
-                # products of a solve run in BLAS on views (a reversed, negative-stride
-                # vector would take numpy off BLAS: 100 us instead of 20 at k = 225)
-                self.uinv = np.ascontiguousarray(ui[::-1, ::-1])
-                self.uinv_t = np.ascontiguousarray(self.uinv.T)
+        # the inverse is taken when a block is first asked for (:meth:`covers`): a factor
+        # that covers no block the corrector needs - the Hessian of an iterate off the
+        # stable branch, not positive definite at the contact edge, which near a fold is
+        # most of the refreshes (91 of 97 on the Fig 4 scene's 631-node sweep) - costs
+        # its Cholesky alone
+        self._u = u[:self.k_valid, :self.k_valid] if self.k_valid > 0 else None
+        self._uinv = self._uinv_t = None
+
+    def _invert(self):
+        """U^-1 in PRECONDITIONER_DTYPE, in natural node order, and its transpose; k_valid
+        drops to 0 where the inversion fails."""
+        from scipy.linalg import lapack
+
+        empty = np.zeros((0, 0), PRECONDITIONER_DTYPE)
+        self._uinv = self._uinv_t = empty
+        u, self._u = self._u, None
+        if u is None or self.k_valid <= 0:
+            return
+        # inverted (and kept) in PRECONDITIONER_DTYPE: the factor is computed in double
+        # (its positive definite size decides which blocks are covered), the inverse is
+        # only a preconditioner's
+        trtri = lapack.strtri if PRECONDITIONER_DTYPE == np.float32 else lapack.dtrtri
+        ui, info = trtri(np.asfortranarray(u, dtype=PRECONDITIONER_DTYPE), lower=False)
+        if info != 0 or not np.all(np.isfinite(np.diagonal(ui))):
+            # a zero pivot in U (or one beyond single precision): nothing is covered
+            self.k_valid = 0
+            return
+        # kept in natural node order (the reversed order's leading blocks are its
+        # trailing blocks), with the transpose as its own contiguous copy: both
+        # products of a solve run in BLAS on views (a reversed, negative-stride
+        # vector would take numpy off BLAS: 100 us instead of 20 at k = 225)
+        self._uinv = np.ascontiguousarray(ui[::-1, ::-1])
+        self._uinv_t = np.ascontiguousarray(self._uinv.T)
+
+    @property
+    def uinv(self):
+        """U^-1 in natural node order (lower triangular, PRECONDITIONER_DTYPE)."""
+        if self._uinv is None:
+            self._invert()
+        return self._uinv
+
+    @property
+    def uinv_t(self):
+        if self._uinv is None:
+            self._invert()
+        return self._uinv_t
 
     @classmethod
     def from_inverse(cls, uinv, n, m0, k_valid):
         """The preconditioner from its kept inverse factor (a checkpoint's arrays)."""
         out = cls.__new__(cls)
         out.n, out.m0, out.k_valid = n, m0, k_valid
-        out.uinv = np.ascontiguousarray(uinv)
-        out.uinv_t = np.ascontiguousarray(out.uinv.T)
+        out._u = None
+        out._uinv = np.ascontiguousarray(uinv, dtype=PRECONDITIONER_DTYPE)
+        out._uinv_t = np.ascontiguousarray(out._uinv.T)
         return out
 
     def covers(self, m):
-        return m >= self.m0 and self.n - m <= self.k_valid
+        if not (m >= self.m0 and self.n - m <= self.k_valid):
+            return False
+        if self._uinv is None:
+            self._invert()          # (may find a zero pivot: then nothing is covered)
+        return self.n - m <= self.k_valid
 
     def solve(self, m, rhs):
         """x with H[m:, m:] x = rhs (natural node order m..n-1): x = U^-1 U^-T rhs."""
@@ -126,7 +173,8 @@ class TrailingCholesky:
         if not self.covers(m):
             raise ValueError(f"trailing block from node {m} is not covered (m0 = {self.m0}, "
                              f"positive definite leading size {self.k_valid})")
-        return self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ rhs)
+        r = np.asarray(rhs, dtype=self.uinv.dtype)      # (a double vector would upcast U)
+        return np.asarray(self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ r), dtype=float)
 
 
 #: Krylov dimension of one preconditioned solve before it counts as failed

@@ -44,6 +44,10 @@ class State:
     converged: bool
     stable: bool
     lu: object = None  # factorisation of the reduced Jacobian (tangent predictor), transient
+    #: (d (m), contact nodes) of the accepted state before this one on its piece of the
+    #: branch (None: the first, or after a landing): the edge predictor's second point
+    #: (:func:`femadh.contact.stepping.edge_set`)
+    edge_from: tuple = None
     diagnostics: dict = field(default_factory=dict)
 
     @property

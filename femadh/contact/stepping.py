@@ -1,8 +1,12 @@
 """Continuation in the separation d: approach and retract branches, fold detection and jumps.
 
 Each grid step is taken with a predictor (the tangent dw/dd of the last state, its active set
-frozen; computed once per state) and the semismooth Newton corrector. A step is accepted only
-if the corrector converges to a *stable* state close to the prediction. A step turned down
+frozen; computed once per state; on a healthy step of a growing contact the set is the disk
+whose edge is extrapolated from the last two states, :func:`edge_set`) and the semismooth
+Newton corrector. A step is accepted only if the corrector converges to a *stable* state
+close to the prediction - measured from where the corrector starts, the predicted contact on
+the floor (:func:`_accept`). A trial step larger than the smallest gets TRIAL_MAX_ITER
+corrector iterations. A step turned down
 because its stable state lies farther from the prediction than the corrector may go, with no
 energy lost beyond one branch's bound (most likely the same branch: the predictor's reach), is
 halved. Any other turned-down step
@@ -44,6 +48,7 @@ import numpy as np
 
 from ..errors import ConvergenceError
 from .complementarity import STALL_ITER, solve_complementarity, tangent
+from .linalg import disk_size
 from .landing import land
 
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
@@ -114,13 +119,45 @@ class Sweep:
     d_current: float = math.nan     # separation of the solve under way (for error messages)
 
 
-def _accept(new, pred_w, d):
+def _accept(new, pred_w, d, problem=None, active=None, released=False):
+    """True if ``new`` converged to a stable state within MAX_CORRECTION_FRACTION of every
+    predicted gap (else it may have left the branch).
+
+    With ``problem`` and the predicted contact set ``active`` (PROJECTED_ACCEPT), the
+    prediction is measured where the corrector starts from: ``pred_w`` with the predicted
+    contact nodes put on the floor (w = b - sigma there, the corrector's first act). A node
+    the predictor put below sigma and that ends in contact has then moved by nothing; measured
+    without the projection it moved by its predicted overshoot (Fig 4's 631-node approach:
+    0.145 nm against a predicted gap of 0.355 nm at the edge, a ratio of 0.41), and healthy
+    steps of a growing contact were turned down and halved (7 of 65 solves of that approach,
+    each halving 3-4 solves for one grid step)."""
     if not (new.converged and new.stable):
         return False
+    pred_w = _projected(problem, pred_w, d, active)
     # gaps of the prediction; the sphere moves by d but b - w_pred is what was predicted
     h_pred = new.h + (new.w - pred_w)
     change = np.abs(new.w - pred_w)
-    return bool(np.all(change <= MAX_CORRECTION_FRACTION * np.maximum(h_pred, 0) + 1e-15))
+    ref = np.maximum(h_pred, 0)
+    if released and active is not None:
+        # a node of the predicted contact that the corrector released: measured against the
+        # gap it opened to (it was predicted on the floor, so any opening beyond a quarter
+        # of sigma turned a healthy step down: 8 of the 631-node retract's steps, each then
+        # halved into 3 solves for the same states); a snap off the contact opens its nodes
+        # to several sigma and stays turned down
+        out = active & ~new.active
+        ref[out] = np.maximum(ref[out], new.h[out])
+    return bool(np.all(change <= MAX_CORRECTION_FRACTION * ref + 1e-15))
+
+
+def _projected(problem, w, d, active):
+    """``w`` with the nodes of ``active`` on the floor h = sigma (the corrector's start), or
+    ``w`` itself without a gap constraint, a set or PROJECTED_ACCEPT."""
+    if not PROJECTED_ACCEPT or problem is None or active is None or problem.sigma is None \
+            or not np.any(active):
+        return w
+    out = np.array(w, dtype=float)
+    out[active] = problem.contour(d)[active] - problem.sigma
+    return out
 
 
 def total_force(problem, state):
@@ -196,6 +233,31 @@ MAX_INDICATOR_TRIALS = 12
 #: an indicator trial must have at least halved the bracket over the last two trials, else the
 #: next one bisects (the safeguard of a regula falsi that keeps landing on one side)
 MIN_SHRINK_PER_TWO = 0.5
+#: corrector iterations a trial step larger than the smallest may take (None: the scene's
+#: max_iter); the smallest step, which decides a fold, keeps the whole budget. A trial that
+#: has not converged by then lies across a fold or too far for the predictor, and is halved
+#: or bracketed as any unconverged trial: on the Fig 4 scene's 631-node retract the trials
+#: that converged took at most 14 iterations, while two trial steps across the pull-off ran
+#: to the budget of 40 as the contact unzipped node by node in the corrector (the stagnation
+#: exit counts a steadily moving edge as progress), 0.2 s each (517 -> 461 iterations over
+#: that retract). At 20 the coarse Fig 4 disk of 100 nodes bracketed trials that would have
+#: converged in 21-25 iterations (its pull-off's fold solves 24 -> 49); at 25, 23
+TRIAL_MAX_ITER = 30
+#: a healthy step's released contact nodes are measured against the gap they opened to
+#: (:func:`_accept`); never a fold's trial or decision
+RELEASED_ACCEPT = True
+#: the acceptance measures the prediction with its contact nodes on the floor (:func:`_accept`)
+PROJECTED_ACCEPT = True
+#: the contact set of a step outside a fold's bracket extrapolated from the last two states
+#: (:func:`edge_set`); False: the set of the last state, grown where the prediction is below
+#: sigma (the tests' reference)
+EDGE_PREDICTOR = True
+#: ... only where the edge moved by at least this many nodes between the two states
+EDGE_MIN_NODES = 2
+#: ... and no further than this many times the distance between the two states (after a
+#: landing or a halving the next step can be 2-4 x the last; the edge's m(d) is concave right
+#: after a jump-in, where a longer reach overshot)
+EDGE_MAX_RATIO = 1.0
 #: False: the plain halving everywhere (the path the bracketed search replaced; the tests'
 #: reference for where the folds are)
 BRACKETED = True
@@ -307,14 +369,22 @@ def _tangent(problem, state, sweep):
     return tangent(problem, state)
 
 
-def _predict(problem, state, d, t=None):
+def _predict(problem, state, d, t=None, edge=False):
     """Predicted displacements at d (tangent of the last state) and the active set they imply.
 
     (A release of the contact ring predicted from the tangent of the contact pressure,
     d lambda_A/dd = -(K t)_A, was measured: 6 % fewer corrector iterations on the Fig 4
     retract, but near the pull-off its decision solve at the smallest step missed a stable
     state the gap-only prediction finds, and moved the fold by one resolution step; the
-    fold's decision must not depend on the predictor, so the set only grows here.)"""
+    fold's decision must not depend on the predictor, so the set only grows here.)
+
+    With ``edge`` (the caller asks for it only on a step outside a fold's bracket, never for
+    a decision solve) a growing contact's set is the disk whose edge is extrapolated from the two states
+    (:func:`edge_set`), and the prediction's nodes in it are put on the floor: the edge
+    advances by 5-23 nodes per grid step on the Fig 4 scene's 631-node member, which a
+    tangent with a frozen set cannot see, and the corrector spent 2-4 iterations finding
+    the set (measured there: 186 -> 112 iterations over the approach's grid steps, with the
+    acceptance of :func:`_accept`)."""
     if t is None and state.lu is not None:
         t = tangent(problem, state)
     if t is not None:
@@ -323,7 +393,50 @@ def _predict(problem, state, d, t=None):
         w = state.w.copy()
     if problem.sigma is None:
         return w, state.active
-    return w, state.active | (problem.contour(d) - w < problem.sigma)
+    b = problem.contour(d)
+    grown = state.active | (b - w < problem.sigma)
+    act = edge_set(state, d) if edge else None
+    if act is None:
+        return w, grown
+    w[act] = b[act] - problem.sigma
+    return w, act
+
+
+def edge_set(state, d):
+    """The contact disk at separation d (m) with its edge extrapolated linearly in d from two
+    accepted disk-shaped states of one branch piece - ``state`` and the one before it,
+    ``state.edge_from`` = (d_p, m_p), kept on the state (and in a checkpoint: a resumed sweep
+    predicts as the uninterrupted one) - as a mask: the
+    edge node count m(d) = m_s + (m_s - m_p) min(x, EDGE_MAX_RATIO), x = (d - d_s) /
+    (d_s - d_p) > 0, rounded, at most every node.
+
+    None where either state is not a disk or has no contact, their separations coincide,
+    the contact did not grow by at least EDGE_MIN_NODES nodes between them, or d does not
+    lie beyond ``state`` as seen from ``prev``. A coarse grid's edge moves node by node:
+    there the rounded extrapolation put a node into the set that the corrector then opened
+    by more than a quarter of sigma, and the step was turned down (the Fig 4 disk at 100
+    nodes: 10 of 38 steps). A shrinking contact keeps the last state's set: near the
+    pull-off a contact is stable with and without the node at its edge over a range of d (it
+    unzips node by node), and the state the sweep follows keeps its nodes until they must
+    go - the corrector's own release from the last set. Released in advance by the
+    extrapolated edge (with the edge zone's profile shifted inward: 213 -> 173 corrector
+    iterations over the 631-node retract's grid steps), the sweep reached the pull-off one
+    resolution step earlier on a 60-nm member of the Fig 4 family
+    (tests/test_estimate_members.py): another state of the branch."""
+    if getattr(state, "edge_from", None) is None:
+        return None
+    d_p, m_p = state.edge_from
+    m_s = disk_size(state.active)
+    if state.d == d_p or not m_s or not m_p or m_s - m_p < EDGE_MIN_NODES:
+        return None
+    x = (d - state.d) / (state.d - d_p)
+    if not x > 0:
+        return None
+    n = state.active.size
+    m = int(min(n, round(m_s + (m_s - m_p) * min(x, EDGE_MAX_RATIO))))
+    out = np.zeros(n, bool)
+    out[:m] = True
+    return out
 
 
 def trace_steps(problem, d_values, *, branch, tol, start=None, max_iter=40, on_state=None,
@@ -408,6 +521,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         # grid step whose bracketed fold's landing did not polish (restarted from its start)
         halving = trapped or not BRACKETED
         start_here = (state, g_state, t_state)
+        edge_off = False    # an edge-predicted step of this grid step was turned down
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
             # edge) brings its own budget; a crawl is cut by crawl_run below
@@ -443,24 +557,43 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                     # corrector's distance from it, not for a fold)
                     d_try = state.d + step
             sweep.d_current = d_try
-            w_pred, act = _predict(problem, state, d_try, t_state)
             # the smallest step decides a fold: its corrector gets the whole budget; a larger
             # step that stagnates is only halved - unless a node softens beyond its own
             # stiffness (it snaps on its own: a slow corrector there is the lattice, and a
             # different path of halvings lands on other lattice states)
             smallest = abs(d_try - state.d) <= min_step * 1.5
+            # the extrapolated edge only on a healthy step: a fold's trials and its decision
+            # keep the set of the last state (the fold must not hang on the predictor), and
+            # a lattice-trapped grid keeps the path it always took
+            edge = EDGE_PREDICTOR and not halving and fold.far is None and not smallest \
+                and not edge_off and edge_set(state, d_try) is not None
+            w_pred, act = _predict(problem, state, d_try, t_state,
+                                   edge)
             if fold.far is not None and fold.located(state):
                 new = None          # decided already: straight to the landing
             else:
                 stall = None if smallest or trapped else STALL_ITER
+                budget = max_iter if smallest or trapped or TRIAL_MAX_ITER is None \
+                    else min(max_iter, TRIAL_MAX_ITER)
                 new = solve_complementarity(problem, d_try, w_pred, tol=tol,
-                                            max_iter=max_iter, active0=act, factor=state.lu,
+                                            max_iter=budget, active0=act, factor=state.lu,
                                             stall_iter=stall, stats=sweep.work)
                 sweep.n_solves += 1
+                if edge and not _accept(new, w_pred, d_try, problem, act):
+                    # the extrapolated edge did not lead to an acceptable state: the step is
+                    # halved (no fold's bracket opens on it) and the rest of this grid step
+                    # keeps the last state's own set, as without the edge predictor, so that
+                    # whether and where a fold is bracketed never hangs on it (retrying the
+                    # same step with the last state's set instead cost a second solve for
+                    # steps that set turns down as well: 18 of 91 on the Fig 4 disk at 100
+                    # nodes, whose coarse edge moves by a node or two)
+                    sweep.work["edge_rejected"] = sweep.work.get("edge_rejected", 0) + 1
+                    edge_off = True
                 if fold.far is not None:
                     sweep.work["fold_solves"] = sweep.work.get("fold_solves", 0) + 1
             accepted, why = False, None
-            if new is not None and _accept(new, w_pred, d_try):
+            healthy = RELEASED_ACCEPT and not halving and fold.far is None and not smallest
+            if new is not None and _accept(new, w_pred, d_try, problem, act, healthy):
                 g_new = total_force(problem, new)
                 share = FOLD_ENERGY_SHARE_MIN_STEP if smallest else FOLD_ENERGY_SHARE
                 accepted = not crossed_fold(problem, state, new, g_state, g_new, share)
@@ -483,6 +616,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 sweep.work[why] = sweep.work.get(why, 0) + 1
             if accepted:
                 last = abs(step if halving else d_try - state.d)
+                # the edge predictor's second point (None after a landing: a new piece)
+                new.edge_from = (state.d, disk_size(state.active))
                 state, g_state = new, g_new
                 t_state = _tangent(problem, state, sweep)
                 fold.see(state, t_state, problem)
@@ -501,7 +636,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                     continue
             else:
                 k = int(round(abs(d_try - state.d) / min_step))
-                if why == "rejected_predictor" and k > 1:
+                if (why == "rejected_predictor" or edge) and k > 1:
                     # half the distance, in whole resolution steps (the trials' lattice)
                     step = math.copysign(max(1, k // 2) * min_step, grid_step)
                     continue

@@ -53,6 +53,8 @@ def save_checkpoint(folder, sink):
             "r_c": np.array(st.r_c), "n_iter": np.array(st.n_iter),
             "residual": np.array(st.residual), "flags": np.array([st.converged, st.stable]),
             "effects": np.array(list(st.p_effects))}
+    if st.edge_from is not None:        # the edge predictor's second point (stepping)
+        data["edge_from"] = np.array(st.edge_from, dtype=float)
     data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
     lu = st.lu
     if lu is None:
@@ -101,9 +103,13 @@ def load_checkpoint(folder, k, d):
             else:
                 lu = None
             conv, stable = (bool(x) for x in z["flags"])
-            return State(float(z["d"]), z["w"], z["h"],
-                         {str(n): z[f"pe_{n}"] for n in z["effects"]}, z["p_contact"],
-                         z["active"], float(z["r_c"]), int(z["n_iter"]),
-                         float(z["residual"]), conv, stable, lu)
+            st = State(float(z["d"]), z["w"], z["h"],
+                       {str(n): z[f"pe_{n}"] for n in z["effects"]}, z["p_contact"],
+                       z["active"], float(z["r_c"]), int(z["n_iter"]),
+                       float(z["residual"]), conv, stable, lu)
+            if "edge_from" in z.files:
+                d_p, m_p = (float(x) for x in z["edge_from"])
+                st.edge_from = (d_p, int(m_p))
+            return st
     except (OSError, ValueError, KeyError):
         return None

@@ -49,6 +49,9 @@ PEAK_WINDOW = 0.125
 #: a member's fold is continued on the fine run's lattice from near the fine run's fold
 #: (False: the fine run's grid step that holds it is traced, halvings and all)
 LATTICE_FOLDS = True
+#: False: a member's lattice walk steps one lattice point at a time up to the fine run's fold
+#: and doubles only beyond it; True: doubles from its start (the walk as it was)
+DOUBLE_TO_FOLD = False
 #: corrector solves a member's fold search may take (a healthy one: 10-20)
 MAX_FOLD_SOLVES = 80
 
@@ -290,7 +293,15 @@ def _lattice_fold(m, d_fold, d_land, before, after):
             ok = not crossed_fold(p, state, new, g, g_new, FOLD_ENERGY_SHARE_MIN_STEP
                                   if step == 1 else FOLD_ENERGY_SHARE)
         if ok:
-            state, g, j, step = new, g_new, j + step, 2 * step
+            # doubling, but landing on the fine run's fold (j = 0) and trying the next
+            # lattice point from there first: the member's fold is most often the fine run's
+            # own lattice point, where a doubled trial past it only fails (a stalled solve
+            # before the decision at j = 1)
+            state, g, j = new, g_new, j + step
+            if DOUBLE_TO_FOLD:
+                step *= 2
+            else:
+                step = min(2 * step, -j) if j < 0 else 1 if j == 0 else 2 * step
             continue
         if step > 1:
             step //= 2
