@@ -24,6 +24,14 @@ RELAX_STEPS = 400
 #: first pseudo-time damping mu (relative to the diagonal of S) and its bounds; mu follows
 #: the residual (switched evolution relaxation: mu_k+1 = mu_k r_k / r_k-1)
 RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
+#: contact edges next to the descent's (nodes added or released at the edge of a disk-shaped
+#: contact set, in this order) from which the corrector polishes a landing that did not
+#: polish from the descent's own set. Measured on the sigma = 0.3 nm slider (507 nodes, 13
+#: nm band spacing), the fourth fold of its approach: the descent settled on 150 contact
+#: nodes, where the collocation form's root has vanished; from 151 Newton converged in 6
+#: iterations on a stable state (the relaxation drifted past that ghost for 400 steps, its
+#: residual ~1e-15 m)
+EDGE_SHIFTS = (1, -1, 2, -2)
 
 
 def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
@@ -141,12 +149,49 @@ def _relaxed(problem, d, st, descent, *, tol, max_iter):
     contact set) that ``st`` (a failed polish) started from, or ``st`` itself if the
     relaxation does not end on a converged, stable state."""
     w, active = descent
+    near = _next_edges(problem, d, w, active, tol=tol, max_iter=max_iter)
+    if near is not None:
+        near.n_iter += st.n_iter
+        return near
     wr, ar, n_relax = _relax(problem, d, w, active, tol=tol)
     if wr is None:
         return st
     out = solve_complementarity(problem, d, wr, tol=tol, max_iter=max_iter, active0=ar)
     out.n_iter += st.n_iter + n_relax
     return out if out.converged and out.stable else st
+
+
+def _next_edges(problem, d, w, active, *, tol, max_iter):
+    """The stable equilibrium of least total energy that the corrector reaches from the
+    descent's minimum w with its disk-shaped contact set moved by one or two nodes at its
+    edge (EDGE_SHIFTS), or None (no such state, or a contact set that is not a disk).
+
+    The energy descent and the corrector solve two forms of one discretisation (the
+    symmetric energy and the collocation equations, :func:`_relax`); at an edge node
+    softening about as fast as its own stiffness their contact edges can differ by a node,
+    and the collocation form's equilibrium on the descent's edge may not exist. The states
+    on the neighbouring edges are where it does; of those the corrector reaches, the landing
+    is the one of least energy (the descent's own merit)."""
+    from .linalg import disk_size
+
+    m = disk_size(active) if active is not None and active.any() else None
+    if m is None:
+        return None
+    b, n = problem.contour(d), w.size
+    best, e_best = None, np.inf
+    for k in EDGE_SHIFTS:
+        if not 0 < m + k < n:
+            continue
+        A = np.zeros(n, bool)
+        A[:m + k] = True
+        w0 = np.array(w, float)
+        w0[A] = b[A] - problem.sigma
+        st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter, active0=A)
+        if st.converged and st.stable:
+            e = problem.energy(st.w, d)
+            if e < e_best:
+                best, e_best = st, e
+    return best
 
 
 def _relax(problem, d, w, active, *, tol, max_steps=None):
