@@ -113,13 +113,24 @@ def test_the_landing_fails_without_the_fallbacks(slider, landed, monkeypatch):
 
 def test_a_neighbouring_edge_polishes(slider, landed):
     """From the descent's minimum, the corrector on the neighbouring contact edges reaches
-    a stable collocation equilibrium (measured: 71 nodes against the descent's 70)."""
+    a stable collocation equilibrium with the contact grown (the collocation form's edge
+    node has lost its root on the descent's set: measured 70 -> 72 nodes here, 150 -> 151
+    on the 13 nm member's fourth fold), the one of least energy among the shifts."""
     scene, p = slider
     d, _, (w, active) = landed[1][0]
     st = landing._next_edges(p, d, w, active, tol=scene.tolerance, max_iter=scene.max_iter)
     assert st is not None
     _check_landing(p, st, scene.tolerance)
-    assert 0 < abs(int(st.active.sum()) - int(active.sum())) <= 2
+    assert 0 < int(st.active.sum()) - int(active.sum()) <= 2
+    b = p.contour(d)
+    for k in landing.EDGE_SHIFTS:
+        A = np.zeros(w.size, bool)
+        A[:int(active.sum()) + k] = True
+        w0 = np.where(A, b - p.sigma, w)
+        other = solve_complementarity(p, d, w0, tol=scene.tolerance,
+                                      max_iter=scene.max_iter, active0=A)
+        if other.converged and other.stable:
+            assert p.energy(st.w, d) <= p.energy(other.w, d)
 
 
 def test_relax_reaches_a_collocation_equilibrium_from_the_descent(slider, landed):

@@ -25,12 +25,12 @@ RELAX_STEPS = 400
 #: the residual (switched evolution relaxation: mu_k+1 = mu_k r_k / r_k-1)
 RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
 #: contact edges next to the descent's (nodes added or released at the edge of a disk-shaped
-#: contact set, in this order) from which the corrector polishes a landing that did not
-#: polish from the descent's own set. Measured on the sigma = 0.3 nm slider (507 nodes, 13
-#: nm band spacing), the fourth fold of its approach: the descent settled on 150 contact
-#: nodes, where the collocation form's root has vanished; from 151 Newton converged in 6
-#: iterations on a stable state (the relaxation drifted past that ghost for 400 steps, its
-#: residual ~1e-15 m)
+#: contact set, in this order) from which the corrector polishes a landing that neither the
+#: descent's own set nor the relaxation polished. Measured on the sigma = 0.3 nm slider (507
+#: nodes, 13 nm band spacing), the fourth fold of its approach: the descent settled on 150
+#: contact nodes, where the collocation form's root has vanished; the relaxation drifted
+#: past that ghost for its 400 steps (residual ~1e-15 m); from 151 nodes Newton converged in
+#: 6 iterations on a stable state
 EDGE_SHIFTS = (1, -1, 2, -2)
 
 
@@ -145,20 +145,24 @@ def _land(problem, d, w_start, *, tol, max_iter, roundoff):
 
 
 def _relaxed(problem, d, st, descent, *, tol, max_iter):
-    """The landing polished by :func:`_relax` from the descent's minimum ``descent`` = (w,
-    contact set) that ``st`` (a failed polish) started from, or ``st`` itself if the
-    relaxation does not end on a converged, stable state."""
+    """The landing from the descent's minimum ``descent`` = (w, contact set) whose polish
+    ``st`` failed: the collocation equations relaxed in pseudo-time from it (:func:`_relax`:
+    the overdamped surface under the forces the corrector balances, so it lands where the
+    descent's surface would roll), else - a relaxation that drifts past a ghost beyond its
+    step cap - the corrector from the contact edges next to it (:func:`_next_edges`); ``st``
+    itself if neither ends on a converged, stable state."""
     w, active = descent
+    wr, ar, n_relax = _relax(problem, d, w, active, tol=tol)
+    if wr is not None:
+        out = solve_complementarity(problem, d, wr, tol=tol, max_iter=max_iter, active0=ar)
+        out.n_iter += st.n_iter + n_relax
+        if out.converged and out.stable:
+            return out
     near = _next_edges(problem, d, w, active, tol=tol, max_iter=max_iter)
     if near is not None:
-        near.n_iter += st.n_iter
+        near.n_iter += st.n_iter + n_relax
         return near
-    wr, ar, n_relax = _relax(problem, d, w, active, tol=tol)
-    if wr is None:
-        return st
-    out = solve_complementarity(problem, d, wr, tol=tol, max_iter=max_iter, active0=ar)
-    out.n_iter += st.n_iter + n_relax
-    return out if out.converged and out.stable else st
+    return st
 
 
 def _next_edges(problem, d, w, active, *, tol, max_iter):
