@@ -931,9 +931,9 @@ DEFECTS = [
       "inverse residual ratio", "femadh/contact/landing.py",
       (("mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r / r_prev))",
         "mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r_prev / r))"),)),
-    D("landing_edges_release_only", "landing: the neighbouring edges only release contact "
-      "nodes, never add them", "femadh/contact/landing.py",
-      (("EDGE_SHIFTS = (1, -1, 2, -2)", "EDGE_SHIFTS = (-1, -2)"),)),
+    D("landing_edges_most_energy", "landing: of the neighbouring edges' stable states the one "
+      "of most energy is kept", "femadh/contact/landing.py",
+      (("            if e < e_best:", "            if best is None or e > e_best:"),)),
     # -- the estimate's members solved where the headline numbers are read (estimate branch)
     D("mem_fold_lattice_step", "member fold search: each trial two lattice steps beyond the "
       "accepted ones (the fold off the fine run's lattice)", "femadh/runner/members.py",
