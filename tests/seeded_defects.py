@@ -983,6 +983,24 @@ DEFECTS = [
     D("landing_no_whole_descent", "landing: a polish that fails after the settled descent is "
       "final (no whole descent)", "femadh/contact/landing.py",
       (("if not trapped and not (st.converged and st.stable):", "if False:"),)),
+    D("landing_no_fallbacks", "landing: a polish that fails after both descents is final "
+      "(no neighbouring edges, no relaxation)", "femadh/contact/landing.py",
+      (("st = _relaxed(problem, d, st, descent, tol=tol, max_iter=max_iter)", "pass"),)),
+    D("landing_relax_sign", "landing relaxation: the pseudo-time step taken uphill",
+      "femadh/contact/landing.py",
+      (("        dw = -sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],",
+        "        dw = sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],"),)),
+    D("landing_relax_no_join", "landing relaxation: a free node reaching the floor never "
+      "joins the contact set", "femadh/contact/landing.py",
+      (("new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))",
+        "new_A = A & (pc + adhesion > 0)"),)),
+    D("landing_relax_ser_inverted", "landing relaxation: the pseudo-time damping follows the "
+      "inverse residual ratio", "femadh/contact/landing.py",
+      (("mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r / r_prev))",
+        "mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r_prev / r))"),)),
+    D("landing_edges_most_energy", "landing: of the neighbouring edges' stable states the one "
+      "of most energy is kept", "femadh/contact/landing.py",
+      (("            if e < e_best:", "            if best is None or e > e_best:"),)),
     # -- the estimate's members solved where the headline numbers are read (estimate branch)
     D("mem_fold_lattice_step", "member fold search: each trial two lattice steps beyond the "
       "accepted ones (the fold off the fine run's lattice)", "femadh/runner/members.py",

@@ -190,6 +190,9 @@ def test_a_landing_whose_polish_fails_after_the_settled_descent_runs_the_whole_d
             st.converged = False
         return st
     monkeypatch.setattr(landing, "solve_complementarity", first_fails)
+    # the last-resort fallbacks (relaxation, neighbouring edges) off: the whole descent alone
+    monkeypatch.setattr(landing, "RELAX_STEPS", 0)
+    monkeypatch.setattr(landing, "EDGE_SHIFTS", ())
     landed = landing.land(p, j.d_land, j.before.w, tol=TOL, max_iter=40)
     assert len(calls) == 3 and landed.converged and landed.stable
     assert np.max(np.abs(landed.w - j.after.w)) <= 3 * TOL
