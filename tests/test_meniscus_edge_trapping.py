@@ -49,10 +49,11 @@ def test_edge_softening_is_the_secant_of_the_step_from_the_floor():
 @pytest.mark.slow
 def test_low_humidity_meniscus_edge_converges_on_its_first_member():
     """The small-size failing case at accuracy 3e-2: the first member, planned from the
-    meniscus' cohesive zone, traces the retract with one fold (the pull-off) and meets the
-    request; its max adhesion against a member at half its spacing (measured 2e-3 off,
-    estimated 6e-3) is within the request. (Planned from LJ alone, the first member, 22 nm,
-    unzipped the retract in 7 folds and missed with an estimate of 4.7e-2.)"""
+    meniscus' cohesive zone (151 nodes, 13.5 nm), traces the retract with one fold (the
+    pull-off) and meets the request in one run; its max adhesion against a member at half
+    its spacing is within the request (measured 4.4e-3 off, estimated 1.1e-2: effectivity
+    2.5). Planned from LJ alone (22 nm, 92 nodes) the same member unzips the retract in 7
+    folds and 9 lattice snaps (the seeded defect step_edge_dropped fails here)."""
     scene = femadh.load_scene(SCENE).replace(SMALL)
     res = femadh.run(scene, None, figures=False, progress=False)
     assert res.status == "converged", res.error
