@@ -33,8 +33,8 @@ class SmoothStepLaw:
     def edge_softening(self, floor):
         """Secant softening (Pa/m) of the step from the floor gap across its edge:
         P(floor) / (h_c + 2w - floor), the pressure a surface at the floor loses per metre of
-        opening until it has passed the edge (S(-2) = 0.12); 0 for an edge at or below the
-        floor (a step the surfaces cannot reach).
+        opening until it has passed the edge (S(-2) = 0.12); 0 where h_c + 2w <= floor (a
+        step the surfaces cannot reach).
 
         Why: on a sigma-gap contact a step whose edge lies just above the floor is a
         Dugdale cohesive zone of stress P0 and opening h_c - floor at the contact edge,
