@@ -597,6 +597,21 @@ DEFECTS = [
       "femadh/discretisation/plan.py",
       (("return trapping_spacing(problem, TRAP_SAFE / MIN_MEMBER_RATIO**2)",
         "return trapping_spacing(problem, TRAP_SAFE / MIN_MEMBER_RATIO)"),)),
+    # -- a meniscus edge just above the sigma-gap floor: its cohesive zone in the plan
+    D("step_edge_dropped", "plan: a sub-grid step's edge softening left out of the trapping "
+      "ratio (the planned spacing from LJ alone)", "femadh/discretisation/plan.py",
+      (("soft = max(soft, law.edge_softening(floor)",
+        "soft = max(soft, 0.0 * law.edge_softening(floor)"),)),
+    D("step_edge_reach", "step edge softening: the secant over h_c + 2w, not from the floor",
+      "femadh/laws/step.py",
+      (("reach = self._center + 2.0 * self.width - floor",
+        "reach = self._center + 2.0 * self.width"),)),
+    D("step_edge_pressure", "step edge softening: the pressure at the edge (P0/2), not at the "
+      "floor", "femadh/laws/step.py",
+      (("float(self.pressure(np.array([floor]))[0]) / reach",
+        "float(self.pressure(np.array([self._center]))[0]) / reach"),)),
+    D("step_safe_loose", "plan: the fine member's step ratio allowed 0.9 (not 0.3)",
+      "femadh/discretisation/plan.py", (("STEP_SAFE = 0.3", "STEP_SAFE = 0.9"),)),
     D("plan_member_ratio", "banded family: members at 2^(1/4) h (Richardson divides by ~0.2)",
       "femadh/discretisation/plan.py",
       (("MIN_MEMBER_RATIO = 2.0**0.5", "MIN_MEMBER_RATIO = 2.0**0.25"),)),

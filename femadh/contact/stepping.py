@@ -57,6 +57,10 @@ MIN_STEP_FRACTION = 2.0**-10
 #: (a fold needs at most ~2 log2(1/MIN_STEP_FRACTION) = 20 bracketed trials, measured 4-8 on
 #: a jump-in; healthy steps need a handful)
 MAX_SOLVES_PER_STEP = 200
+#: ... and each contact node the accepted states released or added on the way brings this
+#: many more (a release costs the halvings down to the smallest step,
+#: log2(1/MIN_STEP_FRACTION))
+SOLVES_PER_EDGE_NODE = 10
 #: folds in a row, each within CRAWL_STEPS smallest steps of the last landing, beyond which the
 #: branch counts as stalled (folds further apart are a contact unzipping node by node)
 MAX_JUMPS_PER_STEP = 3
@@ -522,10 +526,15 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         halving = trapped or not BRACKETED
         start_here = (state, g_state, t_state)
         edge_off = False    # an edge-predicted step of this grid step was turned down
+        n_start = int(np.count_nonzero(state.active))
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
-            # edge) brings its own budget; a crawl is cut by crawl_run below
-            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here):
+            # edge) brings its own budget; a crawl is cut by crawl_run below; so does each
+            # contact node the accepted states released or added (progress: near a pull-off
+            # the edge races across ~100 nodes of a fine band within one grid step)
+            moved = abs(int(np.count_nonzero(state.active)) - n_start)
+            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \
+                    + SOLVES_PER_EDGE_NODE * moved:
                 # the folds of the crawl are not physical snaps: keep them out of the result
                 crawl = sweep.jumps[len(sweep.jumps) - jumps_here:] if jumps_here else []
                 del sweep.jumps[len(sweep.jumps) - jumps_here:]

@@ -16,6 +16,15 @@ The surface-tension ring force at the meniscus edge (relative size ~ sqrt(|r_K|/
 On the Green path the contact problem integrates this law over the gap field between the nodes
 (``SUBGRID``; :mod:`femadh.contact.subgrid`): the edge is ~w / |dh/dr| wide in r, far narrower
 than a node's annulus where the gap is shallow, and collocated it snaps node by node.
+
+At low humidity the edge sits just above the sigma-gap floor: the condensate then acts only
+over the first h_fill - sigma of opening at the contact edge, a Dugdale cohesive zone of
+stress gamma/|r_K| about (pi/4) E* (h_fill - sigma) |r_K| / gamma long (~34 nm for ethanol at
+p/psat = 0.15 on sigma = 0.489 nm and the 2-mm slider's E*). A band spacing comparable to it
+unzips the contact node by node on the retract (the stiction map's low-humidity points); the
+grid planner resolves it through the step's secant softening from the floor
+(:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`,
+:func:`femadh.discretisation.plan.trapping_ratio`).
 """
 from dataclasses import dataclass
 
