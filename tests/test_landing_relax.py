@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import femadh
-from femadh.contact import landing, stepping, trace
+from femadh.contact import landing, linalg, stepping, trace
 from femadh.contact.complementarity import solve_complementarity
 from femadh.contact.stability import is_stable
 from femadh.discretisation import plan_grid
@@ -59,12 +59,21 @@ def landed(slider):
     def relaxed_spy(problem, d, st, descent, **kw):
         fallbacks.append((d, starts[-1], descent))
         return real_relaxed(problem, d, st, descent, **kw)
+    # which fold's landing loses its equilibrium depends on the path to it at round-off: with
+    # the Krylov preconditioner's inverse kept in single precision (linalg.PRECONDITIONER_DTYPE,
+    # the solver's default) the approach on this member passes both folds without needing a
+    # fallback (measured: 2 jumps, 0 fallbacks), with it in double it reaches the landing
+    # described above (2 jumps, 1 fallback). The landing itself is what is tested here: the
+    # double-precision path is taken to reach it
+    dtype = linalg.PRECONDITIONER_DTYPE
     try:
         stepping.land, landing._relaxed = land_spy, relaxed_spy
+        linalg.PRECONDITIONER_DTYPE = np.float64
         sweep = trace(p, D_VALUES, branch="approach", tol=scene.tolerance,
                       max_iter=scene.max_iter)
     finally:
         stepping.land, landing._relaxed = real_land, real_relaxed
+        linalg.PRECONDITIONER_DTYPE = dtype
     return sweep, fallbacks
 
 
