@@ -47,16 +47,31 @@ def test_inconsistent_law_is_refused_before_solving():
         _fig4(SteepDerivative(HAMAKER, Z0))
 
 
-def test_wrong_derivative_fails_cleanly_in_stepping_continuation():
-    """Unchecked, the wrong Jacobian still ends in a ConvergenceError naming where, within
-    seconds (measured 1.6 s), not in a crawl."""
+def test_wrong_derivative_fails_cleanly_in_stepping_continuation(monkeypatch):
+    """Unchecked, the wrong Jacobian still ends in a ConvergenceError naming where, within a
+    bounded number of Newton iterations, not in a crawl. Measured: 92 complementarity solves,
+    3077 Newton iterations in all (2 s quiet) before the landing after the jump-in fails; the
+    bound is 3x that. It counts work, not seconds: a wall-clock bound failed at load 15."""
+    from femadh.contact import landing, stepping
+
+    work = {"solves": 0, "iterations": 0}
+
+    def counted(solve):
+        def spy(*a, **k):
+            st = solve(*a, **k)
+            work["solves"] += 1
+            work["iterations"] += st.n_iter
+            return st
+        return spy
+    monkeypatch.setattr(stepping, "solve_complementarity",
+                        counted(stepping.solve_complementarity))
+    monkeypatch.setattr(landing, "solve_complementarity", counted(landing.solve_complementarity))
     p = _fig4(SteepDerivative(HAMAKER, Z0), check=False)
     ds = np.round(np.arange(2.0, -2.0001, -0.2), 10) * 1e-9
-    t0 = time.perf_counter()
     with pytest.raises(ConvergenceError, match=r"d = .* nm") as e:
         a = trace(p, ds, branch="approach", tol=TOL)
         trace(p, ds[::-1], branch="retract", tol=TOL, start=a.states[-1])
-    assert time.perf_counter() - t0 < 30
+    assert 0 < work["iterations"] <= 3 * 3077, work
     assert "iterations" in str(e.value) and "nan" not in str(e.value)
 
 
