@@ -307,6 +307,15 @@ DEFECTS = [
       "femadh/contact/stepping.py",
       (("return float(np.sum(problem.S_sym @ state.w))",
         "return float(np.sum(problem.K @ state.w))"),)),
+    D("step_budget_edge_ignored", "stepping: a grid step's budget no longer grows with the "
+      "contact nodes it moved", "femadh/contact/stepping.py",
+      (("            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \\\n"
+        "                    + SOLVES_PER_EDGE_NODE * moved:",
+        "            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here):"),)),
+    D("step_budget_edge_signed", "stepping: the nodes moved counted with their sign (a receding "
+      "edge lowers the budget)", "femadh/contact/stepping.py",
+      (("moved = abs(int(np.count_nonzero(state.active)) - n_start)",
+        "moved = int(np.count_nonzero(state.active)) - n_start"),)),
     D("fold_landing_restart", "stepping: a stalled landing no longer restarts on the branch "
       "the corrector found", "femadh/contact/stepping.py",
       (("                    beyond, why = new, \"rejected_energy\"\n",
