@@ -240,7 +240,7 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         r = float(np.max(np.abs(a[idx] * F[idx]) / sdiag[idx])) if idx.size else 0.0
         if not np.isfinite(r):
             return None, None, step
-        if r_prev is not None:
+        if r_prev is not None and r_prev > 0:
             mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r / r_prev))
         r_prev = r
         M = K[np.ix_(idx, idx)]
@@ -251,6 +251,11 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
             dw = -sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],
                                check_finite=False)
         except (ValueError, sla.LinAlgError):
+            return None, None, step
+        if not np.all(np.isfinite(dw)):
+            # lu_factor only warns on an exactly singular matrix: the step is then not
+            # finite, and the relaxation gives up (the next fallback is tried) instead of
+            # carrying it into the law
             return None, None, step
         closing = dw > 0
         alpha = 1.0

@@ -527,13 +527,14 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
         start_here = (state, g_state, t_state)
         edge_off = False    # an edge-predicted step of this grid step was turned down
         n_start = int(np.count_nonzero(state.active))
+        crawling = False    # folds in a row at the smallest step: the step stalls at once
         while state.d != d_next:
             # each fold apart from the last (a contact unzipping node by node past a meniscus
             # edge) brings its own budget; a crawl is cut by crawl_run below; so does each
             # contact node the accepted states released or added (progress: near a pull-off
             # the edge races across ~100 nodes of a fine band within one grid step)
             moved = abs(int(np.count_nonzero(state.active)) - n_start)
-            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \
+            if crawling or solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \
                     + SOLVES_PER_EDGE_NODE * moved:
                 # the folds of the crawl are not physical snaps: keep them out of the result
                 crawl = sweep.jumps[len(sweep.jumps) - jumps_here:] if jumps_here else []
@@ -626,7 +627,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             if accepted:
                 last = abs(step if halving else d_try - state.d)
                 # the edge predictor's second point (None after a landing: a new piece)
-                new.edge_from = (state.d, disk_size(state.active))
+                # 0 where the set is not a disk (read as no edge; a checkpoint keeps numbers)
+                new.edge_from = (state.d, disk_size(state.active) or 0)
                 state, g_state = new, g_new
                 t_state = _tangent(problem, state, sweep)
                 fold.see(state, t_state, problem)
@@ -695,8 +697,10 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                          and abs(state.d - last.d_land) <= CRAWL_STEPS * min_step else 1)
             if crawl_run > MAX_JUMPS_PER_STEP:
                 # fold after fold at the smallest step: not a physical snap but a branch the
-                # model cannot continue (e.g. the Hertz closure's inner problem non-unique)
-                solves_here = MAX_SOLVES_PER_STEP * (1 + jumps_here)
+                # model cannot continue (e.g. the Hertz closure's inner problem non-unique);
+                # a flag, not an exhausted count: the budget's per-edge-node part would let a
+                # crawl that moves a node per fold go on to the end of the grid step
+                crawling = True
             state, g_state = landed, g_landed
             t_state = _tangent(problem, state, sweep)
             fold.restart(state, t_state, problem)
