@@ -309,9 +309,9 @@ DEFECTS = [
         "return float(np.sum(problem.K @ state.w))"),)),
     D("step_budget_edge_ignored", "stepping: a grid step's budget no longer grows with the "
       "contact nodes it moved", "femadh/contact/stepping.py",
-      (("            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \\\n"
+      (("            if crawling or solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here) \\\n"
         "                    + SOLVES_PER_EDGE_NODE * moved:",
-        "            if solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here):"),)),
+        "            if crawling or solves_here >= MAX_SOLVES_PER_STEP * (1 + jumps_here):"),)),
     D("step_budget_edge_signed", "stepping: the nodes moved counted with their sign (a receding "
       "edge lowers the budget)", "femadh/contact/stepping.py",
       (("moved = abs(int(np.count_nonzero(state.active)) - n_start)",
