@@ -4,7 +4,7 @@ achieved and the estimated error and their ratio (effectivity) - for the paper-1
 the FE operator's mesh ladder and the FE meniscus.
 
 ``python -m validation.accuracy [--quick] [--only NAME] [--adaptive]`` writes
-validation/results/accuracy.md and accuracy.png (~10 min on two cores, one BLAS thread; the
+validation/results/accuracy.md and accuracy.png (~2 min on two cores, one BLAS thread; the
 times are the numbers, so run it on a quiet machine: the load is printed in the file). The
 smooth-sphere map and the peer problem have their own tables: validation/regime.py and
 validation/peer_lj82.py.
