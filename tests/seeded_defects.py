@@ -316,6 +316,10 @@ DEFECTS = [
       "edge lowers the budget)", "femadh/contact/stepping.py",
       (("moved = abs(int(np.count_nonzero(state.active)) - n_start)",
         "moved = int(np.count_nonzero(state.active)) - n_start"),)),
+    D("step_crawl_flag_ignored", "stepping: a crawl of folds no longer stalls its grid step "
+      "at once (the cut left to the budget, which the per-edge-node part extends)",
+      "femadh/contact/stepping.py",
+      (("                crawling = True\n", "                crawling = False\n"),)),
     D("fold_landing_restart", "stepping: a stalled landing no longer restarts on the branch "
       "the corrector found", "femadh/contact/stepping.py",
       (("                    beyond, why = new, \"rejected_energy\"\n",

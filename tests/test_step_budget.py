@@ -39,3 +39,28 @@ def test_a_receding_edge_earns_its_solves(disk, monkeypatch):
     monkeypatch.setattr(stepping, "SOLVES_PER_EDGE_NODE", 0)
     with pytest.raises(ConvergenceError, match="continuation stalled"):
         fig4_sweeps(p)
+
+
+def test_a_crawl_of_folds_stalls_its_grid_step_at_once(monkeypatch):
+    """Folds in a row at the smallest step (MAX_JUMPS_PER_STEP + 1 within CRAWL_STEPS smallest
+    steps of each other's landing) are not physical snaps: the grid step stalls there, its
+    folds kept out of the result, whatever the per-edge-node budget would still allow. A crawl
+    is forced on the Fig 4 disk (100 nodes): every step in contact counts as crossing a fold
+    and no landing counts as a lattice snap. Measured: the stall comes 4 folds into the first
+    crawl, at d = 1.10898 nm, after 19 solves, no jump reported; when the cut was an exhausted
+    count that the allowance overrode, the crawl ran on through the grid step and the next
+    (562 folds reported as jumps, 1153 solves)."""
+    p = fig4_problem(100)
+    real = stepping.crossed_fold
+    monkeypatch.setattr(stepping, "crossed_fold", lambda problem, state, new, *a, **k:
+                        bool(state.active.any()) or real(problem, state, new, *a, **k))
+    monkeypatch.setattr(stepping, "lattice_snap", lambda *a, **k: False)
+    from femadh.contact import trace
+
+    from conftest import FIG4_D_VALUES, FIG4_TOL
+    with pytest.raises(ConvergenceError, match="4 folds in a row at the smallest step") as e:
+        trace(p, FIG4_D_VALUES, branch="approach", tol=FIG4_TOL)
+    sweep = e.value.sweep
+    assert sweep.jumps == []
+    assert sweep.n_solves <= 3 * 19, sweep.n_solves
+    assert 1.0e-9 < e.value.d < 1.2e-9          # inside the grid step the crawl began in
