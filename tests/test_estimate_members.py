@@ -98,6 +98,20 @@ def test_uniform_grids_keep_their_members_traced_whole():
     assert "uniform grid" in res.grid["member_solves"][0]["why"]
 
 
+def _f_lj_on(ref, fine, st, sc):
+    """F_LJ (N) of the state ``st`` of problem ``fine`` carried to the finer problem ``ref``
+    and solved there (one Newton solve from the interpolated state)."""
+    from femadh.contact.complementarity import solve_complementarity
+    from femadh.contact.forces import state_forces
+    from femadh.discretisation.moving import interpolate_state
+
+    w0, act = interpolate_state(fine, ref, st.d, st.w)
+    sr = solve_complementarity(ref, st.d, w0, tol=sc.tolerance, max_iter=sc.max_iter,
+                               active0=act)
+    assert sr.converged and sr.stable
+    return state_forces(ref, sr)[0]
+
+
 def test_locked_deepest_estimate_effectivity_against_a_fine_reference():
     """The Fig 3 scene at accuracy 1e-2 (58 nodes, band spacing 137 nm): the grid part of
     F_LJ at the deepest separation against the same family's state at a sixteenth of the
@@ -105,9 +119,7 @@ def test_locked_deepest_estimate_effectivity_against_a_fine_reference():
     -8.4e-8 N, effectivity 2.55; the family's own members (193, 273 nm: across the edge's
     node-crossing sawtooth) gave 7.2e-3 relative, effectivity 24."""
     from femadh.contact import trace
-    from femadh.contact.complementarity import solve_complementarity
     from femadh.contact.forces import state_forces
-    from femadh.discretisation.moving import interpolate_state
     from femadh.scene import build_problem
 
     base = femadh.load_scene(f"{SCENES}/paper1_fig3.toml")
@@ -128,11 +140,7 @@ def test_locked_deepest_estimate_effectivity_against_a_fine_reference():
     assert state_forces(fine, st)[0] == pytest.approx(res.headline["F_LJ_deepest_N"],
                                                       rel=1e-9, abs=0)
     _, ref = member(g["spacing_m"] / 16)
-    w0, act = interpolate_state(fine, ref, st.d, st.w)
-    sr = solve_complementarity(ref, st.d, w0, tol=sc.tolerance, max_iter=sc.max_iter,
-                               active0=act)
-    assert sr.converged and sr.stable
-    true = state_forces(ref, sr)[0] - res.headline["F_LJ_deepest_N"]
+    true = _f_lj_on(ref, fine, st, sc) - res.headline["F_LJ_deepest_N"]
     est = res.estimates["F_LJ_deepest_N"]["grid"]
     # the grid part is the uneven Richardson of the placed members at their own ratios
     (h1, h2), (lv1, lv2) = g["deepest_member_spacings_m"], g["deepest_members"]
@@ -243,9 +251,6 @@ def test_uniform_grid_gets_members_placed_by_the_deepest_edge():
     own error ~5e-6 of the force, from N = 800's 1.7e-5 at order 2): measured grid part
     -1.84e-8 N against an error of -9.56e-9 N, effectivity 1.92; the N/2, N/4 members gave
     -1.16e-7 N (effectivity 12.1)."""
-    from femadh.contact.complementarity import solve_complementarity
-    from femadh.contact.forces import state_forces
-    from femadh.discretisation.moving import interpolate_state
     from femadh.scene import build_problem
 
     sc = _slider_uniform(400)
@@ -267,11 +272,7 @@ def test_uniform_grid_gets_members_placed_by_the_deepest_edge():
     assert got["locked"][0][0] == pytest.approx(2 * h, rel=0.02, abs=0)
     fine, st = got["problem"], got["state"]
     ref = build_problem(estimates.variant(sc, nodes=1600))
-    w0, act = interpolate_state(fine, ref, st.d, st.w)
-    sr = solve_complementarity(ref, st.d, w0, tol=sc.tolerance, max_iter=sc.max_iter,
-                               active0=act)
-    assert sr.converged and sr.stable
-    true = state_forces(ref, sr)[0] - res.headline["F_LJ_deepest_N"]
+    true = _f_lj_on(ref, fine, st, sc) - res.headline["F_LJ_deepest_N"]
     est = res.estimates["F_LJ_deepest_N"]["grid"]
     assert est * true > 0                       # the side the error is on
     assert 0.5 <= est / true <= 5.0, (est, true)
