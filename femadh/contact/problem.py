@@ -204,12 +204,7 @@ class ContactProblem:
         the solve where it arose."""
         out = np.zeros_like(h)
         for name, eff in (self.effects if laws is None else laws).items():
-            v = getattr(eff, part)(h)
-            if not np.all(np.isfinite(v)):
-                k = int(np.flatnonzero(~np.isfinite(v))[0])
-                raise ConvergenceError(f"law {name!r}: {part} is not finite at node {k} "
-                                       f"(gap h = {np.ravel(h)[k]:.6g} m)")
-            out += v
+            out += self._finite(name, part, getattr(eff, part)(h), h)
         return out
 
     def energy(self, w, d):
