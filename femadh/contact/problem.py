@@ -235,7 +235,10 @@ class ContactProblem:
             flat[::n + 1] += a * np.diagonal(J)
             flat[1::n + 1] += a[:-1] * np.diagonal(J, 1)
             flat[n::n + 1] += a[1:] * np.diagonal(J, -1)
-            return H if free is None else H[np.ix_(free, free)]
+            if free is None:
+                return H
+            m = free.size - int(np.count_nonzero(free))
+            return H[m:, m:] if free[m:].all() else H[np.ix_(free, free)]
         if free is None:
             H = self.S_sym.copy()
             H[np.diag_indices_from(H)] += self.areas * self.dpressure(h)

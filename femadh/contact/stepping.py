@@ -365,7 +365,7 @@ class _Bracket:
         return a + self.dir * (n // 2) * h
 
 
-def _tangent(problem, state, sweep):
+def _tangent(problem, state):
     """dw/dd (m/m) of ``state`` with its active set frozen, or None without a factorisation
     (the predictor then takes the state itself); computed once per state, not per trial."""
     if state.lu is None:
@@ -512,7 +512,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # a law that softens beyond a node's stiffness somewhere the surfaces can reach: nodes
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
-    t_state = _tangent(problem, state, sweep)
+    t_state = _tangent(problem, state)
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -630,7 +630,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # 0 where the set is not a disk (read as no edge; a checkpoint keeps numbers)
                 new.edge_from = (state.d, disk_size(state.active) or 0)
                 state, g_state = new, g_new
-                t_state = _tangent(problem, state, sweep)
+                t_state = _tangent(problem, state)
                 fold.see(state, t_state, problem)
                 step = math.copysign(min(2 * last, abs(grid_step)), grid_step)
                 if fold.far is not None and state.d == fold.far:
@@ -685,7 +685,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             if lattice_snap(problem, state, landed, g_state, g_landed):
                 sweep.work["lattice_snaps"] = sweep.work.get("lattice_snaps", 0) + 1
                 state, g_state, beyond = landed, g_landed, None
-                t_state = _tangent(problem, state, sweep)
+                t_state = _tangent(problem, state)
                 fold.restart(state, t_state, problem)
                 continue
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
@@ -702,7 +702,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # crawl that moves a node per fold go on to the end of the grid step
                 crawling = True
             state, g_state = landed, g_landed
-            t_state = _tangent(problem, state, sweep)
+            t_state = _tangent(problem, state)
             fold.restart(state, t_state, problem)
         sweep.states.append(state)
         if on_state:

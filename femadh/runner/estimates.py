@@ -49,6 +49,7 @@ from .peak import peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
+from ..estimate.richardson import _finite  # noqa: E402 (one home)
 from ..estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F401
                                    discretisation)
 
@@ -278,10 +279,6 @@ def fe_against_green(fe, green):
     function on the same nodes gives the body without its mesh (finite floats only)."""
     return {k: green[k] - v for k, v in fe.items()
             if _finite(v) and _finite(green.get(k))}
-
-
-def _finite(x):
-    return isinstance(x, float) and math.isfinite(x)
 
 
 def _stop_if_stopped(member):

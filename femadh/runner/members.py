@@ -39,6 +39,7 @@ import numpy as np
 
 from ..contact.stepping import MIN_STEP_FRACTION
 from ..estimate.guards import TRAPPING_LIMIT
+from .peak import off_branch
 
 #: grid states the member may walk past the fine run's peak looking for its own grid maximum
 PEAK_WALK = 3
@@ -141,8 +142,7 @@ class _Member:
         self.solves += 1
         if not (st.converged and st.stable):
             return None
-        if branch and np.any(np.abs(st.w - w0) > 0.25 * np.maximum(
-                self.problem.contour(d) - w0, 0) + 1e-15):
+        if branch and off_branch(self.problem, d, st.w, w0):
             return None
         return st
 
@@ -322,7 +322,7 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         # a quarter of every gap): a member that lands elsewhere - a contact unzipping in
         # several folds on a coarse grid - is not the fine run's picture and is traced whole
         w0 = m.carried(after, d)
-        if np.any(np.abs(landed.w - w0) > 0.25 * np.maximum(p.contour(d) - w0, 0) + 1e-15):
+        if off_branch(p, d, landed.w, w0):
             raise _NotReduced(f"the member lands elsewhere than the fine run after its fold at "
                               f"d = {state.d * 1e9:.6g} nm")
         return state.d, m.released(state, landed, d)

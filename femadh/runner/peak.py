@@ -40,11 +40,15 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
     elif problem.sigma is not None:
         kw["active0"] = near.active | (problem.contour(d) - w_start < problem.sigma)
     st = solve_state(problem, d, w_start, tol=scene.tolerance, max_iter=scene.max_iter, **kw)
-    h_pred = problem.contour(d) - w0
-    if not (st.converged and st.stable) or np.any(
-            np.abs(st.w - w0) > 0.25 * np.maximum(h_pred, 0) + 1e-15):
+    if not (st.converged and st.stable) or off_branch(problem, d, st.w, w0):
         return None
     return st
+
+
+def off_branch(problem, d, w, w0):
+    """True when the surface w (m) at separation d (m) moved from w0 by more than a quarter
+    of a gap w0 left anywhere: another branch than w0's, not the same one nearby."""
+    return bool(np.any(np.abs(w - w0) > 0.25 * np.maximum(problem.contour(d) - w0, 0) + 1e-15))
 
 
 #: the bounded search's tolerance in d as a fraction of the grid bracket (the half-width of
