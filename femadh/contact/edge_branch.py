@@ -190,6 +190,7 @@ class _Newton:
     def _setup(self, C0, K0, shape0, nodes0, k, tol):
         self.C0, self.K0, self.shape0, self.nodes0 = C0, K0, shape0, nodes0
         self.k, self.tol = k, tol
+        self._kdiag0 = np.diag(K0).copy()
         self.n = n = K0.shape[0]
         self.n_solves = 0
         self.n_iter = 0
@@ -293,6 +294,12 @@ class _Newton:
         self.n_iter += MAX_ITER
         return None
 
+    def node_softening_ratio(self, st):
+        """max_i -P'(h_i) / K_ii at a state (on a scaled grid K = K0 / lam; lam = 1 on the
+        centre-gap branch's fixed grid), as :meth:`ContactProblem.node_softening_ratio`
+        without a gap constraint."""
+        return float((-self._dpressure(st.h) * st.lam / self._kdiag0).max())
+
 
 class EdgeBranch(_Newton):
     """Solves of the contact branch at given edge radii.
@@ -323,7 +330,6 @@ class EdgeBranch(_Newton):
                                     subgrid=False)
         self._setup(base.compliance, base.stiffness, None, base.grid.nodes, k, tol)
         self._areas0 = base.grid.areas
-        self._kdiag0 = np.diag(self.K0).copy()
 
     def problem(self, c):
         """The problem on the grid whose node k sits at c (m): the reference problem with its
@@ -344,11 +350,6 @@ class EdgeBranch(_Newton):
         side): near 1 a node snaps on its own."""
         _, _, soft, _ = self._base.surface_force_stiffness()
         return soft / float(self._base.K[self.k, self.k])
-
-    def node_softening_ratio(self, st):
-        """max_i -P'(h_i) / K_ii at a state (its scaled grid: K = K0 / lam), as
-        :meth:`ContactProblem.node_softening_ratio` without a gap constraint."""
-        return float((-self._dpressure(st.h) * st.lam / self._kdiag0).max())
 
     def grid_force(self, st):
         """The force (N) of a state's pressure on the analysis disk of its scaled grid (the
@@ -458,10 +459,6 @@ class CentreGapBranch(_Newton):
         self.n_iter += MAX_ITER
         self.n_factor += n_lu
         return None
-
-    def node_softening_ratio(self, st):
-        """max_i -P'(h_i) / K_ii at a state."""
-        return float((-self._dpressure(st.h) / np.diag(self.K0)).max())
 
     def slope(self, st):
         """dd/dg (-) along the branch: J dx/dg = -dF/dg = (0, ..., 0, 1)."""
