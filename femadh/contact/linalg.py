@@ -63,11 +63,11 @@ def disk_size(A):
     return m if A[:m].all() else None
 
 
-#: precision of :class:`TrailingCholesky`'s kept inverse factor: single halves the memory the
-#: two products of each preconditioner solve read (the solve is bound by memory: 187 -> 69 us
-#: at 450 of 631 nodes, one thread), and a preconditioner of GMRES with its directions kept
-#: (``x = Z y``, the residual of the exact product) needs no more than its ~7 digits: the
-#: Krylov steps still reach GMRES_RTOL = 1e-6 of the exact Jacobian
+#: precision of :class:`TrailingCholesky`'s kept factor: single halves the memory the two
+#: triangular solves of each preconditioner application read (the solve is bound by memory),
+#: and a preconditioner of GMRES with its directions kept (``x = Z y``, the residual of the
+#: exact product) needs no more than its ~7 digits: the Krylov steps still reach
+#: GMRES_RTOL = 1e-6 of the exact Jacobian
 PRECONDITIONER_DTYPE = np.float32
 
 
@@ -79,10 +79,15 @@ class TrailingCholesky:
     block is a leading block, and the Cholesky factor U of a leading block is the leading part
     of the full factor - there is no pivoting to spoil it (unlike :class:`TrailingLU`). It is
     positive definite near a stable state; where it is not, ``k_valid`` is the largest leading
-    block that is (LAPACK potrf's info), and blocks beyond it are not covered. The inverse of
-    U is kept (the leading block of the inverse of a triangular matrix is the inverse of its
-    leading block), so a solve is two products with views of it: no copy per block; it is
-    kept in PRECONDITIONER_DTYPE (single precision).
+    block that is (LAPACK potrf's info), and blocks beyond it are not covered. The factor is
+    kept in PRECONDITIONER_DTYPE (single precision); a solve is two triangular solves (BLAS
+    trsv) with the leading block of the block size asked for, copied contiguous once per
+    size (the contact edge moves by a node or a few per state, and each size serves the
+    corrector's iterations and its GMRES products). (It used to keep the inverse of U,
+    whose leading blocks are views: the inversion, LAPACK trtri, cost as much as the
+    factorisation itself - 2.3 against 2.8 ms at 600 nodes - for every refresh, and its
+    two matrix-vector products 42 us against the two triangular solves' 25 us at 450
+    nodes.)
 
     It differs from the area-scaled collocation Jacobian diag(area)(K + D) by the
     antisymmetric part of S (measured 1.4 % of its norm on the Fig 4 scene's 285-node grid)
@@ -101,80 +106,81 @@ class TrailingCholesky:
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
         self.n, self.m0 = n, m0
         self.k_valid = n - m0 if info == 0 else int(info) - 1
-        # the inverse is taken when a block is first asked for (:meth:`covers`): a factor
-        # that covers no block the corrector needs - the Hessian of an iterate off the
-        # stable branch, not positive definite at the contact edge, which near a fold is
-        # most of the refreshes (91 of 97 on the Fig 4 scene's 631-node sweep) - costs
-        # its Cholesky alone
+        # the factor in the kept precision is taken when a block is first asked for
+        # (:meth:`covers`): a factor that covers no block the corrector needs - the Hessian
+        # of an iterate off the stable branch, not positive definite at the contact edge,
+        # which near a fold is most of the refreshes (91 of 97 on the Fig 4 scene's 631-node
+        # sweep) - costs its Cholesky alone
         self._u = u[:self.k_valid, :self.k_valid] if self.k_valid > 0 else None
-        self._uinv = self._uinv_t = None
+        self._kept = None
+        self._block = (None, None)
 
-    def _invert(self):
-        """U^-1 in PRECONDITIONER_DTYPE, in natural node order, and its transpose; k_valid
-        drops to 0 where the inversion fails."""
-        from scipy.linalg import lapack
-
-        empty = np.zeros((0, 0), PRECONDITIONER_DTYPE)
-        self._uinv = self._uinv_t = empty
+    def _keep(self):
+        """U (reversed node order, upper) in PRECONDITIONER_DTYPE; k_valid drops to 0 where
+        a diagonal entry is not a finite positive number in that precision."""
         u, self._u = self._u, None
+        self._kept = np.zeros((0, 0), PRECONDITIONER_DTYPE, order="F")
         if u is None or self.k_valid <= 0:
             return
-        # inverted (and kept) in PRECONDITIONER_DTYPE: the factor is computed in double
-        # (its positive definite size decides which blocks are covered), the inverse is
-        # only a preconditioner's
-        trtri = lapack.strtri if PRECONDITIONER_DTYPE == np.float32 else lapack.dtrtri
-        ui, info = trtri(np.asfortranarray(u, dtype=PRECONDITIONER_DTYPE), lower=False)
-        if info != 0 or not np.all(np.isfinite(np.diagonal(ui))):
-            # a zero pivot in U (or one beyond single precision): nothing is covered
+        kept = np.asfortranarray(u, dtype=PRECONDITIONER_DTYPE)
+        diag = np.diagonal(kept)
+        if not np.all(np.isfinite(diag) & (diag > 0)):
+            # a pivot beyond single precision (under- or overflow): nothing is covered
             self.k_valid = 0
             return
-        # kept in natural node order (the reversed order's leading blocks are its
-        # trailing blocks), with the transpose as its own contiguous copy: both
-        # products of a solve run in BLAS on views (a reversed, negative-stride
-        # vector would take numpy off BLAS: 100 us instead of 20 at k = 225)
-        self._uinv = np.ascontiguousarray(ui[::-1, ::-1])
-        self._uinv_t = np.ascontiguousarray(self._uinv.T)
+        self._kept = kept
 
     @property
-    def uinv(self):
-        """U^-1 in natural node order (lower triangular, PRECONDITIONER_DTYPE)."""
-        if self._uinv is None:
-            self._invert()
-        return self._uinv
-
-    @property
-    def uinv_t(self):
-        if self._uinv is None:
-            self._invert()
-        return self._uinv_t
+    def kept(self):
+        """U in reversed node order (upper triangular, PRECONDITIONER_DTYPE): what a
+        checkpoint stores (:meth:`from_kept`)."""
+        if self._kept is None:
+            self._keep()
+        return self._kept
 
     @classmethod
-    def from_inverse(cls, uinv, n, m0, k_valid):
-        """The preconditioner from its kept inverse factor (a checkpoint's arrays)."""
+    def from_kept(cls, kept, n, m0, k_valid):
+        """The preconditioner from its kept factor (a checkpoint's arrays)."""
         out = cls.__new__(cls)
         out.n, out.m0, out.k_valid = n, m0, k_valid
         out._u = None
-        out._uinv = np.ascontiguousarray(uinv, dtype=PRECONDITIONER_DTYPE)
-        out._uinv_t = np.ascontiguousarray(out._uinv.T)
+        out._kept = np.asfortranarray(kept, dtype=PRECONDITIONER_DTYPE)
+        out._block = (None, None)
         return out
 
     def covers(self, m):
         if not (m >= self.m0 and self.n - m <= self.k_valid):
             return False
-        if self._uinv is None:
-            self._invert()          # (may find a zero pivot: then nothing is covered)
+        if self._kept is None:
+            self._keep()            # (may find a pivot out of range: then nothing is covered)
         return self.n - m <= self.k_valid
 
+    def _factor_block(self, k):
+        """The leading k x k block of U, contiguous (one copy per block size)."""
+        if self._block[0] != k:
+            kept = self.kept
+            blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])
+            self._block = (k, blk)
+        return self._block[1]
+
     def solve(self, m, rhs):
-        """x with H[m:, m:] x = rhs (natural node order m..n-1): x = U^-1 U^-T rhs."""
+        """x with H[m:, m:] x = rhs (natural node order m..n-1): U^T U x' = rhs' in reversed
+        order (x' = x reversed), two triangular solves."""
+        from scipy.linalg import blas
+
         k = self.n - m
         if k <= 0:
             return np.zeros(0)
         if not self.covers(m):
             raise ValueError(f"trailing block from node {m} is not covered (m0 = {self.m0}, "
                              f"positive definite leading size {self.k_valid})")
-        r = np.asarray(rhs, dtype=self.uinv.dtype)      # (a double vector would upcast U)
-        return np.asarray(self.uinv[-k:, -k:] @ (self.uinv_t[-k:, -k:] @ r), dtype=float)
+        u = self._factor_block(k)
+        trsv = blas.strsv if u.dtype == np.float32 else blas.dtrsv
+        # (a double vector would be converted by the wrapper anyway; reversed, contiguous)
+        r = np.array(rhs[::-1], dtype=u.dtype)
+        y = trsv(u, r, trans=1, overwrite_x=1)          # U^T y = r
+        x = trsv(u, y, trans=0, overwrite_x=1)          # U x = y
+        return np.asarray(x[::-1], dtype=float)
 
 
 #: Krylov dimension of one preconditioned solve before it counts as failed
