@@ -62,10 +62,12 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
             return w, True
         H = problem.energy_hessian(b - w, free)
         while True:
-            M = H.copy()
+            # a copy in LAPACK's (Fortran) order, factorised in place: the wrapper would
+            # otherwise copy a C-ordered M once more for every trial damping
+            M = np.array(H, order="F")
             M[np.diag_indices_from(M)] += lam * scale_diag[free]
             try:
-                c = sla.cho_factor(M, check_finite=False)
+                c = sla.cho_factor(M, check_finite=False, overwrite_a=True)
             except sla.LinAlgError:
                 lam *= 4
                 if lam > 1e12:
