@@ -874,6 +874,27 @@ DEFECTS = [
     D("newton_cholesky_transpose", "trailing Cholesky: U y = r for U^T y = r (U^-1 U^-1)",
       "femadh/contact/linalg.py",
       (("y = trsv(u, r, trans=1, overwrite_x=1)", "y = trsv(u, r, trans=0, overwrite_x=1)"),)),
+    D("state_pre_stability_off_by_one", "a Krylov state's stability read off one node short "
+      "of its free block", "femadh/contact/complementarity.py",
+      (("    if pre.k_valid >= n - m:", "    if pre.k_valid >= n - m - 1:"),)),
+    D("state_pre_without_law", "a Krylov state's stability test and preconditioner without the "
+      "law's stiffness", "femadh/contact/complementarity.py",
+      (("    held = _held_zero(D, A)", "    held = np.zeros_like(D)"),)),
+    D("corrector_contact_rows_transposed", "corrector: the contact pressure from K's columns "
+      "instead of its rows", "femadh/contact/complementarity.py",
+      (("K[:m] @ w if m is not None", "K[:, :m].T @ w if m is not None"),)),
+    D("cholesky_block_trailing", "trailing Cholesky: a solve with the trailing block of the "
+      "kept factor for the leading one", "femadh/contact/linalg.py",
+      (("blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])",
+        "blk = kept if k == kept.shape[0] else np.asfortranarray(kept[-k:, -k:])"),)),
+    D("checkpoint_factor_transposed", "a checkpoint's preconditioner read back transposed",
+      "femadh/contact/linalg.py",
+      (("out._kept = np.asfortranarray(kept, dtype=PRECONDITIONER_DTYPE)",
+        "out._kept = np.asfortranarray(kept.T, dtype=PRECONDITIONER_DTYPE)"),)),
+    D("landing_damps_the_hessian_itself", "landing descent: each trial damping added to the "
+      "Hessian itself (a view), earlier dampings carried over",
+      "femadh/contact/landing.py",
+      (('            M = np.array(H, order="F")', "            M = H.T"),)),
     D("newton_givens_rotation", "GMRES: the earlier Givens rotations applied transposed",
       "femadh/contact/linalg.py",
       (("col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c",

@@ -381,7 +381,8 @@ def _stable_preconditioner(problem, h, A):
     m = disk_size(A)
     D = problem.law_jacobian(h)         # (a non-finite law value raises where it arises)
     m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-    pre = TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0)
+    held = _held_zero(D, A)
+    pre = TrailingCholesky(problem.S_sym, problem.areas, held, m0)
     if pre.k_valid >= n - m:
         return True, pre
     return False, None
