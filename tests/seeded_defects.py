@@ -874,12 +874,6 @@ DEFECTS = [
     D("newton_cholesky_transpose", "trailing Cholesky: U y = r for U^T y = r (U^-1 U^-1)",
       "femadh/contact/linalg.py",
       (("y = trsv(u, r, trans=1, overwrite_x=1)", "y = trsv(u, r, trans=0, overwrite_x=1)"),)),
-    D("state_pre_stability_off_by_one", "a Krylov state's stability read off one node short "
-      "of its free block", "femadh/contact/complementarity.py",
-      (("    if pre.k_valid >= n - m:", "    if pre.k_valid >= n - m - 1:"),)),
-    D("state_pre_without_law", "a Krylov state's stability test and preconditioner without the "
-      "law's stiffness", "femadh/contact/complementarity.py",
-      (("    held = _held_zero(D, A)", "    held = np.zeros_like(D)"),)),
     D("corrector_contact_rows_transposed", "corrector: the contact pressure from K's columns "
       "instead of its rows", "femadh/contact/complementarity.py",
       (("K[:m] @ w if m is not None", "K[:, :m].T @ w if m is not None"),)),

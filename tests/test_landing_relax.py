@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import femadh
-from femadh.contact import complementarity, landing, linalg, stepping, trace
+from femadh.contact import landing, linalg, stepping, trace
 from femadh.contact.complementarity import solve_complementarity
 from femadh.contact.stability import is_stable
 from femadh.discretisation import plan_grid
@@ -63,22 +63,17 @@ def landed(slider):
     # the Krylov preconditioner's inverse kept in single precision (linalg.PRECONDITIONER_DTYPE,
     # the solver's default) the approach on this member passes both folds without needing a
     # fallback (measured: 2 jumps, 0 fallbacks), with it in double it reaches the landing
-    # described above (2 jumps, 1 fallback). So does the preconditioner each Krylov state
-    # carries: built at the state itself (complementarity.STATE_PRECONDITIONER, the default)
-    # the approach passes both folds without a fallback (measured: 1 jump), the corrector's
-    # last one reaches the landing. The landing itself is what is tested here: the
-    # double-precision path with the corrector's preconditioner is taken to reach it
-    dtype, state_pre = linalg.PRECONDITIONER_DTYPE, complementarity.STATE_PRECONDITIONER
+    # described above (2 jumps, 1 fallback). The landing itself is what is tested here: the
+    # double-precision path is taken to reach it
+    dtype = linalg.PRECONDITIONER_DTYPE
     try:
         stepping.land, landing._relaxed = land_spy, relaxed_spy
         linalg.PRECONDITIONER_DTYPE = np.float64
-        complementarity.STATE_PRECONDITIONER = False
         sweep = trace(p, D_VALUES, branch="approach", tol=scene.tolerance,
                       max_iter=scene.max_iter)
     finally:
         stepping.land, landing._relaxed = real_land, real_relaxed
         linalg.PRECONDITIONER_DTYPE = dtype
-        complementarity.STATE_PRECONDITIONER = state_pre
     return sweep, fallbacks
 
 

@@ -344,48 +344,10 @@ def _finish(problem, d, w, h, pc, A, it, res, factor, fresh=False):
     """Package a converged state; its stability is the inertia of the energy Hessian on the
     free nodes (:func:`femadh.contact.stability.is_stable`), never read off the Newton
     factorisation (that one is of the collocation Jacobian, whose pivot signs do not give
-    the Hessian's inertia).
-
-    A state the Krylov steps reached (``fresh == "krylov"``: a disk contact) has its test
-    and its next preconditioner in one factorisation (STATE_PRECONDITIONER,
-    :func:`_stable_preconditioner`)."""
-    if fresh == "krylov" and STATE_PRECONDITIONER:
-        stable, pre = _stable_preconditioner(problem, h, A)
-        if pre is not None:
-            factor = pre
-    else:
-        stable = is_stable(problem, h, ~A)
+    the Hessian's inertia)."""
     return State(d, w, h, _effect_pressures(problem, h, A), _contact_pressure(problem, pc, A),
-                 A.copy(), _area_radius(problem, A), it, res, True, stable, factor)
-
-
-#: a state reached by Krylov steps is tested for stability by the preconditioner built at its
-#: own gaps (:func:`_stable_preconditioner`), which it then carries as its factorisation
-#: (False: the separate stability test and the last preconditioner of the corrector)
-STATE_PRECONDITIONER = True
-
-
-def _stable_preconditioner(problem, h, A):
-    """(stable, preconditioner) of a converged disk-contact state from one Cholesky.
-
-    The energy Hessian on the free nodes m..n-1 is the leading block of the reversed
-    :class:`TrailingCholesky` built at the state's gaps from the margin m0 = m - margin (its
-    held margin nodes enter with their stiffness alone, after the free ones in that order):
-    the state is stable iff that block is positive definite (k_valid >= n - m; the same
-    test as :func:`~femadh.contact.stability.is_stable`, in reversed node order). The
-    factor is then the next corrector's and the tangent's preconditioner, taken at the
-    latest state instead of at an iterate of some earlier solve: the stability test's
-    Cholesky was one per state anyway, and the corrector's own refreshes are spared
-    (returned None: the state is unstable)."""
-    n = h.size
-    m = disk_size(A)
-    D = problem.law_jacobian(h)         # (a non-finite law value raises where it arises)
-    m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
-    held = _held_zero(D, A)
-    pre = TrailingCholesky(problem.S_sym, problem.areas, held, m0)
-    if pre.k_valid >= n - m:
-        return True, pre
-    return False, None
+                 A.copy(), _area_radius(problem, A), it, res, True, is_stable(problem, h, ~A),
+                 factor)
 
 
 def _held_zero(D, A):
