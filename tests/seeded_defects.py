@@ -874,9 +874,6 @@ DEFECTS = [
     D("newton_cholesky_transpose", "trailing Cholesky: U y = r for U^T y = r (U^-1 U^-1)",
       "femadh/contact/linalg.py",
       (("y = trsv(u, r, trans=1, overwrite_x=1)", "y = trsv(u, r, trans=0, overwrite_x=1)"),)),
-    D("corrector_contact_rows_transposed", "corrector: the contact pressure from K's columns "
-      "instead of its rows", "femadh/contact/complementarity.py",
-      (("K[:m] @ w if m is not None", "K[:, :m].T @ w if m is not None"),)),
     D("cholesky_block_trailing", "trailing Cholesky: a solve with the trailing block of the "
       "kept factor for the leading one", "femadh/contact/linalg.py",
       (("blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])",

@@ -1,6 +1,6 @@
 """The trailing Cholesky kept as its single-precision factor (two triangular solves per
-preconditioner application, no inverse), the corrector's contact and free rows of K w, and the
-landing descent's damped Hessian factorised in place.
+preconditioner application, no inverse), and the landing descent's damped Hessian factorised
+in place.
 
 Judged independently: the energy Hessian at a state's gaps (numpy's eigvalsh for positive
 definiteness, not a Cholesky) against the factor's solves and the blocks it covers; the

@@ -162,9 +162,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         if np.any(h[I] <= 0):
             break  # the guess put the surfaces through each other: hopeless, report failure
         P = problem.pressure(h)
+        F_I = (K @ w)[I] - P[I]
         m = disk_size(A)
-        # the elastic pressure on the free rows only (of a disk: the trailing rows, a view)
-        F_I = (K[m:] @ w if m is not None else (K @ w)[I]) - P[I]
         dw = None
         if m is not None and KRYLOV and not adhesion and n - m > KRYLOV_MIN_FREE:
             # a disk: a Newton step solved by GMRES on the exact Jacobian, preconditioned by
@@ -183,9 +182,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         P = problem.pressure(h)
         pc = np.zeros(n)
         if sigma is not None:
-            # (the contact rows only: of a disk the leading m rows, a view; with the free rows
-            # above, one product with K per iteration instead of two)
-            pc[A] = P[A] - (K[:m] @ w if m is not None else (K @ w)[A])
+            pc[A] = P[A] - (K @ w)[A]
             # a contact node stays while its asperities push (lambda = pc + P_LJa > 0: with
             # eq 20 on the contact set it holds a net tension up to P_LJa) ...
             new_A = (A & (pc + adhesion > 0)) | (I & (h < sigma))
