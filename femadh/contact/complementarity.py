@@ -302,9 +302,11 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
         if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
                 or stalled:
             idx = np.flatnonzero(I)
-            M = K[idx[:, None], idx]
+            # the free block in LAPACK's (Fortran) order, factorised in place (K.T's block,
+            # transposed: the same values, without the wrapper's transposing copy)
+            M = K.T[idx[:, None], idx].T
             add_jacobian(M, problem.law_jacobian(h), idx)
-            lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False), I, True
+            lu, lu_I, fresh = linalg.lu_factor(M, check_finite=False, overwrite_a=True), I, True
             n_factor += 1
             res_prev = math.inf
         else:

@@ -18,7 +18,7 @@ class TrailingLU:
     def __init__(self, K, D, m0, scale=None):
         n = K.shape[0]
         # reversed trailing block, a copy (the reversed slice is cheaper than fancy indexing)
-        M = np.array(K[m0:, m0:][::-1, ::-1])
+        M = np.array(K[m0:, m0:][::-1, ::-1], order="F")    # LAPACK's order: no 2nd copy
         if D.ndim == 2:     # a sub-grid law's tridiagonal Jacobian (ContactProblem.law_jacobian)
             M += D[m0:, m0:][::-1, ::-1]
         else:
@@ -30,7 +30,7 @@ class TrailingLU:
         if self.scale is not None:
             M *= self.scale[m0:][::-1, None]
         self.n, self.m0 = n, m0
-        self.lu, self.piv = linalg.lu_factor(M, check_finite=False)
+        self.lu, self.piv = linalg.lu_factor(M, check_finite=False, overwrite_a=True)
         swaps = np.flatnonzero(self.piv != np.arange(n - m0))
         self.k_valid = int(swaps[0]) if swaps.size else n - m0
         self._block = (None, None)
@@ -41,7 +41,9 @@ class TrailingLU:
     def _lu_block(self, m):
         k = self.n - m
         if self._block[0] != k:
-            lu = self.lu if k == self.lu.shape[0] else np.ascontiguousarray(self.lu[:k, :k])
+            # (in LAPACK's order, as getrf left it: a C-ordered block was copied once more
+            # by the wrapper on every solve)
+            lu = self.lu if k == self.lu.shape[0] else np.asfortranarray(self.lu[:k, :k])
             self._block = (k, (lu, self.piv[:k]))
         return self._block[1]
 
