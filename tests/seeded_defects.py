@@ -882,6 +882,17 @@ DEFECTS = [
       "femadh/contact/linalg.py",
       (("out._kept = np.asfortranarray(kept, dtype=PRECONDITIONER_DTYPE)",
         "out._kept = np.asfortranarray(kept.T, dtype=PRECONDITIONER_DTYPE)"),)),
+    D("trailing_lu_block_trailing", "trailing LU: a chord solve with the trailing block of "
+      "the factor for the leading one", "femadh/contact/linalg.py",
+      (("else np.asfortranarray(self.lu[:k, :k])", "else np.asfortranarray(self.lu[-k:, -k:])"),)),
+    D("general_lu_transposed", "the corrector's general LU: the free block of K transposed",
+      "femadh/contact/complementarity.py",
+      (("            M = K.T[idx[:, None], idx].T", "            M = K.T[idx[:, None], idx]"),)),
+    D("stability_without_law", "stability test (collocated laws): the elastic block factorised "
+      "for the Hessian, the law's softening dropped", "femadh/contact/stability.py",
+      (("lapack.dpotrf(H.T, lower=False, clean=False, overwrite_a=True)",
+        "lapack.dpotrf(problem.S_sym[np.ix_(free, free)], lower=False, clean=False, "
+        "overwrite_a=True)"),)),
     D("landing_damps_the_hessian_itself", "landing descent: each trial damping added to the "
       "Hessian itself (a view), earlier dampings carried over",
       "femadh/contact/landing.py",
