@@ -60,7 +60,7 @@ def landed(slider):
         fallbacks.append((d, starts[-1], descent))
         return real_relaxed(problem, d, st, descent, **kw)
     # which fold's landing loses its equilibrium depends on the path to it at round-off: with
-    # the Krylov preconditioner's inverse kept in single precision (linalg.PRECONDITIONER_DTYPE,
+    # the Krylov preconditioner's factor kept in single precision (linalg.PRECONDITIONER_DTYPE,
     # the solver's default) the approach on this member passes both folds without needing a
     # fallback (measured: 2 jumps, 0 fallbacks), with it in double it reaches the landing
     # described above (2 jumps, 1 fallback). The landing itself is what is tested here: the

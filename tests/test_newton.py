@@ -136,8 +136,8 @@ def test_lattice_snaps_are_stepped_over_and_contact_snaps_stay_jumps(monkeypatch
 def test_trailing_cholesky_solves_every_covered_trailing_block(dtype, tol, monkeypatch):
     """The reversed Cholesky's leading blocks are the trailing blocks' factors (no
     pivoting): each solve meets its own block to round-off - of double precision, and of the
-    single precision the kept inverse has by default (linalg.PRECONDITIONER_DTYPE; measured
-    residual 3.9e-7 of the right-hand side here, condition number ~10) - a block beyond the
+    single precision the kept factor has by default (linalg.PRECONDITIONER_DTYPE; measured
+    residual 3.4e-7 of the right-hand side here, condition number ~10) - a block beyond the
     positive definite part is refused, not solved."""
     from femadh.contact import linalg as la
 
