@@ -55,6 +55,10 @@ LATTICE_FOLDS = True
 DOUBLE_TO_FOLD = False
 #: corrector solves a member's fold search may take (a healthy one: 10-20)
 MAX_FOLD_SOLVES = 80
+#: a member's contact radius at zero force from the fine run's sign-change interval alone
+#: where the member's F_ex changes sign there too (2 states per branch); its neighbours
+#: (4 states) only where it does not. False: the four states always (as before)
+ZERO_FORCE_PAIR_FIRST = True
 
 
 class _NotReduced(Exception):
@@ -363,7 +367,17 @@ def _zero_force_radius(m, res, snaps, branch):
           and f[k] != f[k + 1]]
     if not ks:
         return None
-    window = [j for j in range(ks[0] - 1, ks[0] + 3) if 0 <= j < len(f)]
+    k = ks[0]
+    if ZERO_FORCE_PAIR_FIRST:
+        # the fine run's interval first: where the member's F_ex changes sign there too, its
+        # crossing is read off those two states alone (the window's first crossing is the
+        # same unless the member's F_ex changes sign twice within three grid steps)
+        sts = [m.state(branch, snaps[branch], j) for j in (k, k + 1)]
+        rc = _zero_crossing([s.d for s in sts], [m.f_ex(s) for s in sts],
+                            [s.r_c for s in sts])
+        if math.isfinite(rc):
+            return rc
+    window = [j for j in range(k - 1, k + 3) if 0 <= j < len(f)]
     sts = [m.state(branch, snaps[branch], j) for j in window]
     rc = _zero_crossing([s.d for s in sts], [m.f_ex(s) for s in sts], [s.r_c for s in sts])
     if not math.isfinite(rc):
@@ -372,7 +386,7 @@ def _zero_force_radius(m, res, snaps, branch):
     return rc
 
 
-def reduced_member(scene, member, problem, sink, res):
+def reduced_member(scene, member, problem, sink, res, deepest=True):
     """The member's headline numbers from the states they are read at (see the module
     docstring), or (None, why) where the member must be traced whole.
 
@@ -386,6 +400,9 @@ def reduced_member(scene, member, problem, sink, res):
         The fine run's sink: its committed states and its peak.
     res : ContactResult
         The fine run's result: its curves and jumps.
+    deepest : bool
+        Solve the deepest separation's state (F_LJ and F_ex there); False where the members
+        placed by its contact edge (:func:`deepest_locked`) give those numbers' grid part.
 
     Returns
     -------
@@ -408,7 +425,7 @@ def reduced_member(scene, member, problem, sink, res):
             return None, "a lattice-trapped member (traced whole)"
         hl = {}
         fine = res.headline
-        if "F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine:
+        if deepest and ("F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine):
             from ..contact.forces import state_forces
 
             st = m.state("approach", snaps["approach"], len(snaps["approach"]) - 1)
