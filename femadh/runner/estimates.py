@@ -64,6 +64,10 @@ MAX_REFINEMENTS = 5
 #: run's (femadh.runner.members); False traces every member whole (the reference the reduced
 #: members are tested against)
 REDUCED_MEMBERS = True
+#: where the members placed by the deepest state's contact edge give the forces there, the
+#: family's reduced members do not solve that state (its grid part would be replaced: one
+#: solve less per member); False: they solve it anyway (as before)
+LOCKED_DEEPEST_ONLY = True
 
 
 def variant(scene, **changes):
@@ -204,9 +208,9 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         with _phase(f"estimate: {label}"):
             # the member solved only where the headline numbers are read, from the fine
             # run's states (femadh.runner.members); traced whole where it cannot stand in
-            hl_m, how = (reduced_member(scene, member, problem, sink, res,
-                                        deepest=locked is None) if REDUCED_MEMBERS
-                         else (None, "reduced members off"))
+            deepest = locked is None or not LOCKED_DEEPEST_ONLY
+            hl_m, how = (reduced_member(scene, member, problem, sink, res, deepest=deepest)
+                         if REDUCED_MEMBERS else (None, "reduced members off"))
             if hl_m is not None:
                 levels.append(hl_m)
                 solved.append({"member": label, "reduced": True, "solves": how})
