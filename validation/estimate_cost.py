@@ -36,6 +36,22 @@ PARTS = ("deepest", "peak grid states", "peak search", "folds", "zero force", "e
 @contextlib.contextmanager
 def _setting(flags):
     saved = {}
+    flags = dict(flags)
+    xtol = flags.pop("member_peak_xtol", None)
+    if xtol is not None:
+        # what-if only (not a setting of femadh): the members' peak searches at another
+        # tolerance in d, the fine run's own search unchanged
+        orig = estimates.reduced_member
+
+        def reduced(*a, **kw):
+            from femadh.runner import peak
+            old, peak.PEAK_XTOL_FRACTION = peak.PEAK_XTOL_FRACTION, xtol
+            try:
+                return orig(*a, **kw)
+            finally:
+                peak.PEAK_XTOL_FRACTION = old
+        saved[(estimates, "reduced_member")] = orig
+        estimates.reduced_member = reduced
     for k, v in flags.items():
         mod = members if hasattr(members, k) else estimates
         saved[(mod, k)] = getattr(mod, k)
@@ -210,7 +226,14 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--only", help="the scenes whose name contains this (no file written)")
+    ap.add_argument("--what-if-member-xtol", type=float, default=None, metavar="F",
+                    help="add a third setting: 'after' with the members' peak searches at "
+                    "tolerance F of the bracket (femadh.runner.peak.PEAK_XTOL_FRACTION, 1e-4; "
+                    "a measurement, not a setting femadh has)")
     args = ap.parse_args(argv)
+    if args.what_if_member_xtol is not None:
+        SETTINGS["what-if"] = {**SETTINGS["after"],
+                               "member_peak_xtol": args.what_if_member_xtol}
     load0 = os.getloadavg()
     rows = []
     for name, (_n, requests, _h, _q) in CASES.items():
@@ -232,42 +255,54 @@ def main(argv=None):
              f"Load (1/5/15-minute averages) at the start {load0[0]:.2f}/{load0[1]:.2f}/"
              f"{load0[2]:.2f}, at the end {load1[0]:.2f}/{load1[1]:.2f}/{load1[2]:.2f} "
              f"on 2 cores; one BLAS thread; median of {args.repeat} runs. Counts are the "
-             "last trial's estimate (the one the ratio judges), both members together.", "",
-             "## Time", "",
-             "| scene | request | nodes | solve (s) | estimate (s) before → after | "
-             "estimate / solve before → after |", "|---|---|---|---|---|---|"]
+             "last trial's estimate (the one the ratio judges), both members together."]
+    if "what-if" in SETTINGS:
+        lines += ["", "\"what-if\": \"after\" with the members' peak searches at "
+                  f"{args.what_if_member_xtol:g} of their bracket in d instead of "
+                  "PEAK_XTOL_FRACTION (femadh.runner.peak, 1e-4) - a measurement of what "
+                  "that part of the estimate costs, not a setting femadh has."]
+    names = list(SETTINGS)
+    arrow = " → ".join(names)
+    lines += ["", "## Time", "",
+              f"| scene | request | nodes | solve (s) | estimate (s) {arrow} | "
+              f"estimate / solve {arrow} |", "|---|---|---|---|---|---|"]
     for name, acc, out in rows:
-        b, a = out["before"], out["after"]
+        a = out["after"]
         lines.append(f"| {name} | {acc:g} | {a[3]} | {_med([x[2] for x in a[0]]):.3f} | "
-                     f"{_med([x[1] for x in b[0]]):.3f} → {_med([x[1] for x in a[0]]):.3f} | "
-                     f"{_med([x[0] for x in b[0]]):.2f} → {_med([x[0] for x in a[0]]):.2f} |")
+                     + " → ".join(f"{_med([x[1] for x in out[n][0]]):.3f}" for n in names)
+                     + " | "
+                     + " → ".join(f"{_med([x[0] for x in out[n][0]]):.2f}" for n in names)
+                     + " |")
     keys = ("states", "fresh states", "solves", "iterations", "factorisations", "folds",
             "landings", "windowed searches", "whole-bracket searches")
-    lines += ["", "## Work by part (before → after)", "",
+    lines += ["", f"## Work by part ({arrow})", "",
               "| scene | request | part | " + " | ".join(keys) + " |",
               "|---|---|---|" + "---|" * len(keys)]
+
+    def cell(vals):
+        return " → ".join(str(v) for v in vals) if len(set(vals)) > 1 else str(vals[0])
     for name, acc, out in rows:
-        cb, ca = out["before"][1], out["after"][1]
+        cs = [out[n][1] for n in names]
         for part in PARTS:
-            if not any(cb[part].values()) and not any(ca[part].values()):
+            if not any(any(c[part].values()) for c in cs):
                 continue
-            cells = [f"{cb[part][k]} → {ca[part][k]}" if cb[part][k] != ca[part][k]
-                     else f"{ca[part][k]}" for k in keys]
-            lines.append(f"| {name} | {acc:g} | {part} | " + " | ".join(cells) + " |")
-        tb = {k: _sum(cb, k) for k in keys}
-        ta = {k: _sum(ca, k) for k in keys}
-        lines.append(f"| {name} | {acc:g} | **all** | " + " | ".join(
-            f"{tb[k]} → {ta[k]}" if tb[k] != ta[k] else f"{ta[k]}" for k in keys) + " |")
-    lines += ["", "## What the estimate says (before → after)", "",
-              "Headline numbers of both settings are compared bit for bit; the estimated "
-              "errors that moved are listed.", ""]
+            lines.append(f"| {name} | {acc:g} | {part} | "
+                         + " | ".join(cell([c[part][k] for c in cs]) for k in keys) + " |")
+        lines.append(f"| {name} | {acc:g} | **all** | "
+                     + " | ".join(cell([_sum(c, k) for c in cs]) for k in keys) + " |")
+    lines += ["", "## What the estimate says", "",
+              "Headline numbers compared bit for bit with \"before\"; the estimated errors "
+              "that moved are listed.", ""]
     for name, acc, out in rows:
-        hb, ha = out["before"][2], out["after"][2]
-        head = [k for k in hb if not k.endswith("_error") and not _same(hb[k], ha.get(k))]
-        err = [k for k in hb if k.endswith("_error") and not _same(hb[k], ha.get(k))]
-        lines.append(f"- {name} {acc:g}: headline {'identical' if not head else head}; "
-                     + ("estimates identical" if not err else "estimates moved: " + ", ".join(
-                         f"{k} {hb[k]:.6g} → {ha[k]:.6g}" for k in err)))
+        hb = out["before"][2]
+        for n in names[1:]:
+            ha = out[n][2]
+            head = [k for k in hb if not k.endswith("_error") and not _same(hb[k], ha.get(k))]
+            err = [k for k in hb if k.endswith("_error") and not _same(hb[k], ha.get(k))]
+            lines.append(f"- {name} {acc:g}, {n}: headline "
+                         f"{'identical' if not head else head}; "
+                         + ("estimates identical" if not err else "estimates moved: "
+                            + ", ".join(f"{k} {hb[k]:.6g} → {ha[k]:.6g}" for k in err)))
     text = "\n".join(lines) + "\n"
     print(text)
     if not args.only:

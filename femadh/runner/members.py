@@ -8,7 +8,8 @@ of them is read off at most a few states of the fine run, so the member solves t
 only, each by Newton from the fine run's committed state there carried to the member's grid
 (:func:`femadh.discretisation.moving.interpolate_state`):
 
-- the deepest separation: one state (F_LJ and F_ex there);
+- the deepest separation: one state (F_LJ and F_ex there) - none where the members placed by
+  its contact edge (:func:`deepest_locked`) give those numbers' grid part;
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
   the fine run's (:func:`femadh.runner.peak.peak_adhesion`);
@@ -17,7 +18,8 @@ only, each by Newton from the fine run's committed state there carried to the me
   acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
   point and landing as a whole trace, in ~10-20 solves where halving the grid step down to
   the fold and landing takes ~40; the grid step traced whole where that finds none;
-- the contact radius at zero force: the grid states around the fine run's sign change.
+- the contact radius at zero force: the two grid states of the fine run's sign change, where
+  the member's F_ex changes sign between them too; else the four around it.
 
 A member state is the member's equilibrium on the fine run's branch at that separation; a
 whole trace reaches the same state where its branch is the same (measured on the Fig 3 scene's
