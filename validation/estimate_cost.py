@@ -90,6 +90,7 @@ def counting():
     """Wrap the entries the members call so that their work is counted by part."""
     import femadh.contact.complementarity as cc
     import femadh.contact.landing as cl
+    import femadh.contact.stepping as cs
     import femadh.runner.peak as pk
 
     cnt = Counter()
@@ -138,7 +139,11 @@ def counting():
 
     def estimate(f):
         def g(*a, **kw):
+            # the sweep's work since the last estimate: this trial's sweep (and the state
+            # carried to its grid)
+            sweep = dict(cnt.c["sweep"])
             cnt.reset()
+            cnt.c["sweep"].update(sweep)
             cnt.enter("estimate")
             try:
                 return f(*a, **kw)
@@ -165,6 +170,7 @@ def counting():
 
     patch(cc, "solve_complementarity", solves)
     patch(cl, "solve_complementarity", solves)       # a landing's polish (its own import)
+    patch(cs, "solve_complementarity", solves)       # the sweep's and a traced step's
     patch(cl, "land", counted("landings"))
     patch(pk, "peak_adhesion", lambda f: _peak_counted(f, cnt))
     patch(pk, "state_between", counted("fresh states"))
@@ -264,14 +270,22 @@ def main(argv=None):
     names = list(SETTINGS)
     arrow = " → ".join(names)
     lines += ["", "## Time", "",
+              "Newton iterations: the members' (every part below) over the sweep's (the last "
+              "trial's, with the state carried to its grid); a member's iteration is on "
+              "fewer nodes than the sweep's, so this ratio is an upper bound of the work's "
+              "ratio that the load does not move.", "",
               f"| scene | request | nodes | solve (s) | estimate (s) {arrow} | "
-              f"estimate / solve {arrow} |", "|---|---|---|---|---|---|"]
+              f"estimate / solve {arrow} | Newton iterations estimate / sweep {arrow} |",
+              "|---|---|---|---|---|---|---|"]
     for name, acc, out in rows:
         a = out["after"]
         lines.append(f"| {name} | {acc:g} | {a[3]} | {_med([x[2] for x in a[0]]):.3f} | "
                      + " → ".join(f"{_med([x[1] for x in out[n][0]]):.3f}" for n in names)
                      + " | "
                      + " → ".join(f"{_med([x[0] for x in out[n][0]]):.2f}" for n in names)
+                     + " | "
+                     + " → ".join(f"{_sum(out[n][1], 'iterations')}/"
+                                  f"{out[n][1]['sweep']['iterations']}" for n in names)
                      + " |")
     keys = ("states", "fresh states", "solves", "iterations", "factorisations", "folds",
             "landings", "windowed searches", "whole-bracket searches")
