@@ -1192,6 +1192,10 @@ DEFECTS = [
     D("est_locked_not_applied", "edge-placed members solved but their grid part not applied",
       "femadh/runner/estimates.py",
       (("    if locked is not None and levels:", "    if locked is not None and not levels:"),)),
+    D("est_fold_stall_inverted", "member fold decision: the whole budget where it should stop "
+      "on stagnation, stagnation where it should not", "femadh/runner/members.py",
+      (("stall_iter=None if step == 1 and not FOLD_DECISION_STALL",
+        "stall_iter=None if step == 1 and FOLD_DECISION_STALL"),)),
     D("roughness_interrupt_ignored", "validation/roughness.py: a run stopped by a signal does "
       "not stop the script (its loops go on)", "validation/roughness.py",
       (('    if res.status == "interrupted":\n        raise Interrupted(res.exit_code - 128)',

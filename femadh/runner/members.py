@@ -61,6 +61,16 @@ MAX_FOLD_SOLVES = 80
 #: where the member's F_ex changes sign there too (2 states per branch); its neighbours
 #: (4 states) only where it does not. False: the four states always (as before)
 ZERO_FORCE_PAIR_FIRST = True
+#: a member's fold decision (the one-lattice-step trial beyond its last state) gives up when
+#: its corrector stops making progress (STALL_ITER), as the stepping's larger trials do,
+#: instead of running to max_iter: beyond a fold no equilibrium is near and the failing
+#: corrector took the whole budget (Fig 4 at 1e-3: 296 of the members' 409 Newton
+#: iterations; with it 118, every fold, landing and estimate bit for bit the same at 1e-2,
+#: 3e-3 and 1e-3). A decision cut short by a slow corrector that would have converged is no
+#: fold here: the landing from the last state then ends on the same branch, releasing no
+#: more than the step's work (:func:`~femadh.contact.stepping.lattice_snap`), and the walk
+#: goes on from it. False: the whole budget (as the fine run's stepping gives its own)
+FOLD_DECISION_STALL = True
 
 
 class _NotReduced(Exception):
@@ -288,7 +298,9 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         act = None if p.sigma is None else state.active | (p.contour(d) - w < p.sigma)
         kw = {} if act is None else {"active0": act}
         new = solve_complementarity(p, d, w, tol=sc.tolerance, max_iter=sc.max_iter,
-                                    factor=state.lu, stall_iter=None if step == 1 else STALL_ITER,
+                                    factor=state.lu,
+                                    stall_iter=None if step == 1 and not FOLD_DECISION_STALL
+                                    else STALL_ITER,
                                     **kw)
         solves, m.solves = solves + 1, m.solves + 1     # counted as made (a fallback's too)
         ok = new.converged and new.stable and bool(np.all(
