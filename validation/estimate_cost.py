@@ -1,6 +1,7 @@
 """What the error estimate costs, and where its time goes: the adaptive rows of
 validation/accuracy.py, each run with the estimate's reductions off ("before": every member
-solves the deepest state and four states around each zero-force crossing) and on ("after"),
+solves the deepest state and four states around each zero-force crossing, and its fold
+decisions run to max_iter) and on ("after"),
 counting the members' work by part - states, corrector solves, Newton iterations,
 factorisations, folds, landings, peak searches (windowed and over the whole bracket) and the
 fresh states they solve - and timing the estimate against the sweep it judges (median of
@@ -28,8 +29,10 @@ from .accuracy import CASES, SCENES, _adaptive, _timed
 
 RESULTS = Path(__file__).resolve().parent / "results"
 #: the settings compared: module flags of femadh.runner.members / estimates
-SETTINGS = {"before": {"ZERO_FORCE_PAIR_FIRST": False, "LOCKED_DEEPEST_ONLY": False},
-            "after": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True}}
+SETTINGS = {"before": {"ZERO_FORCE_PAIR_FIRST": False, "LOCKED_DEEPEST_ONLY": False,
+                       "FOLD_DECISION_STALL": False},
+            "after": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True,
+                      "FOLD_DECISION_STALL": True}}
 PARTS = ("deepest", "peak grid states", "peak search", "folds", "zero force", "edge-placed")
 
 
