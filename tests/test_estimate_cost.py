@@ -19,7 +19,8 @@ R_C = ("r_c_at_zero_force_approach_m", "r_c_at_zero_force_retract_m")
 
 def _fig3_banded():
     """The Fig 3 scene on the banded grid its accuracy 1e-2 run ends on (58 nodes, spacing
-    136.7 nm in a 6.56-um band, a = 25.3 um), its sweep as the scene's: F_ex changes sign on both branches."""
+    136.7 nm in a 6.56-um band, a = 25.3 um), its sweep as the scene's: F_ex changes sign on
+    both branches."""
     base = femadh.load_scene(f"{SCENES}/paper1_fig3.toml")
     raw = copy.deepcopy(base.raw)
     raw["solver"].pop("accuracy", None)
