@@ -1194,6 +1194,30 @@ DEFECTS = [
       "corrector solves uncounted", "femadh/runner/members.py",
       (("        solves, m.solves = solves + 1, m.solves + 1     # counted as made",
         "        solves = solves + 1     # counted as made"),)),
+    # -- the estimate's cost (estcost): member states solved only where the numbers need them
+    D("est_zero_pair_shifted", "member zero-force radius: the interval before the fine run's "
+      "sign change read first", "femadh/runner/members.py",
+      (("        sts = [m.state(branch, snaps[branch], j) for j in (k, k + 1)]",
+        "        sts = [m.state(branch, snaps[branch], j) for j in (k - 1, k)]"),)),
+    D("est_zero_pair_wide", "member zero-force radius: the crossing interpolated over two "
+      "grid steps", "femadh/runner/members.py",
+      (("        sts = [m.state(branch, snaps[branch], j) for j in (k, k + 1)]",
+        "        sts = [m.state(branch, snaps[branch], j) for j in (k, k + 2)]"),)),
+    D("est_zero_pair_unchecked", "member zero-force radius: the interval's value kept without "
+      "a sign change in it", "femadh/runner/members.py",
+      (("        if math.isfinite(rc):\n            return rc",
+        "        if True:\n            return rc"),)),
+    D("est_deepest_always_skipped", "family members skip the deepest state even without "
+      "edge-placed members", "femadh/runner/estimates.py",
+      (("            deepest = locked is None or not LOCKED_DEEPEST_ONLY",
+        "            deepest = False"),)),
+    D("est_locked_not_applied", "edge-placed members solved but their grid part not applied",
+      "femadh/runner/estimates.py",
+      (("    if locked is not None and levels:", "    if locked is not None and not levels:"),)),
+    D("est_fold_stall_inverted", "member fold decision: the whole budget where it should stop "
+      "on stagnation, stagnation where it should not", "femadh/runner/members.py",
+      (("stall_iter=None if step == 1 and not FOLD_DECISION_STALL",
+        "stall_iter=None if step == 1 and FOLD_DECISION_STALL"),)),
     D("roughness_interrupt_ignored", "validation/roughness.py: a run stopped by a signal does "
       "not stop the script (its loops go on)", "validation/roughness.py",
       (('    if res.status == "interrupted":\n        raise Interrupted(res.exit_code - 128)',

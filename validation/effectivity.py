@@ -119,16 +119,11 @@ def table(envelope_log=None):
 
 
 def deepest_reference(name, h_ref, radius_factor=2.0):
-    """The F_LJ of the reference at the deepest state, checked below its own spacing: the
-    reference run (band spacing h_ref, m) and members placed by its deepest contact edge at
-    h_ref / sqrt 2 and h_ref / 2 (:func:`femadh.runner.members.deepest_locked` with a ratio
-    below 1: one Newton solve each), Richardson at the order they show, plus the tail beyond
-    the reference's radius. Returns {"spacings_m", "F_LJ_N" (the three), "order",
-    "extrapolated_N", "tail_N", "limit_N"}."""
-    from femadh.estimate.richardson import observed_order_uneven, richardson
-    from femadh.runner.members import deepest_locked
-
-    from .effectivity_scan import capture
+    """The F_LJ of the reference at the deepest state, checked below its own spacing
+    (:func:`validation.accuracy.checked_deepest`: members placed by its deepest contact edge
+    at h_ref / sqrt 2 and h_ref / 2, Richardson at the order they show, plus the tail beyond
+    the reference's radius)."""
+    from .accuracy import capture, checked_deepest
 
     base = femadh.load_scene(SCENES / f"{name}.toml")
     reference(name, h_ref, radius_factor)           # the family's plan, cached
@@ -136,19 +131,12 @@ def deepest_reference(name, h_ref, radius_factor=2.0):
     sc = variant(base, grid={"spacing": h_ref, "band": fam["band"], "grading": fam["grading"]},
                  radius=radius_factor * fam["a"])
     res, got = capture(sc)
-    locked = deepest_locked(got["scene"], got["problem"], got["sink"], 2**-0.5, variant)
-    if locked is None:
+    out = checked_deepest(res, got)
+    if out is None:
         raise SystemExit(f"{name}: no members placed by the reference's deepest edge at "
                          f"{h_ref / 2**0.5:.3g} and {h_ref / 2:.3g} m (no edge the members can "
                          "be placed by, or a member that did not solve)")
-    (h1, h2), (lv1, lv2) = locked
-    q = [res.headline["F_LJ_deepest_N"], lv1["F_LJ_deepest_N"], lv2["F_LJ_deepest_N"]]
-    # the finest member first: spacings h2 < h1 < h_ref
-    p = observed_order_uneven(q[2], q[1], q[0], h1 / h2, h_ref / h1)
-    ext = q[2] + richardson(q[2], q[1], h1 / h2, p if p else 1.0)
-    tail = res.estimates["F_LJ_deepest_N"]["tail"]
-    return {"spacings_m": [h_ref, h1, h2], "F_LJ_N": q, "order": p, "extrapolated_N": ext,
-            "tail_N": tail, "limit_N": ext + tail}
+    return out
 
 
 if __name__ == "__main__":

@@ -7,38 +7,14 @@ same family at each band spacing and prints its headline numbers, with the fract
 spacing at which the contact edge of the deepest state sits (r_e / h mod 1).
 """
 import sys
-import warnings
 
 import femadh
 import femadh.runner.estimates as est
-from femadh.errors import MeshResolutionWarning
 from femadh.runner.members import contact_edge, reduced_member
 
-from .accuracy import SCENES, _adaptive
+from .accuracy import SCENES, _adaptive, capture
 
 Q = ("max_adhesion_N", "d_at_max_adhesion_m", "F_LJ_deepest_N", "jump_in_d_m", "jump_out_d_m")
-
-
-def capture(scene):
-    """Run ``scene`` with its estimate and keep (scene, res, problem, sink) of the last trial."""
-    got = {}
-    orig = est.estimate_errors
-
-    def spy(scene, res, problem, sink, half=0.0, *, run):
-        got.update(scene=scene, res=res, problem=problem, sink=sink)
-        return orig(scene, res, problem, sink, half, run=run)
-    est.estimate_errors = spy
-    import femadh.runner.contact as rc
-    saved = getattr(rc, "estimate_errors", None)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", MeshResolutionWarning)
-            res = femadh.run(scene, progress=False, figures=False)
-    finally:
-        est.estimate_errors = orig
-        if saved is not None:
-            rc.estimate_errors = saved
-    return res, got
 
 
 def main(argv=None):

@@ -64,6 +64,10 @@ MAX_REFINEMENTS = 5
 #: run's (femadh.runner.members); False traces every member whole (the reference the reduced
 #: members are tested against)
 REDUCED_MEMBERS = True
+#: where the members placed by the deepest state's contact edge give the forces there, the
+#: family's reduced members do not solve that state (its grid part would be replaced: one
+#: solve less per member); False: they solve it anyway (as before)
+LOCKED_DEEPEST_ONLY = True
 
 
 def variant(scene, **changes):
@@ -194,13 +198,19 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 "estimated: the stated errors lack it")
     levels = []
     ratio, members = coarser_members(scene, problem, green)
+    # the forces at the deepest separation: members placed by its contact edge (the same
+    # fraction of a spacing as the fine grid's), where they can be; the family's reduced
+    # members then skip that state (its grid part would be replaced)
+    locked = deepest_locked(scene, problem, sink, ratio, variant) \
+        if REDUCED_MEMBERS and members else None
     solved = []
     for i, (label, member) in enumerate(members):
         with _phase(f"estimate: {label}"):
             # the member solved only where the headline numbers are read, from the fine
             # run's states (femadh.runner.members); traced whole where it cannot stand in
-            hl_m, how = (reduced_member(scene, member, problem, sink, res) if REDUCED_MEMBERS
-                         else (None, "reduced members off"))
+            deepest = locked is None or not LOCKED_DEEPEST_ONLY
+            hl_m, how = (reduced_member(scene, member, problem, sink, res, deepest=deepest)
+                         if REDUCED_MEMBERS else (None, "reduced members off"))
             if hl_m is not None:
                 levels.append(hl_m)
                 solved.append({"member": label, "reduced": True, "solves": how})
@@ -223,11 +233,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
                                    ratio=ratio).items():
             parts.setdefault(k, {})["grid"] = v
-    # the forces at the deepest separation: members placed by its contact edge (the same
-    # fraction of a spacing as the fine grid's), where they can be
-    locked = deepest_locked(scene, problem, sink, ratio, variant) if REDUCED_MEMBERS and \
-        levels else None
-    if locked is not None:
+    if locked is not None and levels:
         (h1, h2), (lv1, lv2) = locked
         h0 = float(problem.grid.nodes[1])
         for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,

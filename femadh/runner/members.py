@@ -8,7 +8,8 @@ of them is read off at most a few states of the fine run, so the member solves t
 only, each by Newton from the fine run's committed state there carried to the member's grid
 (:func:`femadh.discretisation.moving.interpolate_state`):
 
-- the deepest separation: one state (F_LJ and F_ex there);
+- the deepest separation: one state (F_LJ and F_ex there) - none where the members placed by
+  its contact edge (:func:`deepest_locked`) give those numbers' grid part;
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
   the fine run's (:func:`femadh.runner.peak.peak_adhesion`);
@@ -17,7 +18,8 @@ only, each by Newton from the fine run's committed state there carried to the me
   acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
   point and landing as a whole trace, in ~10-20 solves where halving the grid step down to
   the fold and landing takes ~40; the grid step traced whole where that finds none;
-- the contact radius at zero force: the grid states around the fine run's sign change.
+- the contact radius at zero force: the two grid states of the fine run's sign change, where
+  the member's F_ex changes sign between them too; else the four around it.
 
 A member state is the member's equilibrium on the fine run's branch at that separation; a
 whole trace reaches the same state where its branch is the same (measured on the Fig 3 scene's
@@ -55,6 +57,20 @@ LATTICE_FOLDS = True
 DOUBLE_TO_FOLD = False
 #: corrector solves a member's fold search may take (a healthy one: 10-20)
 MAX_FOLD_SOLVES = 80
+#: a member's contact radius at zero force from the fine run's sign-change interval alone
+#: where the member's F_ex changes sign there too (2 states per branch); its neighbours
+#: (4 states) only where it does not. False: the four states always (as before)
+ZERO_FORCE_PAIR_FIRST = True
+#: a member's fold decision (the one-lattice-step trial beyond its last state) gives up when
+#: its corrector stops making progress (STALL_ITER), as the stepping's larger trials do,
+#: instead of running to max_iter: beyond a fold no equilibrium is near and the failing
+#: corrector took the whole budget (Fig 4 at 1e-3: 296 of the members' 409 Newton
+#: iterations; with it 118, every fold, landing and estimate bit for bit the same at 1e-2,
+#: 3e-3 and 1e-3). A decision cut short by a slow corrector that would have converged is no
+#: fold here: the landing from the last state then ends on the same branch, releasing no
+#: more than the step's work (:func:`~femadh.contact.stepping.lattice_snap`), and the walk
+#: goes on from it. False: the whole budget (as the fine run's stepping gives its own)
+FOLD_DECISION_STALL = True
 
 
 class _NotReduced(Exception):
@@ -282,7 +298,9 @@ def _lattice_fold(m, d_fold, d_land, before, after):
         act = None if p.sigma is None else state.active | (p.contour(d) - w < p.sigma)
         kw = {} if act is None else {"active0": act}
         new = solve_complementarity(p, d, w, tol=sc.tolerance, max_iter=sc.max_iter,
-                                    factor=state.lu, stall_iter=None if step == 1 else STALL_ITER,
+                                    factor=state.lu,
+                                    stall_iter=None if step == 1 and not FOLD_DECISION_STALL
+                                    else STALL_ITER,
                                     **kw)
         solves, m.solves = solves + 1, m.solves + 1     # counted as made (a fallback's too)
         ok = new.converged and new.stable and bool(np.all(
@@ -363,7 +381,17 @@ def _zero_force_radius(m, res, snaps, branch):
           and f[k] != f[k + 1]]
     if not ks:
         return None
-    window = [j for j in range(ks[0] - 1, ks[0] + 3) if 0 <= j < len(f)]
+    k = ks[0]
+    if ZERO_FORCE_PAIR_FIRST:
+        # the fine run's interval first: where the member's F_ex changes sign there too, its
+        # crossing is read off those two states alone (the window's first crossing is the
+        # same unless the member's F_ex changes sign twice within three grid steps)
+        sts = [m.state(branch, snaps[branch], j) for j in (k, k + 1)]
+        rc = _zero_crossing([s.d for s in sts], [m.f_ex(s) for s in sts],
+                            [s.r_c for s in sts])
+        if math.isfinite(rc):
+            return rc
+    window = [j for j in range(k - 1, k + 3) if 0 <= j < len(f)]
     sts = [m.state(branch, snaps[branch], j) for j in window]
     rc = _zero_crossing([s.d for s in sts], [m.f_ex(s) for s in sts], [s.r_c for s in sts])
     if not math.isfinite(rc):
@@ -372,7 +400,7 @@ def _zero_force_radius(m, res, snaps, branch):
     return rc
 
 
-def reduced_member(scene, member, problem, sink, res):
+def reduced_member(scene, member, problem, sink, res, deepest=True):
     """The member's headline numbers from the states they are read at (see the module
     docstring), or (None, why) where the member must be traced whole.
 
@@ -386,6 +414,9 @@ def reduced_member(scene, member, problem, sink, res):
         The fine run's sink: its committed states and its peak.
     res : ContactResult
         The fine run's result: its curves and jumps.
+    deepest : bool
+        Solve the deepest separation's state (F_LJ and F_ex there); False where the members
+        placed by its contact edge (:func:`deepest_locked`) give those numbers' grid part.
 
     Returns
     -------
@@ -408,7 +439,7 @@ def reduced_member(scene, member, problem, sink, res):
             return None, "a lattice-trapped member (traced whole)"
         hl = {}
         fine = res.headline
-        if "F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine:
+        if deepest and ("F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine):
             from ..contact.forces import state_forces
 
             st = m.state("approach", snaps["approach"], len(snaps["approach"]) - 1)
