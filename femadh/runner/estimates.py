@@ -111,6 +111,7 @@ def refine_peak(scene, res, problem, sink):
     F, d, half = peak_adhesion(problem, prev, best, nxt, scene)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
+    hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
     return half
 
 

@@ -276,9 +276,9 @@ def trace_arclength(scene, problem, sink):
             if kind == "fold":
                 before = st
                 continue        # the fold state is the jump's 'before', not a grid state
-            sink.state(branch, st)
-            if kind == "land":
+            if kind == "land":  # (the fold first, as the stepping does: the peak's pieces)
                 sink.jump(Jump(branch, dk, dk, 0.0, before, st))
+            sink.state(branch, st)
     sink.close()
 
 
