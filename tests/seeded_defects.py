@@ -1194,10 +1194,9 @@ DEFECTS = [
       (("        if start:\n            prev = snap\n", "        if False:\n            prev = snap\n"),)),
     D("peakfold_end_open", "peak: a fold's last state not the end of its piece's bracket",
       "femadh/runner/sink.py",
-      (("            self.peak = [branch, f, prev, snap, snap if end else None]\n"
-        "            self._need_next = not end",
-        "            self.peak = [branch, f, prev, snap, None]\n"
-        "            self._need_next = True"),)),
+      (("            self.peak = [branch, f, prev, snap, snap if end else None]\n",
+        "            self.peak = [branch, f, prev, snap, None]\n"),
+       ("            self._need_next = not end", "            self._need_next = True"))),
     D("peakfold_landing_force", "peak: a landing's F_ex taken from the state before the fold",
       "femadh/runner/sink.py",
       (("(jump.before, f_before), (jump.after, f_after))))",
@@ -1213,6 +1212,10 @@ DEFECTS = [
     D("peakfold_checkpoint_dropped", "checkpoint: the fold states of the peak's bracket not "
       "saved (a resumed search from re-solved ones)", "femadh/runner/checkpoint.py",
       (("    data.update(_fold_data(sink))\n", ""),)),
+    D("peakfold_search_last_grid", "follow band: the peak searched on the sweep's last grid, "
+      "not on its states' own", "femadh/runner/estimates.py",
+      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)',
+        "peak_adhesion(problem, prev, best, nxt, scene)"),)),
     D("peakfold_resume_order", "resume: the folds not replayed (the resumed bracket reaches "
       "across them)",
       "femadh/runner/sink.py",

@@ -51,6 +51,10 @@ class Sink:
         # bracket may be the wider: see _element)
         self.peak, self._prev, self._need_next = None, None, False
         self._rival = None
+        # the problem whose grid the peak's (and the rival's) bracket states are on: a band
+        # that follows the edge exchanges grids, and the search solves on the states' own
+        # (femadh.runner.tracing._exchange)
+        self.peak_problem = self.rival_problem = problem
         # each fold per branch: (committed states of the branch before it, the last state of
         # the departing piece, the landing), the two as Committed records with their F_ex;
         # a landing starts a new piece of the branch (femadh.runner.peak.piece)
@@ -146,9 +150,11 @@ class Sink:
         if peak is not None and peak[0] != branch and snap.d == peak[3].d and \
                 abs(f - peak[1]) <= TIE_REL * abs(peak[1]) and self._rival is None:
             self._rival = [branch, f, prev, snap, snap if end else None]
+            self.rival_problem = self.problem
             self._settle()
         elif peak is None or f > peak[1]:
             self.peak = [branch, f, prev, snap, snap if end else None]
+            self.peak_problem = self.problem
             self._need_next = not end
             self._rival = None
         self._prev = (branch, snap)
@@ -175,7 +181,7 @@ class Sink:
             return
         if p[2] is None or p[4] is None or _extent(r) > _extent(p) or (
                 _extent(r) == _extent(p) and r[1] > p[1]):
-            self.peak = r
+            self.peak, self.peak_problem = r, self.rival_problem
             self._need_next = False
         self._rival = None
 
