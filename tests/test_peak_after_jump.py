@@ -103,6 +103,7 @@ def test_a_fold_bounds_the_peak_bracket():
         s = Sink.__new__(Sink)
         s.peak, s._prev, s._need_next, s._rival, s.pieces, s.committed, s.last = \
             None, None, False, None, {}, {}, {}
+        s.problem = s.peak_problem = s.rival_problem = None
         return s
 
     for f_next in (8.5, 10.0):           # the landing leads; the state after it leads
