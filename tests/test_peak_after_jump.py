@@ -58,11 +58,17 @@ def _text():
 
 
 @pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    """(scene file, its run with the peak search, the dense scan's (F, d) maximum of the
-    contact piece from the landing to the next grid state, the landing's d, that state's d)."""
+def scene_path(tmp_path_factory):
     path = tmp_path_factory.mktemp("peak") / "jump.toml"
     path.write_text(_text())
+    return path
+
+
+@pytest.fixture(scope="module")
+def case(scene_path):
+    """(scene file, its run with the peak search, the dense scan's (F, d) maximum of the
+    contact piece from the landing to the next grid state, the landing's d, that state's d)."""
+    path = scene_path
     sc = femadh.load_scene(path)
     res = femadh.run(sc, progress=False, estimate="peak")
     problem, sweeps, err = solve_sweeps(sc)
@@ -80,6 +86,7 @@ def case(tmp_path_factory):
     return path, res, best, jump.d_land, nxt.d
 
 
+@pytest.mark.slow
 def test_the_peak_just_after_the_jump_in_is_found(case):
     _, res, (f_dense, d_dense), d_land, d_next = case
     hl = res.headline
@@ -147,6 +154,7 @@ def test_a_fold_bounds_the_peak_bracket():
     assert s.peak[2:] == [e[1], b3, b3]
 
 
+@pytest.mark.slow
 def test_a_resumed_run_searches_from_the_same_landing(case, tmp_path):
     """Stopped by SIGTERM right after the state past the landing (its bracket then holds the
     landing): resumed from the checkpoint, the largest adhesion is the uninterrupted run's bit
@@ -172,11 +180,10 @@ def test_a_resumed_run_searches_from_the_same_landing(case, tmp_path):
                 assert got[k] == pytest.approx(want[k], rel=RESUME_REL, abs=0), k
 
 
-def test_the_sink_keeps_a_fold_s_states_with_their_own_forces(case):
+def test_the_sink_keeps_a_fold_s_states_with_their_own_forces(scene_path):
     """Sink.jump on the case's real fold: the landing is a candidate with its own F_ex and
     brackets its own side; the fold's last state ends the piece before it."""
-    path, *_ = case
-    sc = femadh.load_scene(path)
+    sc = femadh.load_scene(scene_path)
     problem, sweeps, _ = solve_sweeps(sc)
     ap = sweeps["approach"]
     (jump,) = ap.jumps
@@ -207,6 +214,7 @@ def _banded():
     return scene_from_dict(raw, base.path, bare_numbers=False)
 
 
+@pytest.mark.slow
 def test_members_search_the_piece_after_the_landing_as_a_whole_trace(monkeypatch):
     """The estimate's members solved on the fine run's piece (the landing brackets the peak)
     give the max adhesion's grid part of members traced whole (each its own sweep, folds
