@@ -1234,6 +1234,39 @@ DEFECTS = [
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',
         'return rec.get("status") in ("converged", "failed")'),)),
+    # -- the peak bracket bounded by folds (tests/test_peak_after_jump.py)
+    D("peakfold_landing_prev", "peak: a landing bracketed by the last state before the "
+      "fold (across it), not by itself", "femadh/runner/sink.py",
+      (("        if start:\n            prev = snap\n", "        if False:\n            prev = snap\n"),)),
+    D("peakfold_end_open", "peak: a fold's last state not the end of its piece's bracket",
+      "femadh/runner/sink.py",
+      (("            self.peak = [branch, f, prev, snap, snap if end else None]\n",
+        "            self.peak = [branch, f, prev, snap, None]\n"),
+       ("            self._need_next = not end", "            self._need_next = True"))),
+    D("peakfold_landing_force", "peak: a landing's F_ex taken from the state before the fold",
+      "femadh/runner/sink.py",
+      (("(jump.before, f_before), (jump.after, f_after))))",
+        "(jump.before, f_before), (jump.after, f_before))))"),)),
+    D("peakfold_tie_narrower", "peak: a tie at one separation goes to the narrower bracket",
+      "femadh/runner/sink.py",
+      (("if p[2] is None or p[4] is None or _extent(r) > _extent(p) or (",
+        "if p[2] is None or p[4] is None or _extent(r) < _extent(p) or ("),)),
+    D("peakfold_pieces_unsplit", "members: the fine run's branch walked as one piece (the "
+      "folds ignored)", "femadh/runner/peak.py",
+      (('    folds = list(getattr(sink, "pieces", {}).get(branch, []))',
+        "    folds = []"),)),
+    D("peakfold_checkpoint_dropped", "checkpoint: the fold states of the peak's bracket not "
+      "saved (a resumed search from re-solved ones)", "femadh/runner/checkpoint.py",
+      (("    data.update(_fold_data(sink))\n", ""),)),
+    D("peakfold_search_last_grid", "follow band: the peak searched on the sweep's last grid, "
+      "not on its states' own", "femadh/runner/estimates.py",
+      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)',
+        "peak_adhesion(problem, prev, best, nxt, scene)"),)),
+    D("peakfold_resume_order", "resume: the folds not replayed (the resumed bracket reaches "
+      "across them)",
+      "femadh/runner/sink.py",
+      (('            while folds.get(b) and (folds[b][0]["d_land_m"] - d) * sign <= 0:',
+        '            while folds.get(b) and (folds[b][0]["d_land_m"] - d) * sign < -1e-9:'),)),
 ]
 
 

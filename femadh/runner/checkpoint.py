@@ -56,6 +56,7 @@ def save_checkpoint(folder, sink):
     if st.edge_from is not None:        # the edge predictor's second point (stepping)
         data["edge_from"] = np.array(st.edge_from, dtype=float)
     data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
+    data.update(_fold_data(sink))
     lu = st.lu
     if lu is None:
         data["lu_kind"] = np.array("none")
@@ -113,3 +114,39 @@ def load_checkpoint(folder, k, d):
             return st
     except (OSError, ValueError, KeyError):
         return None
+
+
+def _fold_data(sink):
+    """The fold states (a fold's last state, a landing) that bracket the kept peak or its
+    tied rival (:class:`~femadh.runner.sink.Sink`): the files do not hold them, and a
+    resumed peak search needs them (bit for bit: :func:`load_fold_states`)."""
+    ids = {id(s) for folds in getattr(sink, "pieces", {}).values() for _, b, a in folds
+           for s in (b, a)}
+    held = [s for x in (sink.peak, getattr(sink, "_rival", None)) if x is not None
+            for s in x[2:5] if s is not None and id(s) in ids]
+    held = list({id(s): s for s in held}.values())
+    n = sink.problem.grid.n
+    if not held or any(np.ndim(s.w) != 1 or np.size(s.w) != n for s in held):
+        # (none, or on an exchanged grid: a run whose band follows the edge is not resumed
+        # mid-sweep)
+        return {}
+    return {"fold_d": np.array([s.d for s in held]), "fold_f": np.array([s.f_ex for s in held]),
+            "fold_w": np.array([s.w for s in held]),
+            "fold_active": np.array([s.active for s in held]),
+            "fold_r_c": np.array([s.r_c for s in held], dtype=float)}
+
+
+def load_fold_states(folder):
+    """{(d, F_ex): (w, active, r_c)} of the fold states the checkpoint holds (empty: none, no
+    checkpoint, unreadable)."""
+    path = folder / CHECKPOINT
+    if not path.exists():
+        return {}
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if "fold_d" not in z.files:
+                return {}
+            return {(float(d), float(f)): (w, a, float(rc)) for d, f, w, a, rc in zip(
+                z["fold_d"], z["fold_f"], z["fold_w"], z["fold_active"], z["fold_r_c"])}
+    except (OSError, ValueError, KeyError):
+        return {}

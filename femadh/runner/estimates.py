@@ -112,9 +112,10 @@ def refine_peak(scene, res, problem, sink):
     if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
         return 0.0
     branch, f_grid, prev, best, nxt = sink.peak
-    F, d, half = peak_adhesion(problem, prev, best, nxt, scene)
+    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
+    hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
     return half
 
 

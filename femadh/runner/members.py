@@ -180,19 +180,40 @@ class _Member:
 
 
 def _peak(m, sink, snaps, d_fine=None):
-    """(F, d) of the member's largest adhesion: its grid maximum near the fine run's, then
-    the bounded search between the grid states around it."""
-    from .peak import peak_adhesion
+    """(F, d) of the member's largest adhesion: its grid maximum near the fine run's on the
+    same piece of the branch (between the folds: :func:`femadh.runner.peak.pieces`), then
+    the bounded search between the states around it - a fold's landing or last state where
+    the piece ends there, as the fine run's bracket."""
+    from .peak import peak_adhesion, pieces
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]
-    i = next((j for j, s in enumerate(states) if s is best), None)
-    if i is None:
+    at = {id(s): j for j, s in enumerate(states)}
+    where = [(p, lands, folds) for p, lands, folds in pieces(sink, branch)
+             if any(s is best for s in p)]
+    if not where:
         raise _NotReduced("the fine run's peak state is not among its committed states")
-    n = len(states)
+    piece, lands, folds = where[0]
+    i = next(j for j, s in enumerate(piece) if s is best)
+    fold_states = {}
+
+    def member(j):
+        """The member's state at the piece's j-th state: a committed state's as
+        :meth:`_Member.state`; a fold's last state or landing by Newton from it carried."""
+        s = piece[j]
+        if id(s) in at:
+            return m.state(branch, states, at[id(s)])
+        if id(s) not in fold_states:
+            st = m.near(s, s.d)
+            if st is None:
+                raise _NotReduced(f"the member has no state on the fine run's piece at the "
+                                  f"fold's d = {s.d * 1e9:.6g} nm ({branch})")
+            fold_states[id(s)] = st
+        return fold_states[id(s)]
+    n = len(piece)
     k = i
     for _ in range(PEAK_WALK + 1):
-        f = {j: m.f_ex(m.state(branch, states, j)) for j in (k - 1, k, k + 1) if 0 <= j < n}
+        f = {j: m.f_ex(member(j)) for j in (k - 1, k, k + 1) if 0 <= j < n}
         top = max(f, key=lambda j: (f[j], -abs(j - k)))
         if top == k:
             break
@@ -201,16 +222,20 @@ def _peak(m, sink, snaps, d_fine=None):
         raise _NotReduced("the member's largest adhesion is not near the fine run's")
     if abs(k - i) > PEAK_WALK:
         raise _NotReduced("the member's largest adhesion is not near the fine run's")
-    st = m.state(branch, states, k)
-    if prev is None or nxt is None or k == 0 or k == n - 1:
+    st = member(k)
+    # the piece's ends: a landing brackets its own side, a fold's last state its own
+    j_lo = k - 1 if k > 0 else (0 if lands else None)
+    j_hi = k + 1 if k < n - 1 else (k if folds else None)
+    if prev is None or nxt is None or j_lo is None or j_hi is None:
         # the fine run's peak is at a branch end (no bracket): the grid value, as there
         return float(m.f_ex(st)), float(st.d)
-    around = (m.state(branch, states, k - 1), st, m.state(branch, states, k + 1))
+    around = (member(j_lo), st, member(j_hi))
     if k == i and d_fine is not None:
         # the member's peak lies within its grid difference of the fine run's: the search
         # on PEAK_WINDOW of the grid step around it (the same tolerance in d), the whole
         # bracket where the member's optimum ends at the window's edge
-        half = PEAK_WINDOW * abs(states[i + 1].d - states[i].d)
+        half = PEAK_WINDOW * (abs(piece[j_hi].d - piece[i].d)
+                              or abs(piece[i].d - piece[j_lo].d))
         F, d, tol = peak_adhesion(m.problem, *around, m.scene,
                                   within=(d_fine - half, d_fine + half), reuse=True)
         if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:

@@ -66,7 +66,9 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
     interpolated between the bracketing grid states and accepted only if it stays on that
     branch (within a quarter of every gap of the interpolation). The states may be
     :class:`~femadh.runner.sink.Committed` records (d, w, active, r_c, f_ex) as the files
-    hold them. ``within`` = (lo, hi) narrows the search to that part of the bracket (an
+    hold them. A fold bounds the bracket: the landing that starts a piece of the branch is
+    its own previous neighbour, the last state before a fold its own next one
+    (:func:`pieces`). ``within`` = (lo, hi) narrows the search to that part of the bracket (an
     estimate's member near the fine run's peak: fewer fresh states, the same absolute
     tolerance in d); ``reuse``: see :func:`state_between`. Returns (F, d, half-width of the
     final d bracket)."""
@@ -77,10 +79,15 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False):
     xatol = PEAK_XTOL_FRACTION * (hi - lo)
     if within is not None:
         lo, hi = max(lo, within[0]), min(hi, within[1])
+    if not hi > lo:
+        # a piece of one state (a landing that folds again at once): nothing between
+        return float(f_best), float(best.d), xatol
     found, fresh = {}, []
 
     def neg(d):
-        a, b = (prev, best) if (d - best.d) * (prev.d - best.d) > 0 else (best, nxt)
+        # (a fold's last state is its own next neighbour: only the side before it)
+        a, b = (prev, best) if nxt.d == best.d or (d - best.d) * (prev.d - best.d) > 0 \
+            else (best, nxt)
         st = state_between(problem, a, b, d, scene, reuse, _warm(fresh, a, b, d))
         if st is None:
             return -f_best
@@ -116,3 +123,28 @@ def _warm(fresh, a, b, d):
     if other is None or abs(other.d - near.d) < 1e-6 * abs(b.d - a.d):
         return near, (b.w - a.w) / (b.d - a.d)
     return near, (other.w - near.w) / (other.d - near.d)
+
+
+def pieces(sink, branch):
+    """The committed states and fold states of ``branch`` split into the pieces the folds
+    leave, in the order of the sweep: [(states, starts at a landing, ends at a fold)].
+
+    A piece holds its landing (the fold's state after the snap), the branch's committed
+    states up to the next fold and that fold's last state; a state at the separation of the
+    one before it is that state and is left out (a landing on a grid separation, a fold
+    right at a committed state), as the sink's peak bookkeeping does
+    (:meth:`femadh.runner.sink.Sink._element`)."""
+    states = sink.committed.get(branch, [])
+    folds = list(getattr(sink, "pieces", {}).get(branch, []))
+    out, cur, starts = [], [], False
+    for i in range(len(states) + 1):
+        while folds and folds[0][0] == i:
+            _, before, after = folds.pop(0)
+            if not (cur and cur[-1].d == before.d):
+                cur.append(before)
+            out.append((cur, starts, True))
+            cur, starts = [after], True
+        if i < len(states) and not (cur and cur[-1].d == states[i].d):
+            cur.append(states[i])
+    out.append((cur, starts, False))
+    return out

@@ -46,8 +46,19 @@ class Sink:
         self.profile_picks = {}
         self.bar = None
         self.scene = result.scene
-        # the state of largest F_ex and its neighbours (the peak search needs them)
+        # the state of largest F_ex and its neighbours on its piece of the branch (the peak
+        # search needs them), and a state at the same separation whose F_ex ties it (its
+        # bracket may be the wider: see _element)
         self.peak, self._prev, self._need_next = None, None, False
+        self._rival = None
+        # the problem whose grid the peak's (and the rival's) bracket states are on: a band
+        # that follows the edge exchanges grids, and the search solves on the states' own
+        # (femadh.runner.tracing._exchange)
+        self.peak_problem = self.rival_problem = problem
+        # each fold per branch: (committed states of the branch before it, the last state of
+        # the departing piece, the landing), the two as Committed records with their F_ex;
+        # a landing starts a new piece of the branch (femadh.runner.peak.piece)
+        self.pieces = {}
         # the last committed state of each branch (a resumed branch restarts from it), and
         # the last one whole (state number, branch, State: the checkpoint of a stopped run)
         self.last = {}
@@ -97,21 +108,88 @@ class Sink:
         prof["P_el_Pa"].append(p_el.copy())
 
     def _track_peak(self, branch, snap):
-        """Keep the committed state of largest F_ex (the first of equals) and its neighbours
-        on its branch."""
+        """A committed state: a candidate for the largest F_ex and the next neighbour of the
+        kept one (the last committed state of its branch is kept for a restart)."""
+        self._element(branch, snap)
+        self.last[branch] = snap
+
+    def _track_fold(self, branch, before, after, count=None):
+        """A fold of ``branch``: the departing piece ends at ``before`` (the last state
+        found stable on it) and a new piece starts at the landing ``after``; each is a state
+        of the curve and a candidate for the largest F_ex. Without this the bracket of a
+        peak next to a fold reached across it - an approach's peak just after its jump-in
+        was bracketed by the last state before the snap, whose interpolation with the
+        contact states the branch test turns down: the search kept the grid value (the
+        paper 1 slider, sigma = 0.489 nm, p/psat 0.25, approach only: 3.1e-3 below the
+        true maximum, validation/results/peak_after_jump.md)."""
+        count = len(self.committed.get(branch, [])) if count is None else count
+        self.pieces.setdefault(branch, []).append((count, before, after))
+        self._element(branch, before, end=True)
+        self._element(branch, after, start=True)
+
+    def _element(self, branch, snap, start=False, end=False):
+        """The peak bookkeeping of one state of the curve, in the order of the sweep.
+
+        ``start``: the first state of a piece (a landing): it brackets its own side. ``end``:
+        the last state of a piece (a fold's departing state): it is its own next neighbour.
+        A state at the separation of the one before it on its piece is that state (a landing
+        on a grid separation, a fold right at a committed state): not a new neighbour.
+        Ties (the same separation and F_ex within TIE_REL, e.g. approach and retract through
+        one contact state): the first is kept unless the other's bracket is wider (it holds
+        a part of the curve the first's does not: the first's is cut by a fold)."""
         f = snap.f_ex
-        prev = self._prev if self._prev is not None and self._prev[0] == branch else None
+        prev = self._prev[1] if self._prev is not None and self._prev[0] == branch else None
+        if start:
+            prev = snap
+        elif prev is not None and prev.d == snap.d:
+            if end:
+                self._close(branch, prev)
+            return
+        self._close(branch, snap)
+        peak = self.peak
+        if peak is not None and peak[0] != branch and snap.d == peak[3].d and \
+                abs(f - peak[1]) <= TIE_REL * abs(peak[1]) and self._rival is None:
+            self._rival = [branch, f, prev, snap, snap if end else None]
+            self.rival_problem = self.problem
+            self._settle()
+        elif peak is None or f > peak[1]:
+            self.peak = [branch, f, prev, snap, snap if end else None]
+            self.peak_problem = self.problem
+            self._need_next = not end
+            self._rival = None
+        self._prev = (branch, snap)
+
+    def _close(self, branch, snap):
+        """``snap`` is the next neighbour of the kept peak (and of its rival) still waiting
+        for one on ``branch``."""
         if self._need_next and self.peak is not None and self.peak[0] == branch:
             self.peak[4] = snap
-        self._need_next = False
-        if self.peak is None or f > self.peak[1]:
-            self.peak = [branch, f, prev[1] if prev else None, snap, None]
-            self._need_next = True
-        self._prev = (branch, snap)
-        self.last[branch] = snap
+            self._need_next = False
+        if self._rival is not None and self._rival[0] == branch and self._rival[4] is None:
+            self._rival[4] = snap
+            self._settle()
+
+    def _settle(self):
+        """The tied rival, once its bracket is complete, takes the kept peak's place if its
+        bracket spans more separations (the kept one's is cut by a fold, or missing); with
+        equal spans the larger F_ex, as without the rival (the first of equals)."""
+        r, p = self._rival, self.peak
+        if r[2] is None:                # a branch's first state: no wider bracket
+            self._rival = None
+            return
+        if r[4] is None:                # waits for its next neighbour
+            return
+        if p[2] is None or p[4] is None or _extent(r) > _extent(p) or (
+                _extent(r) == _extent(p) and r[1] > p[1]):
+            self.peak, self.peak_problem = r, self.rival_problem
+            self._need_next = False
+        self._rival = None
 
     def jump(self, jump):
         p = self.problem
+        f_before, f_after = (state_forces(p, s)[2] for s in (jump.before, jump.after))
+        self._track_fold(jump.branch, *(Committed(s.d, s.w, s.active, s.r_c, f) for s, f in (
+            (jump.before, f_before), (jump.after, f_after))))
         if self._keep:
             self.jump_states.append((jump.branch, jump.before, jump.after))
         # (each fold's last state and landing: where the estimate's members look for theirs)
@@ -125,8 +203,7 @@ class Sink:
         self.result.jumps.append({
             "branch": jump.branch, "d_fold_m": jump.d_fold, "d_land_m": jump.d_land,
             "resolution_m": jump.resolution,
-            "F_ex_before_N": state_forces(p, jump.before)[2],
-            "F_ex_after_N": state_forces(p, jump.after)[2],
+            "F_ex_before_N": f_before, "F_ex_after_N": f_after,
             "h0_before_m": jump.before.h0, "h0_after_m": jump.after.h0,
             "energy_released_J": released})
         if self.writer:
@@ -152,7 +229,8 @@ class Sink:
     def load(self, folder, resume):
         """Resume: the committed states and jumps of the previous run, into the result, as
         the uninterrupted run held them - the rows, the profiles it kept, the peak and its
-        neighbours and the last state of each branch (from fields.csv: the same bits)."""
+        neighbours (the folds' states among them) and the last state of each branch (from
+        fields.csv and the checkpoint: the same bits; see :meth:`_fold_fields`)."""
         import csv
 
         from ..io.resume_check import field_states
@@ -161,17 +239,35 @@ class Sink:
         with open(folder / "curve.csv") as f:
             head = f.readline().strip().split(",")
         col = [head.index(c) for c in self.columns]
+        with open(folder / "jumps.csv", newline="") as f:
+            jumps = [{k: (v if k == "branch" else float(v)) for k, v in r.items()}
+                     for j, r in zip(range(resume["jumps"]), csv.DictReader(f))]
+        folds = {}
+        for jp in jumps:
+            folds.setdefault(jp["branch"], []).append(jp)
         per_branch = {}
-        # the peak bookkeeping replayed over the committed rows (state numbers stand in for
-        # the states until the few it needs are read)
+        # the peak bookkeeping replayed over the committed rows and the folds between them,
+        # in the sweep's order (state numbers stand in for the states until the few it
+        # needs are read; a fold's states carry the committed state beside them on their
+        # piece, from which they are re-solved without a checkpoint)
         for k, r in enumerate(rows):
             b = r[1]
             vals = [r[j] for j in col]
+            d = float(r[2])
+            # (a fold lands beyond the last state before it, along the sweep)
+            sign = -1.0 if b == "approach" else 1.0
+            while folds.get(b) and (folds[b][0]["d_land_m"] - d) * sign <= 0:
+                jp = folds[b].pop(0)
+                before, after = (Committed(jp[f"d_{x}_m"], None, None, math.nan,
+                                           jp[f"F_ex_{y}_N"])
+                                 for x, y in (("fold", "before"), ("land", "after")))
+                before.near, after.near = per_branch.get(b, [k])[-1], k
+                self._track_fold(b, before, after, len(per_branch[b]))
             self.rows.setdefault(b, []).append(
                 [v == "True" if c in ("converged", "stable") else float(v)
                  for c, v in zip(self.columns, vals)])
             per_branch.setdefault(b, []).append(k)
-            self._track_peak(b, Committed(float(r[2]), None, None,
+            self._track_peak(b, Committed(d, None, None,
                                           float(vals[self.columns.index("r_c_m")]), float(
                                               vals[self.columns.index("F_ex_N")])))
             self.last[b].w = k           # (the state number, replaced below)
@@ -180,24 +276,77 @@ class Sink:
         # the profiles the uninterrupted run kept: the picks of each branch's full length
         picks = {b: [ks[j] for j in sorted(_picks(len(self.scene.d_values))) if j < len(ks)]
                  for b, ks in per_branch.items()}
-        snaps = [s for s in ([self.peak[2], self.peak[3], self.peak[4]] if self.peak else [])
-                 + list(self.last.values()) if s is not None]
-        wanted = {s.w for s in snaps} | {k for ks in picks.values() for k in ks}
+        held = [x for x in (self.peak, self._rival) if x is not None]
+        snaps = [s for s in [t for x in held for t in x[2:5]] + list(self.last.values())
+                 if s is not None]
+        at_fold = [s for s in {id(s): s for s in snaps}.values() if s.w is None]
+        snaps = [s for s in snaps if s.w is not None]
+        wanted = {s.w for s in snaps} | {k for ks in picks.values() for k in ks} | {
+            s.near for s in at_fold}
         fields = field_states(folder, wanted)
         self.last_k = {b: s.w for b, s in self.last.items()}
         for s in {id(s): s for s in snaps}.values():
             d, w, _, p_el = fields[s.w]
             s.w, s.active = w, p_el != 0
+        self._fold_fields(folder, at_fold, fields)
         for b, ks in picks.items():
             for k in ks:
                 d, w, p_lj, p_el = fields[k]
                 self._profile(b, d, w, p_lj, p_el)
-        with open(folder / "jumps.csv", newline="") as f:
-            for j, r in enumerate(csv.DictReader(f)):
-                if j >= resume["jumps"]:
-                    break
-                self.result.jumps.append({k: (v if k == "branch" else float(v))
-                                          for k, v in r.items()})
+        self.result.jumps += jumps
+
+    def _fold_fields(self, folder, snaps, fields):
+        """The displacements of the fold states a resumed peak search needs: from the
+        checkpoint of a stopped run (the same bits), else (a kill -9: no checkpoint) traced
+        to their separation from the committed state beside them on their piece (the same
+        equilibrium to the solver's tolerance, as a resumed branch's restart). One that does
+        not trace there is replaced in the bracket by that committed state (the bracket the
+        search had before folds bounded it), with a warning."""
+        from ..contact import solve_state, trace
+        from ..errors import ConvergenceError
+        from .checkpoint import load_fold_states
+
+        saved = load_fold_states(folder)
+        p, sc = self.problem, self.scene
+        for s in snaps:
+            got = saved.get((s.d, s.f_ex))
+            if got is not None:
+                s.w, s.active, s.r_c = got
+                continue
+            d0, w, _, p_el = fields[s.near]
+            kw = {} if p.sigma is None else {"active0": p_el != 0}
+            st = solve_state(p, d0, w, tol=sc.tolerance, max_iter=sc.max_iter, **kw)
+            try:
+                sw = trace(p, [d0, s.d], branch="retract" if s.d > d0 else "approach",
+                           tol=sc.tolerance, start=st, max_iter=sc.max_iter)
+                ok = st.converged and st.stable and not sw.jumps
+            except ConvergenceError:
+                ok = False
+            if ok:
+                s.w, s.active, s.r_c = sw.states[-1].w, sw.states[-1].active, \
+                    sw.states[-1].r_c
+                continue
+            # (the committed neighbour stands in: its record from the fields)
+            stand = Committed(d0, w, p_el != 0, math.nan, state_forces(p, st)[2]
+                              if st.converged and st.stable else math.nan)
+            for x in (self.peak, self._rival):
+                if x is not None:
+                    x[2:5] = [stand if y is s else y for y in x[2:5]]
+            self.result.warnings.append(
+                f"resume: the fold state at d = {s.d * 1e9:.6g} nm (no checkpoint) did not "
+                f"trace again from the state at {d0 * 1e9:.6g} nm; the largest adhesion is "
+                "searched up to that state instead")
+
+
+#: relative difference of F_ex below which two states at one separation tie (round-off: the
+#: approach's and the retract's state through one contact state differ by 1.2e-13 relative on
+#: the paper 1 slider at sigma = 0.489 nm, p/psat 0.25; a different state differs by far more)
+TIE_REL = 1e-9
+
+
+def _extent(peak):
+    """The length (m) of the separations a peak's bracket spans."""
+    return abs(peak[4].d - peak[2].d)
 
 
 def _picks(n):

@@ -84,8 +84,23 @@ def _exchange(sink, old, new):
     the search solves fresh states from them)."""
     from ..discretisation.moving import interpolate_state
 
-    snaps = ([s for s in sink.peak[2:] if s is not None] if sink.peak else []) + \
-        list(sink.last.values())
+    from dataclasses import replace
+
+    # a peak whose bracket is complete stays on the grid its states were solved on (the
+    # search solves there: on the sweep's last grid the band may be far from the peak's
+    # edge); one still waiting for its next state goes on with them to the new grid
+    held = []
+    for attr, grid_of in (("peak", "peak_problem"), ("_rival", "rival_problem")):
+        x = getattr(sink, attr, None)
+        if x is not None and x[4] is None:
+            held += [s for s in x[2:4] if s is not None]
+            setattr(sink, grid_of, new)
+    kept = {id(s) for x in (sink.peak, getattr(sink, "_rival", None)) if x is not None
+            for s in x[2:5] if s is not None} - {id(s) for s in held}
+    for b, s in list(sink.last.items()):
+        if id(s) in kept:           # (a restart's copy, the peak's own left as it is)
+            sink.last[b] = replace(s)
+    snaps = held + list(sink.last.values())
     for snap in {id(x): x for x in snaps}.values():
         if getattr(snap, "w", None) is not None and np.ndim(snap.w) == 1 and \
                 snap.w.size == old.grid.n:
@@ -276,9 +291,9 @@ def trace_arclength(scene, problem, sink):
             if kind == "fold":
                 before = st
                 continue        # the fold state is the jump's 'before', not a grid state
-            sink.state(branch, st)
-            if kind == "land":
+            if kind == "land":  # (the fold first, as the stepping does: the peak's pieces)
                 sink.jump(Jump(branch, dk, dk, 0.0, before, st))
+            sink.state(branch, st)
     sink.close()
 
 
