@@ -44,10 +44,6 @@ _WS = np.stack([_GW * (1 - _GT), _GW * _GT], axis=1)
 _WD = np.stack([_GW * (1 - _GT) ** 2, _GW * (1 - _GT) * _GT, _GW * _GT ** 2], axis=1)
 
 
-def _logistic(x):
-    return 0.5 * (1.0 + np.tanh(0.5 * x))
-
-
 class SubgridStep:
     """A step law integrated over the elements of a radial grid (see the module docstring).
 
@@ -145,7 +141,7 @@ class SubgridStep:
         rw = (re[k, None] + dr[k, None] * t) * wt
         if energy:
             return np.bincount(k, (np.logaddexp(0.0, x) * rw).sum(axis=1), minlength=ne)
-        s = _logistic(x)
+        s = expit(x)
         sp = s * (1.0 - s) * rw
         s = s * rw
         a = 1.0 - t
