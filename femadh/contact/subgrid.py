@@ -44,6 +44,15 @@ _WS = np.stack([_GW * (1 - _GT), _GW * _GT], axis=1)
 _WD = np.stack([_GW * (1 - _GT) ** 2, _GW * (1 - _GT) * _GT, _GW * _GT ** 2], axis=1)
 
 
+def _logistic(x):
+    # = scipy.special.expit(x) to round-off (<= 2.2e-16 absolute on |x| <= 40), kept: the swap
+    # leaves the bundled scenes' headline values bit-identical, but on the low-humidity
+    # meniscus edge (tests/test_meniscus_edge_trapping.py) it moves max adhesion by one ulp
+    # and, through a lattice-trapped estimate member, its estimated error from 1.13e-2 to
+    # 1.50e-2 (measured): not a change to make as a cleanup
+    return 0.5 * (1.0 + np.tanh(0.5 * x))
+
+
 class SubgridStep:
     """A step law integrated over the elements of a radial grid (see the module docstring).
 
@@ -141,7 +150,7 @@ class SubgridStep:
         rw = (re[k, None] + dr[k, None] * t) * wt
         if energy:
             return np.bincount(k, (np.logaddexp(0.0, x) * rw).sum(axis=1), minlength=ne)
-        s = expit(x)
+        s = _logistic(x)
         sp = s * (1.0 - s) * rw
         s = s * rw
         a = 1.0 - t
