@@ -86,8 +86,16 @@ def test_resume_inside_the_sweep_without_checkpoint_equals_to_tolerance(ref, tmp
     assert [j["branch"] for j in got["jumps"]] == [j["branch"] for j in ref_summary["jumps"]]
 
 
+@pytest.fixture(scope="module")
+def ref_states(ref):
+    """The number of states of the short scene's sweep, run in this process without estimate
+    (once per module: each damage case used to run it again, ten runs for one number)."""
+    ref_run = femadh.run(femadh.load_scene(ref[0]), progress=False, estimate=False)
+    return sum(len(b["d_m"]) for b in ref_run.branches.values())
+
+
 @pytest.mark.parametrize("name", list(DAMAGES))
-def test_damaged_folder_refused_or_repaired_in_one_line(ref, tmp_path, name):
+def test_damaged_folder_refused_or_repaired_in_one_line(ref, ref_states, tmp_path, name):
     scene = ref[0]
     c = damage_cell(scene, tmp_path / "out", name)
     lines = c["stderr"].splitlines()
@@ -105,9 +113,7 @@ def test_damaged_folder_refused_or_repaired_in_one_line(ref, tmp_path, name):
         assert c["exit"] == 0 and lines[0].startswith("femadh: note: resume: ")
         assert c["status"] == "converged"
     # repaired or resumed from a valid prefix: the full sweep, every row checked again
-    ref_run = femadh.run(femadh.load_scene(scene), progress=False, estimate=False)
-    n = sum(len(b["d_m"]) for b in ref_run.branches.values())
-    assert len(curve_rows(tmp_path / "out")) == n + 1
+    assert len(curve_rows(tmp_path / "out")) == ref_states + 1
 
 
 def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):

@@ -55,13 +55,17 @@ def test_asperity_laws_derivatives_by_finite_differences():
 
 
 def test_paper1_section6_scenes_run_and_report_asperity_forces(tmp_path):
+    """The sec 6 scenes run and write their asperity forces, each integrated from fields.csv
+    (without the error estimate, which reruns each scene on two coarser grids and is judged
+    elsewhere: it cost half of this test)."""
     import csv
 
     import femadh
 
     for name, col in (("paper1_fig8_rho179", "F_LJa_N"), ("paper1_slider_gw", "F_ela_N")):
         sc = femadh.load_scene(f"validation/scenes/{name}.toml")
-        res = femadh.run(sc, str(tmp_path / name), figures=False, progress=False)
+        res = femadh.run(sc, str(tmp_path / name), figures=False, progress=False,
+                         estimate=False)
         assert res.status == "converged"
         rows = list(csv.DictReader(open(tmp_path / name / "curve.csv")))
         assert col in rows[0]
