@@ -221,7 +221,8 @@ DEFECTS = [
         "if False:"),)),
     D("force_contact", "contact force integrated 10 % low", "femadh/contact/forces.py",
       (("f_el = g.force(state.p_contact)", "f_el = 0.9 * g.force(state.p_contact)"),)),
-    D("regime_tail", "regime map: LJ tail beyond the analysis radius dropped",
+    D("regime_tail", "regime map: LJ tail beyond the analysis radius dropped "
+      "(smooth_sphere.paraboloid_tail_force)",
       "femadh/studies/smooth_sphere.py",
       (("return -2 * math.pi * radius * float(law.energy(d + a * a / (2 * radius)))",
         "return 0.0"),)),
@@ -732,7 +733,7 @@ DEFECTS = [
         "return max(TOL, TOL_PER_ACCURACY * z0)"),)),
     D("peer_approach_tail", "edge trace: an approach state's force without the tail beyond "
       "the analysis radius", "femadh/studies/smooth_sphere.py",
-      (("st.force = app.grid.force(st.P) + tail_force(law, R, st.d, app.grid.radius)",
+      (("st.force = app.grid.force(st.P) + paraboloid_tail_force(law, R, st.d, app.grid.radius)",
         "st.force = app.grid.force(st.P)"),)),
     D("peer_md_once", "regime: the point's Maugis-Dugdale fixed grip solved at the wrong mu",
       "femadh/studies/regime.py",

@@ -1,7 +1,6 @@
 """Every solve has a budget and every fault a clear error: an inconsistent law fails in seconds,
 a non-finite value stops the solve where it arises, no message reports a nan residual."""
 import math
-import time
 
 import numpy as np
 import pytest
@@ -77,14 +76,25 @@ def test_wrong_derivative_fails_cleanly_in_stepping_continuation(monkeypatch):
 
 def test_wrong_derivative_fails_cleanly_in_arclength_continuation():
     """Unchecked, the tangent and the corrector disagree; the step budget per point stops
-    the trace (measured 0.5 s; before the budget it ran for over 15 minutes)."""
+    the trace within a bounded amount of work (before the budget it ran for over 15
+    minutes). Measured: 99 corrector solves and 1052 residual evaluations (one per Newton
+    iteration, tangent and fold location included: 0.4 s quiet) before it stalls at
+    d = 0.723 nm; the bounds are 3x that. It counts work, not seconds: a wall-clock bound
+    fails under load."""
     problem, lj, *_, d_min = lj_sphere_problem(2.0, 1e-6, HAMAKER, Z0, 0.4, 120)
     problem = ContactProblem(problem.operator, problem.sphere,
                              {"lj": SteepDerivative(HAMAKER, Z0)}, check_laws=False)
-    t0 = time.perf_counter()
+    calls = {"pressure": 0}
+    pressure = problem.pressure
+
+    def counted(h):
+        calls["pressure"] += 1
+        return pressure(h)
+    problem.pressure = counted          # this instance only: every residual the trace takes
     with pytest.raises(ConvergenceError, match="arclength continuation stalled") as e:
         trace_curve(problem, 12 * Z0, d_min, tol=TOL, scale=Z0, ds=0.2, ds_max=0.5)
-    assert time.perf_counter() - t0 < 30
+    assert 0 < e.value.curve.n_solves <= 3 * 99, e.value.curve.n_solves
+    assert 0 < calls["pressure"] <= 3 * 1052, calls
     assert e.value.curve.points            # the part traced so far is kept
     assert "nan" not in str(e.value)
 

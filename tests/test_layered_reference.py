@@ -256,15 +256,21 @@ def test_quadrature_converged_under_refinement():
 
 @pytest.mark.slow
 def test_remainder_matches_adaptive_scipy_quadrature():
+    """The remainder integral at three radii against scipy's adaptive Gauss-Kronrod
+    quadrature of the three integrands at once (quad_vec: one evaluation of the stack's
+    compliance per k serves all radii, 2121 evaluations against the 4809 of three scalar
+    quad calls; measured the same agreement, <= 4.9e-15 of w(0) either way)."""
     s = _bending_stack()
     scale = s.disk_displacement(0.0, A)
-    for r in (0.0, 0.5 * A, 2 * A):
-        def integrand(k):
-            return (s.excess_reduced_compliance(np.array([k]))[0]
-                    * disk_transform(k, A) * special.j0(k * r))
-        ref, _ = integrate.quad(integrand, 0, s.k_cutoff, limit=2000, epsabs=0, epsrel=1e-12)
+    radii = np.array([0.0, 0.5 * A, 2 * A])
+
+    def integrand(k):
+        return (s.excess_reduced_compliance(np.array([k]))[0]
+                * disk_transform(k, A) * special.j0(k * radii))
+    ref, _ = integrate.quad_vec(integrand, 0, s.k_cutoff, epsabs=0, epsrel=1e-12, limit=10000)
+    for r, want in zip(radii, ref):
         mine = s.disk_displacement(r, A) - disk_displacement(r, A, s.e_star_top)
-        assert abs(mine - ref) < 5e-14 * scale  # measured <= 5.0e-15 of w(0)
+        assert abs(mine - want) < 5e-14 * scale  # measured <= 5.0e-15 of w(0)
 
 
 # ---- stability ----------------------------------------------------------------------------

@@ -66,6 +66,11 @@ def test_low_humidity_meniscus_edge_converges_on_its_first_member():
     g = res.grid
     fine = variant(scene, grid={"spacing": g["spacing_m"] / 2, "band": g["band_m"],
                                 "grading": g["grading_m"]}, radius=g["analysis_radius_m"])
+    # the reference traces only the branch the maximum was read on when that is the approach
+    # (it is: measured the same max adhesion to the last bit as with both branches, in 0.7 of
+    # 2.2 CPU-s; the retract's unzipping is what the run itself is judged by above)
+    if res.headline["max_adhesion_branch"] == "approach":
+        fine = fine.replace({"sweep.directions": ["approach"]})
     ref = femadh.run(fine, None, figures=False, progress=False, estimate="peak")
     assert ref.status == "converged", ref.error
     achieved = abs(F - ref.headline["max_adhesion_N"]) / ref.headline["max_adhesion_N"]

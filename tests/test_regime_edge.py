@@ -284,20 +284,20 @@ def test_state_force_and_softening_read_off_the_branch_are_the_problems():
     (lam^2 area0 . P plus the exact tail) and its node softening ratio (-P' lam / K0_ii)
     equal the ContactProblem's of the scaled grid (lj_force, node_softening_ratio): measured
     equal to the last bit, asserted 1e-12 relative; the same for an approach state."""
-    from femadh.studies.smooth_sphere import jkr_start, lj_force, tail_force
+    from femadh.studies.smooth_sphere import jkr_start, lj_force, paraboloid_tail_force
 
     br, st, c0 = _branch()
     s0 = br.solve(br.r0, *jkr_start(br, st, br.r0))
     s1 = br.solve(0.7 * br.r0, *jkr_start(br, st, 0.7 * br.r0))
     for s in (s0, s1):
         pb = s.problem
-        own = br.grid_force(s) + tail_force(st.law, R, s.d, br.radius(s))
+        own = br.grid_force(s) + paraboloid_tail_force(st.law, R, s.d, br.radius(s))
         assert own == pytest.approx(lj_force(pb, st.law, s.d, s.w), rel=1e-12, abs=0)
         ratio = pb.node_softening_ratio(pb.contour(s.d) - s.w)
         assert br.node_softening_ratio(s) == pytest.approx(ratio, rel=1e-12, abs=0)
     ab, ast = _approach()
     a0 = ab.solve(2.0 * Z0, np.zeros(ab.n), 2.0 * Z0)
-    assert ab.pb.grid.force(a0.P) + tail_force(ast.law, R, a0.d, ab.pb.grid.radius) \
+    assert ab.pb.grid.force(a0.P) + paraboloid_tail_force(ast.law, R, a0.d, ab.pb.grid.radius) \
         == pytest.approx(lj_force(ab.pb, ast.law, a0.d, a0.w), rel=1e-12, abs=0)
     assert ab.node_softening_ratio(a0) == pytest.approx(
         ab.pb.node_softening_ratio(ab.pb.contour(a0.d) - a0.w), rel=1e-12, abs=0)
@@ -362,8 +362,8 @@ def test_approach_path_forces_are_the_law_force_with_its_tail():
     states meeting the residual 1e-19 m; asserted 1e-9; the tail is 1.2e-3 of it, asserted
     above 1e-4)."""
     from femadh.contact.edge_branch import CentreGapBranch
-    from femadh.studies.smooth_sphere import (PointSetup, Resolution, lj_force, tail_force,
-                                              trace_edge_point)
+    from femadh.studies.smooth_sphere import (PointSetup, Resolution, lj_force,
+                                              paraboloid_tail_force, trace_edge_point)
 
     law = LennardJones(HAMAKER, Z0)
     setup = PointSetup(3.0, R, law, Resolution(spacing=0.133))
@@ -374,7 +374,7 @@ def test_approach_path_forces_are_the_law_force_with_its_tail():
     assert st is not None
     f = lj_force(app, law, st.d, st.w)
     assert fa[0] == pytest.approx(f, rel=1e-9, abs=0)
-    assert abs(tail_force(law, R, st.d, app.grid.radius)) > 1e-4 * abs(f)
+    assert abs(paraboloid_tail_force(law, R, st.d, app.grid.radius)) > 1e-4 * abs(f)
 
 
 def test_point_reports_maugis_dugdale_at_its_own_lambda():

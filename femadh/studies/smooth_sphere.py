@@ -105,14 +105,17 @@ def lj_force(problem, lj, d, w):
     paraboloid's force is exactly -2 pi R U(b(a; d)) (Derjaguin is exact for a paraboloid:
     2 pi r dr = 2 pi R dh)."""
     h = problem.contour(d) - w
-    return problem.grid.force(problem.pressure(h)) + tail_force(lj, problem.sphere.radius, d,
-                                                                 problem.grid.radius)
+    return problem.grid.force(problem.pressure(h)) + paraboloid_tail_force(
+        lj, problem.sphere.radius, d, problem.grid.radius)
 
 
-def tail_force(law, radius, d, a):
-    """The force (N, attractive positive) beyond the analysis radius a (m) of a paraboloid of
-    radius R at separation d (m), where the surface is undeformed: -2 pi R U(d + a^2 / 2R)
-    (Derjaguin, exact for a paraboloid)."""
+def paraboloid_tail_force(law, radius, d, a):
+    """The force (N, attractive positive) of one law beyond the analysis radius a (m) of a
+    paraboloid of radius R at separation d (m), where the surface is undeformed:
+    -2 pi R U(d + a^2 / 2R) (Derjaguin, exact for a paraboloid). Not
+    :func:`femadh.discretisation.plan.tail_force` (every law of a scene on its sphere's own
+    contour, used to choose the analysis radius) nor :func:`femadh.contact.forces.tail_force`
+    (a problem's laws)."""
     return -2 * math.pi * radius * float(law.energy(d + a * a / (2 * radius)))
 
 
@@ -449,13 +452,14 @@ def trace_edge_point(setup, tol):
     def F(st):
         # the grid's force from the state's own pressures, and the exact tail
         if st.force is None:
-            st.force = branch.grid_force(st) + tail_force(law, R, st.d, branch.radius(st))
+            st.force = branch.grid_force(st) + paraboloid_tail_force(law, R, st.d,
+                                                                     branch.radius(st))
         return st.force
 
     def Fa(st):
         """The force (N) of an approach state (as lj_force, from its own pressures)."""
         if st.force is None:
-            st.force = app.grid.force(st.P) + tail_force(law, R, st.d, app.grid.radius)
+            st.force = app.grid.force(st.P) + paraboloid_tail_force(law, R, st.d, app.grid.radius)
         return st.force
 
     # down in c past the jump-out fold (d(c) has its largest value there) and past the
