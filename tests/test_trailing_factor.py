@@ -128,7 +128,8 @@ def test_a_checkpointed_preconditioner_solves_bit_for_bit(fig4, tmp_path):
     m = disk_size(st.active)
     st.lu.solve(m, np.ones(N - m))          # the kept factor exists before it is written
     folder = SimpleNamespace(path=tmp_path)
-    sink = SimpleNamespace(writer=object(), last_state=(3, "approach", st), problem=p)
+    sink = SimpleNamespace(writer=object(), last_state=(3, "approach", st), problem=p,
+                           peak=None)             # no peak bracket held yet
     save_checkpoint(folder, sink)
     back = load_checkpoint(tmp_path, 3, st.d)
     assert isinstance(back.lu, TrailingCholesky)
