@@ -269,8 +269,9 @@ class EdgeBand(MovingBand):
 
         def span(k):
             if move is None:
-                # direction unknown: the last travel's size both ways (none yet: a half-width)
-                m = max(abs(x) for x in self.move) if self.move else self.half
+                # direction unknown: the last travel's size both ways (none yet: the edges
+                # themselves - the sweep's first states, before any contact)
+                m = max(abs(x) for x in self.move) if self.move else 0.0
                 return lo - k * m, hi + k * m
             return (min(lo, lo + k * move[0]), max(hi, hi + k * move[1]))
         need, lead = span(NEED_STEPS), span(LEAD_STEPS)
