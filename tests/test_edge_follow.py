@@ -233,3 +233,18 @@ def test_the_followed_deepest_state_is_the_static_bands_own(small_sweep):
     g_lj, _, g_ex = state_forces(static, st)
     assert f_ex == pytest.approx(g_ex, rel=3e-3, abs=0)
     assert f_lj == pytest.approx(g_lj, rel=1e-3, abs=0)
+
+
+def test_a_failed_landing_falls_back_to_the_static_band_only_where_it_is_affordable():
+    """The static band [0, band] at a follow band's spacing: the sigma = 0.3 nm corner's
+    (3.78 nm over 12.1 um: 3234 nodes, measured 37 s for the carry alone at load 8) is
+    refused, the Fig 4 follow test's (39 nm over 5.9 um, 177 nodes) kept."""
+    sc = corner(0.95)
+
+    def build(g, first):
+        return build_problem(sc, operator=GreenOperator(g, sc.e_star))
+    fine = EdgeBand(1.4142e-5, 3.78e-9, 9e-8, 3e-8, build, 0.5e-9, SIGMA, step=0.2e-9)
+    assert GridFamily(1.4142e-5, 12.1e-6, 3e-8).count(3.78e-9) > moving.WIDEN_MAX_NODES
+    assert not fine.widen_affordable(12.1e-6)
+    coarse = EdgeBand(2.53e-5, 39e-9, 1e-6, 1e-6, build, 1.5e-9, 0.5e-9, step=0.4e-9)
+    assert coarse.widen_affordable(5.9e-6)

@@ -40,6 +40,12 @@ NEED_STEPS, LEAD_STEPS = 1.25, 2.5
 #: ... and rebuilt narrower once its span exceeds this multiple of the span it would be built
 #: with now (a fast phase is over: its nodes are no longer needed)
 SHRINK_RATIO = 2.0
+#: the static band [0, band] a failed landing on a follow band falls back to
+#: (:func:`femadh.runner.tracing.trace_steps`) is built only up to this many nodes: at the
+#: band spacing a cohesive zone of tens of nm needs (1.8-3.8 nm on the sigma = 0.3 nm column)
+#: it would hold 3234 nodes over 12 um, measured 37 s for the carry alone at load 8 and
+#: minutes per grid step; the landing's failure is reported instead
+WIDEN_MAX_NODES = 1000
 
 
 def zone_gap(effects, floor):
@@ -200,6 +206,12 @@ class EdgeBand(MovingBand):
         self.step = step
         self.track = None          # (d, lo, hi) of the last state seen on the branch
         self.move = None           # the edges' last travel over one grid step (m, signed)
+
+    def widen_affordable(self, band):
+        """Whether the static band [0, ``band``] (m) at this band's spacing and grading has
+        at most WIDEN_MAX_NODES nodes (the fallback of a failed landing)."""
+        return GridFamily(self.radius, min(band, self.radius), self.grading).count(
+            self.spacing) <= WIDEN_MAX_NODES
 
     def span_family(self, lo, hi):
         """The family whose band is [lo - half, hi + half] (clipped)."""

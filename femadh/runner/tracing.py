@@ -189,7 +189,8 @@ def trace_steps(scene, problem, sink, resume):
                 # from the last committed state on the static band [0, band], which holds
                 # wherever the edge can go; the next exchange returns to the follow band
                 if band is None or jumped[0] or seen[0] == 0 or last[0] is None \
-                        or wide == last[0].d or problem is getattr(sink, "wide", None):
+                        or wide == last[0].d or problem is getattr(sink, "wide", None) \
+                        or not band.widen_affordable(scene.grid["band"]):
                     raise
                 wide = last[0].d
                 problem, start = _widened(band, sink, problem, last[0], scene)
