@@ -23,11 +23,15 @@ about how many nodes the request would need (where the force beyond the analysis
 what falls short: about what radius it would need).
 
 The band is static by default: a band that follows the contact edge
-(``[solver.grid] follow``, FOLLOW_NODES) was measured against it on the Fig 3, Fig 4 and
-slider + meniscus scenes (validation/results/adaptive_follow.md) and did not pay: at the
-same band spacing it has 1/3-1/4 of the nodes, but its estimate (the coarser members follow
-the edge on their own grids) is 3-5x larger and erratic, so the loop refines once more, and
-each of its runs carries the state across a dozen grid exchanges.
+(``[solver.grid] follow``) was measured against it on the Fig 3, Fig 4 and slider + meniscus
+scenes (validation/results/adaptive_follow.md) and did not pay: at the same band spacing it
+has 1/3-1/4 of the nodes, but its estimate (the coarser members follow the edge on their own
+grids) is 3-5x larger and erratic, so the loop refines once more, and each of its runs
+carries the state across a dozen grid exchanges. A sigma-gap scene whose static member at
+the trapping-safe spacing alone would exceed FOLLOW_NODES (a cohesive zone of tens of nm at
+an edge travelling microns: the stiction map's sigma = 0.3 nm column, 1831-3545 nodes) runs
+on a band that follows the edge instead (:func:`_follow_trial`, validation/results/
+sigma03_follow.md).
 """
 from dataclasses import dataclass
 import math
