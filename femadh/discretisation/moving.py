@@ -14,6 +14,10 @@ driven by the runner) follows the edge the same way when its [solver.grid] sets 
 :meth:`MovingBand.regrid` and carries the state to the new grid at the same separation
 (:func:`carry_state`). A static band would have to cover the edge's whole travel at the
 spacing the edge needs: the 2-mm slider at sigma = 0.3 nm, 3.6 nm over 5.6 um, 1830 nodes.
+There the band spans the contact edge to the cohesive zone's end (:func:`zone_gap`) and,
+given the sweep's grid step, leads the edges' travel over the next grid steps
+(:meth:`EdgeBand._travel_regrid`); the adaptive plan chooses it where the static band is too
+large (:func:`femadh.runner.adaptive._follow_trial`; validation/results/sigma03_follow.md).
 """
 import math
 
