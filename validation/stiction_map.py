@@ -212,6 +212,8 @@ def column(sigma):
     print(f"sigma = {sigma}: {n} points in {wall:.1f} s on 2 processes (load "
           f"{load:.1f} -> {os.getloadavg()[0]:.1f}); {n - len(fails)} converged")
     for i, r in enumerate(rel):
+        if not np.isfinite(F[i, 0]):
+            continue            # listed with the failures below
         print(f"  p/psat {r:.2f}: max adhesion / 4 pi R gamma {F[i, 0] / norm:.5g}, "
               f"estimated relative error {E[i, 0] / F[i, 0]:.2g}")
     for sg, r, err in fails:
