@@ -818,8 +818,8 @@ DEFECTS = [
         "return x - math.copysign(lim, x - x0) if abs(x - x0) > lim else x"),)),
     D("edgeband_inner_gap", "follow band: inner edge at the cohesive zone's outer end, not "
       "at sigma", "femadh/runner/tracing.py",
-      (("feature_gap(problem.effects, floor), floor * (1 + 1e-6))",
-        "feature_gap(problem.effects, floor), feature_gap(problem.effects, floor))"),)),
+      (("zone_gap(problem.effects, floor), floor * (1 + 1e-6),",
+        "zone_gap(problem.effects, floor), zone_gap(problem.effects, floor),"),)),
     D("carry_unclipped", "carried state: the interpolated surface may cut below sigma",
       "femadh/discretisation/moving.py", (("    w = np.minimum(w, b - new.sigma)\n", ""),)),
     D("carry_wrong_d", "carried state re-solved 0.01 nm off its separation",
@@ -1268,6 +1268,46 @@ DEFECTS = [
       "femadh/runner/sink.py",
       (('            while folds.get(b) and (folds[b][0]["d_land_m"] - d) * sign <= 0:',
         '            while folds.get(b) and (folds[b][0]["d_land_m"] - d) * sign < -1e-9:'),)),
+    # -- the band that follows the sigma-gap contact edge (issue 21 goal 1, edgefollow)
+    D("ef_zone_fraction_half", "follow band: the cohesive zone ends at half ZONE_FRACTION "
+      "of the softening", "femadh/discretisation/moving.py",
+      (("ok = np.flatnonzero(s >= ZONE_FRACTION * top)",
+        "ok = np.flatnonzero(s >= 0.5 * ZONE_FRACTION * top)"),)),
+    D("ef_zone_step_ignored", "follow band: a meniscus edge inside the zone (its secant "
+      "softening) left out of the zone", "femadh/discretisation/moving.py",
+      (("        if e >= ZONE_FRACTION * top:", "        if False:"),)),
+    D("ef_edge_ratio_max", "edge ratio: the larger of LJ's softening and the meniscus secant, "
+      "not their sum", "femadh/discretisation/plan.py",
+      (("                soft += law.edge_softening(floor)",
+        "                soft = max(soft, law.edge_softening(floor))"),)),
+    D("ef_follow_safe_member_power", "follow-safe spacing: the coarsest member sqrt 2 "
+      "coarser, not 2x", "femadh/discretisation/plan.py",
+      (("return math.inf if ratio <= 0 else h * EDGE_SAFE / MIN_MEMBER_RATIO**2 / ratio",
+        "return math.inf if ratio <= 0 else h * EDGE_SAFE / MIN_MEMBER_RATIO / ratio"),)),
+    D("ef_lead_one_step", "travel-aware band: built to cover one grid step's travel, not "
+      "LEAD_STEPS", "femadh/discretisation/moving.py",
+      (("            return (min(lo, lo + k * move[0]), max(hi, hi + k * move[1]))",
+        "            return (min(lo, lo + move[0]), max(hi, hi + move[1]))"),)),
+    D("ef_travel_across_landing", "travel-aware band: the travel read across a landing's "
+      "jump", "femadh/discretisation/moving.py",
+      (("        if prev is not None and not landed and abs(d - prev[0]) > 0:",
+        "        if prev is not None and abs(d - prev[0]) > 0:"),)),
+    D("ef_widen_unbounded", "follow band: a failed landing falls back to a static band of "
+      "any size", "femadh/discretisation/moving.py",
+      (("            self.spacing) <= WIDEN_MAX_NODES",
+        "            self.spacing) <= 10 * WIDEN_MAX_NODES"),)),
+    D("ef_follow_decided_uncapped", "adaptive plan: follow decided by the uncapped static "
+      "member's count", "femadh/runner/adaptive.py",
+      (("            if family.count(static) <= FOLLOW_NODES:",
+        "            if family.count(spacing) <= FOLLOW_NODES:"),)),
+    D("ef_follow_static_grading", "adaptive plan: the follow band keeps the static family's "
+      "grading (2 % per node)", "femadh/runner/adaptive.py",
+      (("        fam = GridFamily(family.radius, family.band, FOLLOW_GRADING_SPACINGS * h)",
+        "        fam = GridFamily(family.radius, family.band, family.grading)"),)),
+    D("ef_zone_not_in_band", "follow band: the outer edge at the floor gap (the zone out of "
+      "the band)", "femadh/runner/tracing.py",
+      (("                    zone_gap(problem.effects, floor), floor * (1 + 1e-6),",
+        "                    floor * (1 + 2e-6), floor * (1 + 1e-6),"),)),
 ]
 
 

@@ -41,12 +41,14 @@ SCALING = {"effects.asperity_gap.sigma": "0.6 nm..2 nm:6",
 POINT_LIMIT = "90 s"
 
 
-def stiction_map(out):
+def stiction_map(out, sigma=None):
     """The map at the scene's defaults: the adaptive grid to accuracy 1e-3 (points femadh
-    refuses, or that reach POINT_LIMIT, keep their reason)."""
+    refuses, or that reach POINT_LIMIT, keep their reason); ``sigma`` (e.g. "0.3 nm"): only
+    that column."""
     scene = femadh.load_scene(SCENE).replace({"solver.time_limit": POINT_LIMIT})
     t0 = time.perf_counter()
-    points, records = run_study(scene, MAP, out, workers=2, progress=True)
+    vary = MAP if sigma is None else {**MAP, "effects.asperity_gap.sigma": [sigma]}
+    points, records = run_study(scene, vary, out, workers=2, progress=True)
     wall = time.perf_counter() - t0
 
     def rel_of(p):
@@ -147,9 +149,14 @@ def main(argv=None):
     ap.add_argument("--only", choices=("map", "scaling", "edge"),
                     help="run one of the two parts, or (edge) only the low-humidity points "
                     "whose meniscus edge sits just above sigma (printed, no file written)")
+    ap.add_argument("--sigma", help="only the map's column at this asperity gap (e.g. "
+                    "'0.3 nm', the map's first): printed, no file written")
     args = ap.parse_args(argv)
     if args.only == "edge":
         edge_points()
+        return
+    if args.sigma:
+        column(args.sigma)
         return
     RESULTS.mkdir(exist_ok=True)
     if args.only != "scaling":
@@ -190,6 +197,27 @@ def the_map():
     lines += ["", "![](stiction_map.png)", ""]
     (RESULTS / "stiction_map.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
+
+
+def column(sigma):
+    """One sigma column of the map as the map runs it (2 processes, POINT_LIMIT per point):
+    per point its status, max adhesion / 4 pi R gamma, estimated relative error and reason;
+    the wall time and the machine's load. Printed only."""
+    import os
+
+    out = Path("out/stiction-map-column")
+    shutil.rmtree(out, ignore_errors=True)
+    load = os.getloadavg()[0]
+    sig, rel, F, E, norm, wall, fails, n = stiction_map(out, sigma)
+    print(f"sigma = {sigma}: {n} points in {wall:.1f} s on 2 processes (load "
+          f"{load:.1f} -> {os.getloadavg()[0]:.1f}); {n - len(fails)} converged")
+    for i, r in enumerate(rel):
+        if not np.isfinite(F[i, 0]):
+            continue            # listed with the failures below
+        print(f"  p/psat {r:.2f}: max adhesion / 4 pi R gamma {F[i, 0] / norm:.5g}, "
+              f"estimated relative error {E[i, 0] / F[i, 0]:.2g}")
+    for sg, r, err in fails:
+        print(f"  failed {sg * 1e9:.3g} nm, {r:.2f}: {err}")
 
 
 #: the map's points whose meniscus edge lies within ~0.07 nm of sigma (a cohesive zone of

@@ -14,12 +14,72 @@ driven by the runner) follows the edge the same way when its [solver.grid] sets 
 :meth:`MovingBand.regrid` and carries the state to the new grid at the same separation
 (:func:`carry_state`). A static band would have to cover the edge's whole travel at the
 spacing the edge needs: the 2-mm slider at sigma = 0.3 nm, 3.6 nm over 5.6 um, 1830 nodes.
+There the band spans the contact edge to the cohesive zone's end (:func:`zone_gap`) and,
+given the sweep's grid step, leads the edges' travel over the next grid steps
+(:meth:`EdgeBand._travel_regrid`); the adaptive plan chooses it where the static band is too
+large (:func:`femadh.runner.adaptive._follow_trial`; validation/results/sigma03_follow.md).
 """
 import math
 
 import numpy as np
 
 from .family import GridFamily
+
+#: the band's outer feature edge: the gap where the laws' softening at the contact edge has
+#: fallen to this fraction of its largest (the cohesive zone's outer end; LJ's h^-4 softening:
+#: 10^(1/4) sigma). A smoothed step (the meniscus) counts by its secant softening from the
+#: floor across its edge, and only where that is this fraction of the largest: at
+#: p/psat = 0.05 on sigma = 0.3 nm its edge (0.36 nm) is part of the zone; at p/psat = 0.95
+#: it lies 23 nm up the gap, microns out, where the graded spacing resolves it (the sub-grid
+#: quadrature integrates the step exactly on the interpolated gaps)
+ZONE_FRACTION = 0.1
+#: a travel-aware band (:class:`EdgeBand` with ``step``) is exchanged when the edge's
+#: predicted travel over the next NEED_STEPS grid steps would take it closer than half a
+#: half-width to the band's fine span's end, and the new band covers LEAD_STEPS grid steps
+#: of that travel ahead (fewer exchanges than one per step; measured on the stiction map's
+#: sigma = 0.3 nm corner, the edge moves 50-250 nm per 0.2-nm grid step, fastest near the
+#: pull-off: a band that only led by half a half-width let the edge run into the graded
+#: part within a grid step, where it unzipped node by node)
+NEED_STEPS, LEAD_STEPS = 1.25, 2.5
+#: ... and rebuilt narrower once its span exceeds this multiple of the span it would be built
+#: with now (a fast phase is over: its nodes are no longer needed)
+SHRINK_RATIO = 2.0
+#: the static band [0, band] a failed landing on a follow band falls back to
+#: (:func:`femadh.runner.tracing.trace_steps`) is built only up to this many nodes: at the
+#: band spacing a cohesive zone of tens of nm needs (1.8-3.8 nm on the sigma = 0.3 nm column)
+#: it would hold 3234 nodes over 12 um, measured 37 s for the carry alone at load 8 and
+#: minutes per grid step; the landing's failure is reported instead
+WIDEN_MAX_NODES = 1000
+
+
+def zone_gap(effects, floor):
+    """The outer end (m) of the cohesive zone at a contact edge on the floor gap: the largest
+    gap where a collocated law's softening -P'(h) is at least ZONE_FRACTION of the largest
+    softening there, or a smoothed step's edge h_c + 2w where its secant softening from the
+    floor (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`) is; ``floor`` without
+    laws."""
+    from ..laws.step import SmoothStepLaw
+
+    h = floor * np.logspace(0, 3, 1500)
+    soft, edges = [], []
+    for law in effects.values():
+        if isinstance(law, SmoothStepLaw):
+            edges.append((law.edge_softening(floor), law._center + 2.0 * law.width))
+        else:
+            s = -np.asarray(law.dpressure(h), float)
+            soft.append(s)
+    top = max([float(np.max(s)) for s in soft] + [e for e, _ in edges] + [0.0])
+    if not (top > 0 and math.isfinite(top)):
+        return float(floor)
+    out = float(floor)
+    for s in soft:
+        ok = np.flatnonzero(s >= ZONE_FRACTION * top)
+        if ok.size:
+            out = max(out, float(h[ok[-1]]))
+    for e, gap in edges:
+        if e >= ZONE_FRACTION * top:
+            out = max(out, float(gap))
+    return out
 
 
 def contact_edge(problem, w, d, gap):
@@ -141,10 +201,21 @@ class EdgeBand(MovingBand):
     half a half-width (it crosses the band's middle before the next exchange).
     """
 
-    def __init__(self, radius, spacing, half, grading, build, edge_gap, inner_gap):
+    def __init__(self, radius, spacing, half, grading, build, edge_gap, inner_gap,
+                 step=None):
         super().__init__(radius, spacing, half, grading, build, edge_gap)
         self.inner_gap = min(inner_gap, edge_gap)
         self.spans = {}
+        #: the sweep's grid step (m): the band leads the edges' travel (:meth:`regrid`)
+        self.step = step
+        self.track = None          # (d, lo, hi) of the last state seen on the branch
+        self.move = None           # the edges' last travel over one grid step (m, signed)
+
+    def widen_affordable(self, band):
+        """Whether the static band [0, ``band``] (m) at this band's spacing and grading has
+        at most WIDEN_MAX_NODES nodes (the fallback of a failed landing)."""
+        return GridFamily(self.radius, min(band, self.radius), self.grading).count(
+            self.spacing) <= WIDEN_MAX_NODES
 
     def span_family(self, lo, hi):
         """The family whose band is [lo - half, hi + half] (clipped)."""
@@ -171,9 +242,15 @@ class EdgeBand(MovingBand):
         lo, hi = self.spans[id(problem)]
         return max(0.0, lo - edge, edge - hi) / self.half
 
-    def regrid(self, problem, w, d):
+    def regrid(self, problem, w, d, landed=False):
         """A grid whose band leads the moving edges, once either has moved more than half a
-        half-width from where the band was built; None while both are within it."""
+        half-width from where the band was built; None while both are within it.
+
+        With ``step`` (the travel-aware band) the rule is the edges' predicted travel
+        instead (:meth:`_travel_regrid`); ``landed``: the state is a landing after a fold
+        (the edge jumped: no travel is read from it)."""
+        if self.step:
+            return self._travel_regrid(problem, w, d, landed)
         lo0, hi0 = self.spans[id(problem)]
         lo, hi = self.edges(problem, w, d)
         lim = 0.5 * self.half
@@ -183,3 +260,41 @@ class EdgeBand(MovingBand):
         def lead(x, x0):
             return x + math.copysign(lim, x - x0) if abs(x - x0) > lim else x
         return self.problem(lead(lo, lo0), lead(hi, hi0))
+
+    def _travel(self, d, lo, hi, landed):
+        """(move_lo, move_hi): the edges' predicted signed travel over the next grid step (m),
+        from their travel since the last state seen (scaled to a grid step); after a landing,
+        a resume or at the start, the last travel's size in both directions (None: none)."""
+        prev, self.track = self.track, (d, lo, hi)
+        if prev is not None and not landed and abs(d - prev[0]) > 0:
+            scale = self.step / abs(d - prev[0])
+            self.move = ((lo - prev[1]) * scale, (hi - prev[2]) * scale)
+            return self.move
+        if landed:
+            self.track = None      # the jump is no travel: the next state starts a track
+        return None
+
+    def _travel_regrid(self, problem, w, d, landed):
+        """The travel-aware exchange: None while the band's fine span holds both edges with
+        half a half-width to spare over their predicted travel of NEED_STEPS grid steps (and
+        is not more than SHRINK_RATIO too wide); else the problem whose span covers the
+        travel of LEAD_STEPS grid steps ahead."""
+        lo0, hi0 = self.spans[id(problem)]
+        lo, hi = self.edges(problem, w, d)
+        move = self._travel(d, lo, hi, landed)
+
+        def span(k):
+            if move is None:
+                # direction unknown: the last travel's size both ways (none yet: the edges
+                # themselves - the sweep's first states, before any contact)
+                m = max(abs(x) for x in self.move) if self.move else 0.0
+                return lo - k * m, hi + k * m
+            return (min(lo, lo + k * move[0]), max(hi, hi + k * move[1]))
+        need, lead = span(NEED_STEPS), span(LEAD_STEPS)
+        # the band's fine part is [lo0 - half, hi0 + half] (clipped to [0, radius])
+        inside = (need[0] - 0.5 * self.half >= lo0 - self.half or lo0 - self.half <= 0) and \
+            need[1] + 0.5 * self.half <= hi0 + self.half
+        wide = (hi0 - lo0) > SHRINK_RATIO * (lead[1] - lead[0]) + 2 * self.half
+        if inside and not wide:
+            return None
+        return self.problem(max(lead[0], 0.0), lead[1])

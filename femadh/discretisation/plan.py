@@ -217,3 +217,44 @@ def plan_grid(effects, sigma, sphere, radius, d_values, target, nodes=BAND_NODES
     band = band_radius(sphere, H, d_min, a)
     fam = GridFamily(a, band, GRADING_FRACTION * band)
     return GridPlan(fam, band / nodes, H, d_min)
+
+
+#: a band that follows the contact edge: the real nodal ratio (:func:`edge_trapping_ratio`)
+#: its coarsest estimate member (twice the fine spacing) may reach - the measured limit of
+#: clean traces (STEP_SAFE)
+EDGE_SAFE = STEP_SAFE
+
+
+def edge_trapping_ratio(problem):
+    """The softening a band node at the contact edge meets, over its own stiffness: the
+    collocated laws' -P'(floor) plus each sub-grid step's secant softening from the floor
+    across its edge (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`), summed - both
+    act at the same edge when a meniscus edge lies just above sigma - over min K_kk of the
+    finest nodes.
+
+    Unlike :func:`trapping_ratio` (which keeps the larger of the two, the step's scaled, as
+    the static plan was measured with) this is the ratio a node actually meets: on the
+    stiction map's sigma = 0.3 nm, p/psat = 0.05 corner, LJ 1.80e18 Pa/m and the meniscus
+    step 2.07e18 Pa/m against K_kk = 7.6e18 Pa/m at 6 nm: 0.51, where the retract unzipped
+    node by node (validation/results/sigma03_follow.md); the static measure says 0.24."""
+    from ..laws.step import SmoothStepLaw
+
+    floor = reach_floor(problem.effects, problem.sigma)
+    soft = 0.0
+    for law in problem.effects.values():
+        if isinstance(law, SmoothStepLaw):
+            if getattr(law, "SUBGRID", False) and problem.sigma is not None:
+                soft += law.edge_softening(floor)
+            continue
+        soft += max(0.0, float(np.max(-law.dpressure(_scan(floor)[:600]))))
+    k = np.diag(problem.K)[problem.finest_nodes]
+    return float(soft / np.min(k))
+
+
+def follow_safe_spacing(problem):
+    """Largest band spacing (m) of a band following the edge whose coarsest estimate member
+    (MIN_MEMBER_RATIO^2 coarser) stays at EDGE_SAFE (:func:`edge_trapping_ratio`; the ratio
+    grows like the spacing, measured on the problem's own finest spacing)."""
+    ratio = edge_trapping_ratio(problem)
+    h = float(np.min(np.diff(problem.grid.nodes)))
+    return math.inf if ratio <= 0 else h * EDGE_SAFE / MIN_MEMBER_RATIO**2 / ratio

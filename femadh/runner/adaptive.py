@@ -23,11 +23,15 @@ about how many nodes the request would need (where the force beyond the analysis
 what falls short: about what radius it would need).
 
 The band is static by default: a band that follows the contact edge
-(``[solver.grid] follow``, FOLLOW_NODES) was measured against it on the Fig 3, Fig 4 and
-slider + meniscus scenes (validation/results/adaptive_follow.md) and did not pay: at the
-same band spacing it has 1/3-1/4 of the nodes, but its estimate (the coarser members follow
-the edge on their own grids) is 3-5x larger and erratic, so the loop refines once more, and
-each of its runs carries the state across a dozen grid exchanges.
+(``[solver.grid] follow``) was measured against it on the Fig 3, Fig 4 and slider + meniscus
+scenes (validation/results/adaptive_follow.md) and did not pay: at the same band spacing it
+has 1/3-1/4 of the nodes, but its estimate (the coarser members follow the edge on their own
+grids) is 3-5x larger and erratic, so the loop refines once more, and each of its runs
+carries the state across a dozen grid exchanges. A sigma-gap scene whose static member at
+the trapping-safe spacing alone would exceed FOLLOW_NODES (a cohesive zone of tens of nm at
+an edge travelling microns: the stiction map's sigma = 0.3 nm column, 1831-3545 nodes) runs
+on a band that follows the edge instead (:func:`_follow_trial`, validation/results/
+sigma03_follow.md).
 """
 from dataclasses import dataclass
 import math
@@ -56,12 +60,20 @@ MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
 REFERENCE_ACCURACY, MIN_BAND_NODES = 1e-3, 48
 #: a feature beyond this fraction of the band radius widens the band
 BAND_FILL = 0.97
-#: a sigma-gap stepping scene whose static member would have more than this many nodes runs
-#: on a band that follows the contact edge instead ([solver.grid] follow,
-#: :class:`~femadh.discretisation.moving.EdgeBand`; None: never, the default: measured not
-#: to pay, see the module docstring)
-FOLLOW_NODES = None
-#: half-width of that band over the static band's radius
+#: a sigma-gap stepping scene whose static member, at the trapping-safe spacing alone,
+#: would have more than this many nodes runs on a band that follows the contact edge instead
+#: ([solver.grid] follow, :class:`~femadh.discretisation.moving.EdgeBand`; None: never).
+#: Only the trapping cap decides it, not the accuracy's refinement: a static band that pays
+#: at the scene's defaults (the bundled scenes, 161-632 nodes) stays static; the stiction
+#: map's sigma = 0.3 nm column needs 1831-3545 static nodes for its cohesive zone
+#: (validation/results/sigma03_landing.md)
+FOLLOW_NODES = 1000
+#: half-width of that band (beyond the cohesive zone it always spans) and its grading length,
+#: in band spacings of the member: the zone (25-80 nm on the sigma = 0.3 nm column) plus a
+#: margin of ~40 nm at 1.8 nm, then the spacing grows by ~1/8 per node to the analysis radius
+FOLLOW_HALF_SPACINGS, FOLLOW_GRADING_SPACINGS = 24, 8
+#: half-width of a follow band over the static band's radius where FOLLOW_NODES forces one
+#: on a scene whose static member is small (tests: FOLLOW_NODES = 0)
 FOLLOW_HALF = 1 / 6
 
 
@@ -105,8 +117,8 @@ def _follows(scene, family, spacing):
     if FOLLOW_NODES is None or scene.gap is None or scene.continuation == "arclength" or \
             getattr(scene.gap, "contact_model", "complementarity") != "complementarity":
         return None
-    if family.count(spacing) <= FOLLOW_NODES:
-        return None
+    if FOLLOW_NODES != 0:
+        return None             # the trapping cap decides (:func:`_follow_trial`)
     return FOLLOW_HALF * family.band
 
 
@@ -164,8 +176,51 @@ class Trial:
         return out
 
 
+def _follow_trial(scene, family, spacing):
+    """The :class:`Trial` on a band following the contact edge, or None (a static band):
+    where the static member at the trapping-safe spacing would exceed FOLLOW_NODES. Probed on
+    the follow member itself (a few hundred nodes, never the static one): the static cap
+    :func:`~femadh.discretisation.plan.safe_spacing` decides, the follow band's own
+    :func:`~femadh.discretisation.plan.follow_safe_spacing` (the summed softening at the
+    edge, so that its coarsest member does not unzip node by node) caps its spacing; half
+    width and grading scale with that spacing (FOLLOW_HALF_SPACINGS,
+    FOLLOW_GRADING_SPACINGS)."""
+    from ..discretisation.moving import follow_family
+    from ..discretisation.plan import follow_safe_spacing
+    from ..elastic import GreenOperator
+    from ..scene import build_problem
+
+    if FOLLOW_NODES is None or FOLLOW_NODES == 0 or scene.gap is None or \
+            scene.continuation == "arclength" or \
+            getattr(scene.gap, "contact_model", "complementarity") != "complementarity":
+        return None
+    h, op, decided = spacing, None, False
+    for _ in range(3):
+        fam = GridFamily(family.radius, family.band, FOLLOW_GRADING_SPACINGS * h)
+        half = FOLLOW_HALF_SPACINGS * h
+        op = GreenOperator(follow_family(fam.radius, half, fam.grading, 0.0).member(h),
+                           scene.e_star)
+        problem = build_problem(scene, operator=op)
+        if not decided:
+            static = min(spacing, 0.98 * safe_spacing(problem))
+            if family.count(static) <= FOLLOW_NODES:
+                return None
+            decided = True
+        safe = follow_safe_spacing(problem)
+        if h <= safe:
+            break
+        h = 0.98 * safe
+    return Trial(fam, h, spacing, op.grid.n, op, half)
+
+
 def _trial(scene, family, spacing):
     """The :class:`Trial` of ``family`` at band spacing ``spacing`` (m), capped."""
+    try:
+        ft = _follow_trial(scene, family, spacing)
+    except NodeBudgetError:
+        ft = None
+    if ft is not None:
+        return ft
     follow = _follows(scene, family, spacing)
     try:
         h, op, _ = _capped(scene, family, spacing, follow)

@@ -41,31 +41,32 @@ def _follower(scene, problem):
     g = scene.grid
     if not (g and g.get("follow")) or problem.sigma is None:
         return None
-    from ..discretisation.moving import EdgeBand
-    from ..discretisation.plan import feature_gap, reach_floor
+    from ..discretisation.moving import EdgeBand, zone_gap
+    from ..discretisation.plan import reach_floor
     from ..elastic import GreenOperator
 
     def build(grid, first):
         return build_problem(scene, operator=GreenOperator(grid, scene.e_star))
     floor = reach_floor(problem.effects, problem.sigma)
-    # the inner edge at sigma itself (a node held at the floor, to round-off): the LJ
-    # cohesive zone sigma..10^(1/2) sigma is ~0.8 um wide on the Fig 4 slider, and a band
-    # around its outer end alone left the contact edge in the graded part
+    # the inner edge at sigma itself (a node held at the floor, to round-off), the outer at
+    # the cohesive zone's end; the band leads the edges' travel over the next grid steps
+    d = scene.d_values
     band = EdgeBand(problem.grid.radius, g["spacing"], g["follow"], g["grading"], build,
-                    feature_gap(problem.effects, floor), floor * (1 + 1e-6))
+                    zone_gap(problem.effects, floor), floor * (1 + 1e-6),
+                    step=abs(d[1] - d[0]) if len(d) > 1 else None)
     band.spans[id(problem)] = (0.0, 0.0)     # the scene's own first member (scene_grid)
     band.centers[id(problem)] = 0.0
     return band
 
 
-def _regridded(band, sink, problem, state, scene):
+def _regridded(band, sink, problem, state, scene, landed=False):
     """(new problem, the state carried to it) if the edge left the band's middle, else None.
     The sink and its writer write on the new grid from here on; the states the peak search
     and a branch's restart need are carried to it (their displacements interpolated: the
     search solves fresh states from them)."""
     from ..discretisation.moving import carry_state
 
-    new = band.regrid(problem, state.w, state.d)
+    new = band.regrid(problem, state.w, state.d, landed=landed)
     if new is None:
         return None
     st = carry_state(problem, new, state, tol=scene.tolerance, max_iter=scene.max_iter)
@@ -181,7 +182,8 @@ def trace_steps(scene, problem, sink, resume):
             def on_jump(jump, d_vals=d_vals, jumped=jumped):
                 sink.jump(jump)
                 jumped[0] += 1
-                moved = band and _regridded(band, sink, sink.problem, jump.after, scene)
+                moved = band and _regridded(band, sink, sink.problem, jump.after, scene,
+                                              landed=True)
                 if moved:
                     # on from the landing: the separations beyond it
                     sign = math.copysign(1.0, d_vals[-1] - d_vals[0])
@@ -202,7 +204,8 @@ def trace_steps(scene, problem, sink, resume):
                 # from the last committed state on the static band [0, band], which holds
                 # wherever the edge can go; the next exchange returns to the follow band
                 if band is None or jumped[0] or seen[0] == 0 or last[0] is None \
-                        or wide == last[0].d or problem is getattr(sink, "wide", None):
+                        or wide == last[0].d or problem is getattr(sink, "wide", None) \
+                        or not band.widen_affordable(scene.grid["band"]):
                     raise
                 wide = last[0].d
                 problem, start = _widened(band, sink, problem, last[0], scene)
