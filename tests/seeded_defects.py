@@ -816,10 +816,9 @@ DEFECTS = [
       "leading it", "femadh/discretisation/moving.py",
       (("return x + math.copysign(lim, x - x0) if abs(x - x0) > lim else x",
         "return x - math.copysign(lim, x - x0) if abs(x - x0) > lim else x"),)),
-    D("edgeband_inner_gap", "follow band: inner edge at the cohesive zone's outer end, not "
-      "at sigma", "femadh/runner/tracing.py",
-      (("zone_gap(problem.effects, floor), floor * (1 + 1e-6),",
-        "zone_gap(problem.effects, floor), zone_gap(problem.effects, floor),"),)),
+    D("edgeband_inner_gap", "follow band: the band starts half a width beyond the inner "
+      "(contact) edge instead of half a width inside it", "femadh/discretisation/moving.py",
+      (("inner=lo - self.half)", "inner=lo + self.half)"),)),
     D("carry_unclipped", "carried state: the interpolated surface may cut below sigma",
       "femadh/discretisation/moving.py", (("    w = np.minimum(w, b - new.sigma)\n", ""),)),
     D("carry_wrong_d", "carried state re-solved 0.01 nm off its separation",
