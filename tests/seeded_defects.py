@@ -1307,6 +1307,11 @@ DEFECTS = [
       "the band)", "femadh/runner/tracing.py",
       (("                    zone_gap(problem.effects, floor), floor * (1 + 1e-6),",
         "                    floor * (1 + 2e-6), floor * (1 + 1e-6),"),)),
+    # -- review fixes after the session-7 merge
+    D("follow_by_refinement", "adaptive: the follow band chosen by the accuracy's refined "
+      "spacing, not the trapping cap alone", "femadh/runner/adaptive.py",
+      (("if family.count(0.98 * safe_spacing(problem)) <= FOLLOW_NODES:",
+        "if family.count(min(h, 0.98 * safe_spacing(problem))) <= FOLLOW_NODES:"),)),
 ]
 
 

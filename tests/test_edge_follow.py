@@ -104,6 +104,11 @@ def test_the_adaptive_plan_follows_the_edge_only_where_the_static_band_is_too_bi
     q = plan_grid(fig4.effects, fig4.gap.sigma, fig4.sphere, fig4.analysis_radius,
                   fig4.d_values, 1e-3)
     assert adaptive._follow_trial(fig4, q.family, q.spacing) is None
+    # nor when the accuracy's refinement takes its static band past FOLLOW_NODES (Fig 4 at
+    # 1e-4 refines to ~1090 nodes): the trapping cap alone decides
+    fine = q.spacing * 0.15
+    assert q.family.count(fine) > adaptive.FOLLOW_NODES
+    assert adaptive._follow_trial(fig4, q.family, fine) is None
 
 
 def test_the_band_leads_the_edges_travel():

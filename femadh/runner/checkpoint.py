@@ -66,7 +66,7 @@ def save_checkpoint(folder, sink):
         if lu.scale is not None:
             data["scale"] = lu.scale
     elif isinstance(lu, TrailingCholesky):
-        data.update(lu_kind=np.array("cholesky"), lu=lu.kept, dims=np.array([lu.n, lu.m0,
+        data.update(lu_kind=np.array("cholesky_kept"), lu=lu.kept, dims=np.array([lu.n, lu.m0,
                                                                              lu.k_valid]))
     elif isinstance(lu, tuple) and len(lu) == 2 and isinstance(lu[0], tuple):
         data.update(lu_kind=np.array("dense"), lu=lu[0][0], piv=lu[0][1], lu_I=lu[1])
@@ -97,7 +97,9 @@ def load_checkpoint(folder, k, d):
                 lu.lu, lu.piv = z["lu"], z["piv"]
                 lu.scale = z["scale"] if "scale" in z.files else None
                 lu._block = (None, None)
-            elif kind == "cholesky":
+            elif kind == "cholesky_kept":
+                # (a checkpoint of an older femadh holds the factor's inverse under
+                # "cholesky": read as no factorisation, which the resumed state rebuilds)
                 lu = TrailingCholesky.from_kept(z["lu"], *(int(x) for x in z["dims"]))
             elif kind == "dense":
                 lu = ((z["lu"], z["piv"]), z["lu_I"])
