@@ -53,7 +53,8 @@ def accuracy_rows(only=None):
 
     def spy(sc, **kw):
         res, t = timed(sc, **kw)
-        a = sc.target_accuracy if sc.nodes is None and not kw else None
+        a = (sc.target_accuracy if "nodes" not in sc.raw.get("solver", {}) and not kw
+             else None)
         if a is not None and res.accuracy:
             seen[(Path(sc.path).stem, a)] = _record(res)
         return res, t
@@ -72,6 +73,19 @@ def accuracy_rows(only=None):
             print(f"{name}: reference {ref['nodes']} nodes", flush=True)
     finally:
         acc._timed = timed
+    return out
+
+
+def requests(spec):
+    """Each request of ``spec`` ("scene:accuracy,...") run alone: its runs, no reference."""
+    out = {}
+    for item in spec.split(","):
+        name, a = item.split(":")
+        base = femadh.load_scene(acc.SCENES / f"{name}.toml")
+        res, _ = acc._timed(acc._adaptive(base, float(a)))
+        out[item] = _record(res)
+        print(item, out[item]["nodes"], [f"{e:.3g}" for e in out[item]["estimate"]],
+              out[item]["status"], out[item]["met"], flush=True)
     return out
 
 
@@ -96,16 +110,19 @@ def main(argv=None):
     ap.add_argument("--no-accuracy", action="store_true", help="the bundled scenes only")
     ap.add_argument("--no-scenes", action="store_true", help="the accuracy rows only")
     ap.add_argument("--json", help="write the records here")
+    ap.add_argument("--requests", help="scene:accuracy,... run alone (no reference)")
     args = ap.parse_args(argv)
     load = os.getloadavg()[0]
     data = {"load_start": load, "femadh": femadh.__file__}
-    if not args.no_accuracy:
+    if args.requests:
+        data["requests"] = requests(args.requests)
+    elif not args.no_accuracy:
         data["accuracy"] = accuracy_rows(args.only)
         for r in data["accuracy"]:
             print(f"{r['scene']} {r['setting']:g} {r['quantity']}: nodes {r.get('nodes')} "
                   f"runs {r.get('runs')} {r.get('nodes')} est {r['estimated']:.2e} "
                   f"achieved {r['achieved']:.2e} {r['status']} met={r['met']}")
-    if not args.no_scenes:
+    if not (args.no_scenes or args.requests):
         data["scenes"] = scenes(args.only)
     data["load_end"] = os.getloadavg()[0]
     if args.json:
