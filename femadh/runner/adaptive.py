@@ -7,7 +7,12 @@ an analysis radius whose tail is negligible), its band spacing capped so that ne
 the coarser members of its estimate are lattice-trapped, and then refined by the estimate
 until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
 
-    h <- h * clamp((SAFETY * target / error)^(1/ORDER), MIN_FACTOR, MAX_FACTOR)
+    h <- h * clamp((s * target / error)^(1/p), MIN_FACTOR, MAX_FACTOR)
+
+with p the order the estimate showed between the last two converged runs of the same family
+(clamped to ORDER_BOUNDS; the assumed ORDER for the first refinement) and s the aim, SAFETY
+far from the target, closer to AIM the nearer the estimate is to it (:func:`_safety`;
+measured on every adaptive row of validation/accuracy.py: validation/results/adaptive_order.md).
 
 A failed solve (a node snapping on its own, a stalled continuation, a landing after a fold
 that Newton cannot polish) halves h, a contact reaching the analysis radius doubles the
@@ -49,7 +54,8 @@ from .result import STOPPED
 
 #: runs (refinements + 1) an adaptive run may make
 MAX_TRIALS = 5
-#: the refined spacing aims at this fraction of the target (the order is only estimated)
+#: the refined spacing aims at this fraction of the target where the estimate is far from it
+#: (from about 14x the target on; nearer it, :func:`_safety` aims closer)
 SAFETY = 0.6
 #: assumed convergence order of the headline numbers in the band spacing (local orders
 #: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order)
@@ -57,7 +63,12 @@ ORDER = 1.5
 #: limits of one refinement factor of h
 MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
 #: range an order observed between two runs of one family is clamped to (outside it the two
-#: estimates say more about their noise than about the spacing)
+#: estimates say more about their noise than about the spacing: the estimate's orders between
+#: consecutive runs, measured on the adaptive rows of validation/accuracy.py, spread 0.63-6.3,
+#: validation/results/adaptive_order.md). A second run that missed the target was sized with
+#: an order its estimate did not reach (unless MIN_FACTOR limited its step), so the order
+#: observed then is the lower one: the third member is finer than the assumed order would
+#: make it, never coarser
 ORDER_BOUNDS = (0.5, 4.0)
 #: the aim near the target: the next member is sized so that even an order ORDER_SPREAD x
 #: the one it is sized with lands the estimate at AIM x the target (measured: Fig 4 at 1e-3,
