@@ -64,7 +64,7 @@ ORDER = 1.5
 MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
 #: range an order observed between two runs of one family is clamped to (outside it the two
 #: estimates say more about their noise than about the spacing: the estimate's orders between
-#: consecutive runs, measured on the adaptive rows of validation/accuracy.py, spread 0.63-6.3,
+#: consecutive runs, measured on the adaptive rows of validation/accuracy.py, spread 0.3-7.1,
 #: validation/results/adaptive_order.md). A second run that missed the target was sized with
 #: an order its estimate did not reach (unless MIN_FACTOR limited its step), so the order
 #: observed then is the lower one: the third member is finer than the assumed order would
