@@ -1210,6 +1210,10 @@ DEFECTS = [
       "femadh/runner/adaptive.py",
       (('                or prev.get("analysis_radius_m") != step["analysis_radius_m"]):',
         "                ):"),)),
+    D("refine_order_across_follow", "adaptive loop: the order observed between a static band "
+      "and one that follows the edge", "femadh/runner/adaptive.py",
+      (('                or ("follow_m" in prev) != ("follow_m" in step)):',
+        "                or False):"),)),
     D("refine_order_rising_estimate", "adaptive loop: an estimate that rose read as an order (clamped "
       "to its floor)", "femadh/runner/adaptive.py",
       (("        if e0 <= e1:\n            return ORDER", "        if False:\n            return ORDER"),)),

@@ -102,13 +102,15 @@ def test_an_observed_order_outside_the_bounds_is_clamped(q, expect):
 
 
 def test_the_observed_order_needs_the_same_family_and_a_falling_estimate():
-    """Another analysis radius or band, a failed or unjudged earlier run, an estimate that rose:
-    the assumed ORDER; the latest qualifying step is the one used."""
+    """Another analysis radius or band, a static band against one following the edge, a failed
+    or unjudged earlier run, an estimate that rose: the assumed ORDER; the latest qualifying
+    step is the one used."""
     step = {"spacing_m": 1e-9, "grid_rel_error": 2e-3, "tail_rel_error": 1e-4,
             "band_m": 1e-6, "analysis_radius_m": 1e-5, "status": "converged"}
     good = dict(step, spacing_m=2e-9, grid_rel_error=2e-3 * 2**2.0 + 1e-4 * (2**2.0 - 1))
     assert adaptive._order(step, [good]) == pytest.approx(2.0, rel=1e-12, abs=0)
     for other in (dict(good, analysis_radius_m=2e-5), dict(good, band_m=2e-6),
+                  dict(good, follow_m=5e-8),
                   dict(good, status="failed"), dict(good, members_failed=True),
                   dict(good, grid_rel_error=1e-3), dict(good, grid_rel_error=math.nan),
                   dict(good, spacing_m=1e-9)):

@@ -459,15 +459,16 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):
 
 def _order(step, history):
     """The order the next member is sized with: the estimate's observed order between
-    ``step`` and the latest earlier converged step of the same family (band, analysis radius)
-    at another spacing, p = log(e0 / e1) / log(h0 / h1), clamped to ORDER_BOUNDS; ORDER
+    ``step`` and the latest earlier converged step of the same family (band, analysis radius,
+    a static band or one following the edge) at another spacing, p = log(e0 / e1) / log(h0 / h1), clamped to ORDER_BOUNDS; ORDER
     where there is none or the estimate did not fall with the spacing (its order says
     nothing then)."""
     h1, e1 = step["spacing_m"], step["grid_rel_error"] + step["tail_rel_error"]
     for prev in reversed(history):
         if (prev.get("status") != "converged" or prev.get("members_failed")
                 or prev.get("band_m") != step["band_m"]
-                or prev.get("analysis_radius_m") != step["analysis_radius_m"]):
+                or prev.get("analysis_radius_m") != step["analysis_radius_m"]
+                or ("follow_m" in prev) != ("follow_m" in step)):
             continue
         h0 = prev["spacing_m"]
         e0 = prev["grid_rel_error"] + prev["tail_rel_error"]
