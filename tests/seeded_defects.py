@@ -1208,8 +1208,8 @@ DEFECTS = [
       (("        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))", "        return p"),)),
     D("refine_order_any_family", "adaptive loop: the order observed across a grown analysis radius",
       "femadh/runner/adaptive.py",
-      (('                or prev.get("analysis_radius_m") != step["analysis_radius_m"]):',
-        "                ):"),)),
+      (('                or prev.get("analysis_radius_m") != step["analysis_radius_m"]\n',
+        ""),)),
     D("refine_order_across_follow", "adaptive loop: the order observed between a static band "
       "and one that follows the edge", "femadh/runner/adaptive.py",
       (('                or ("follow_m" in prev) != ("follow_m" in step)):',
