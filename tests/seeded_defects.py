@@ -1190,6 +1190,41 @@ DEFECTS = [
     D("adaptive_radius_need_power", "adaptive grid: the radius needed from the tail's decay "
       "with the power p, not 1/p", "femadh/runner/adaptive.py",
       (("a1 * (t1 / tail_target) ** (1 / p) * 1e6", "a1 * (t1 / tail_target) ** p * 1e6"),)),
+    # -- the adaptive loop sized by the estimate's observed order (refine)
+    D("refine_order_assumed_always", "adaptive loop: every refinement sized with the assumed ORDER, "
+      "the observed order ignored", "femadh/runner/adaptive.py",
+      (("    order = _order(step, history)", "    order = ORDER"),)),
+    D("refine_order_not_applied", "adaptive loop: the observed order recorded but the factor taken "
+      "at ORDER", "femadh/runner/adaptive.py",
+      (("factor = (safety * target / err) ** (1.0 / order)",
+        "factor = (safety * target / err) ** (1.0 / ORDER)"),)),
+    D("refine_order_half", "adaptive loop: the observed order over twice the log spacing ratio",
+      "femadh/runner/adaptive.py",
+      (("p = math.log(e0 / e1) / math.log(h0 / h1)",
+        "p = math.log(e0 / e1) / (2 * math.log(h0 / h1))"),)),
+    D("refine_order_unclamped", "adaptive loop: the observed order not clamped to ORDER_BOUNDS",
+      "femadh/runner/adaptive.py",
+      (("        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))", "        return p"),)),
+    D("refine_order_any_family", "adaptive loop: the order observed across a grown analysis radius",
+      "femadh/runner/adaptive.py",
+      (('                or prev.get("analysis_radius_m") != step["analysis_radius_m"]\n',
+        ""),)),
+    D("refine_order_across_follow", "adaptive loop: the order observed between a static band "
+      "and one that follows the edge", "femadh/runner/adaptive.py",
+      (('                or ("follow_m" in prev) != ("follow_m" in step)):',
+        "                or False):"),)),
+    D("refine_order_rising_estimate", "adaptive loop: an estimate that rose read as an order (clamped "
+      "to its floor)", "femadh/runner/adaptive.py",
+      (("        if e0 <= e1:\n            return ORDER", "        if False:\n            return ORDER"),)),
+    D("refine_order_oldest_step", "adaptive loop: the order from the oldest qualifying run, not the "
+      "latest", "femadh/runner/adaptive.py",
+      (("    for prev in reversed(history):", "    for prev in history:"),)),
+    D("refine_safety_far_everywhere", "adaptive loop: SAFETY at every distance from the target (no "
+      "near aim)", "femadh/runner/adaptive.py",
+      (("    return min(AIM, max(SAFETY, s))", "    return SAFETY"),)),
+    D("refine_safety_exponent", "adaptive loop: the near aim's exponent -(1 - c) instead of "
+      "-(1 - c)/c", "femadh/runner/adaptive.py",
+      (("ratio ** (-(1.0 - c) / c) if ratio > 0", "ratio ** (-(1.0 - c)) if ratio > 0"),)),
     D("mem_fold_solves_uncounted", "reduced member: a fold search that falls back leaves its "
       "corrector solves uncounted", "femadh/runner/members.py",
       (("        solves, m.solves = solves + 1, m.solves + 1     # counted as made",

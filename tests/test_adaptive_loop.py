@@ -101,7 +101,9 @@ def test_members_failed_refine_and_a_last_run_without_them_is_not_judged():
 
 def test_a_budget_spent_names_the_accuracy_reached_the_nodes_the_time_and_the_need():
     """An estimate that stays at 1.5x the target: each refinement takes the factor
-    (SAFETY / 1.5)^(1/ORDER); MAX_TRIALS runs, then one line naming the accuracy reached,
+    (s / 1.5)^(1/ORDER), s the aim near the target (AIM^(1/c) 1.5^(-(1-c)/c), c =
+    ORDER_SPREAD), the assumed order throughout (an estimate that did not fall shows none);
+    MAX_TRIALS runs, then one line naming the accuracy reached,
     the nodes, the runs, the time and about how many nodes the request needs (the family's
     count at the spacing the assumed order gives)."""
     from femadh.discretisation.plan import GRADING_FRACTION
@@ -110,7 +112,8 @@ def test_a_budget_spent_names_the_accuracy_reached_the_nodes_the_time_and_the_ne
     run, seen = scripted([{"grid": 1.5e-2}])
     res = adaptive.run_adaptive(sc, None, run=run)
     assert len(seen) == adaptive.MAX_TRIALS
-    factor = (adaptive.SAFETY / 1.5) ** (1 / adaptive.ORDER)
+    c = adaptive.ORDER_SPREAD
+    factor = (adaptive.AIM ** (1 / c) * 1.5 ** (-(1 - c) / c) / 1.5) ** (1 / adaptive.ORDER)
     for (h, *_), (h_next, *_) in zip(seen, seen[1:]):
         assert h_next == pytest.approx(factor * h, rel=1e-12, abs=0)
     last = res.accuracy["steps"][-1]

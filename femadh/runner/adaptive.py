@@ -7,7 +7,12 @@ an analysis radius whose tail is negligible), its band spacing capped so that ne
 the coarser members of its estimate are lattice-trapped, and then refined by the estimate
 until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
 
-    h <- h * clamp((SAFETY * target / error)^(1/ORDER), MIN_FACTOR, MAX_FACTOR)
+    h <- h * clamp((s * target / error)^(1/p), MIN_FACTOR, MAX_FACTOR)
+
+with p the order the estimate showed between the last two converged runs of the same family
+(clamped to ORDER_BOUNDS; the assumed ORDER for the first refinement) and s the aim, SAFETY
+far from the target, closer to AIM the nearer the estimate is to it (:func:`_safety`;
+measured on every adaptive row of validation/accuracy.py: validation/results/adaptive_order.md).
 
 A failed solve (a node snapping on its own, a stalled continuation, a landing after a fold
 that Newton cannot polish) halves h, a contact reaching the analysis radius doubles the
@@ -49,13 +54,30 @@ from .result import STOPPED
 
 #: runs (refinements + 1) an adaptive run may make
 MAX_TRIALS = 5
-#: the refined spacing aims at this fraction of the target (the order is only estimated)
+#: the refined spacing aims at this fraction of the target where the estimate is far from it
+#: (from about 3.7x the target on; nearer it, :func:`_safety` aims closer)
 SAFETY = 0.6
 #: assumed convergence order of the headline numbers in the band spacing (local orders
 #: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order)
 ORDER = 1.5
 #: limits of one refinement factor of h
 MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
+#: range an order observed between two runs of one family is clamped to (outside it the two
+#: estimates say more about their noise than about the spacing: the estimate's orders between
+#: consecutive runs, measured on the adaptive rows of validation/accuracy.py, spread 0.3-7.1,
+#: validation/results/adaptive_order.md). A second run that missed the target was sized with
+#: an order its estimate did not reach (unless MIN_FACTOR limited its step), so the order
+#: observed then is the lower one: the third member is finer than the assumed order would
+#: make it, never coarser
+ORDER_BOUNDS = (0.5, 4.0)
+#: the aim near the target: the next member is sized so that even an order ORDER_SPREAD x
+#: the one it is sized with lands the estimate at AIM x the target (ORDER_SPREAD measured on
+#: Fig 4 at 1e-3: its estimate's order 1.29 between the 279- and 631-node runs against the
+#: assumed 1.5); AIM leaves room for the estimate's jitter about its power law, up to 1.31x
+#: measured between consecutive runs (a stiction-map point, sigma 1.43 nm, p/psat 0.55: 1.17e-3
+#: -> 1.10e-3 on a step promising 1.40x; with AIM 0.9 it needed a third run), AIM = 1 / 1.31.
+#: Far from the target this needs a safety below SAFETY, which then holds
+ORDER_SPREAD, AIM = 0.87, 0.76
 #: the accuracy the plan's BAND_NODES are sized for; the fewest nodes across any band
 REFERENCE_ACCURACY, MIN_BAND_NODES = 1e-3, 48
 #: a feature beyond this fraction of the band radius widens the band
@@ -286,7 +308,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                       "tail_rel_error": tail_e, "wall_time_s": res.wall_time})
         if tr.follow:
             steps[-1]["follow_m"] = tr.follow
-        why = _decide(scene, tr, res, estimate, steps[-1], plan, target, ahead)
+        why = _decide(scene, tr, res, estimate, steps[-1], plan, target, ahead, steps[:-1])
         return res, (grid_e + tail_e if why is None else math.inf), why
 
     def refine(tr, res, error, why):
@@ -368,7 +390,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     return res
 
 
-def _decide(scene, tr, res, estimate, step, plan, target, ahead):
+def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):
     """Judge one trial's result and decide the next member: sets ``ahead["next"]`` (the
     (family, band spacing) to run next, or None) and ``ahead["failure"]`` (why the request
     ends, or None), records the reason in ``step``; returns why the trial is not resolved
@@ -378,7 +400,10 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead):
     the remedy: a contact at the analysis radius doubles the disk, any other failure of the
     discretisation (a node snapping on its own, a stalled continuation, a landing Newton
     could not polish after a fold) halves h; a stopped run (signal, time limit) or an
-    unjudged one (``estimate`` not True) ends the loop."""
+    unjudged one (``estimate`` not True) ends the loop. An estimate above the target sizes
+    the next member with the order the estimate showed between this run and the last
+    converged one of the same family (``history``, the earlier steps; :func:`_order`), the
+    assumed ORDER without one, aiming closer the nearer the target it is (:func:`_safety`)."""
     family, h = tr.family, tr.spacing
     ahead["next"] = ahead["failure"] = None
     if res.status in STOPPED:
@@ -428,9 +453,47 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead):
                             f"sphere's radius {scene.sphere.radius * 1e9:.4g} nm); the grid "
                             f"part is {grid_e:.2g}")
         return None
-    factor = (SAFETY * target / err) ** (1.0 / ORDER) if err > 0 else MIN_FACTOR
+    order = _order(step, history)
+    safety = _safety(err / target)
+    step["order_used"], step["safety"] = order, safety
+    factor = (safety * target / err) ** (1.0 / order) if err > 0 else MIN_FACTOR
     ahead["next"] = (family, h * min(MAX_FACTOR, max(MIN_FACTOR, factor)))
     return None
+
+
+def _order(step, history):
+    """The order the next member is sized with: the estimate's observed order between
+    ``step`` and the latest earlier converged step of the same family (band, analysis radius,
+    a static band or one following the edge) at another spacing, p = log(e0 / e1) / log(h0 / h1), clamped to ORDER_BOUNDS; ORDER
+    where there is none or the estimate did not fall with the spacing (its order says
+    nothing then)."""
+    h1, e1 = step["spacing_m"], step["grid_rel_error"] + step["tail_rel_error"]
+    for prev in reversed(history):
+        if (prev.get("status") != "converged" or prev.get("members_failed")
+                or prev.get("band_m") != step["band_m"]
+                or prev.get("analysis_radius_m") != step["analysis_radius_m"]
+                or ("follow_m" in prev) != ("follow_m" in step)):
+            continue
+        h0 = prev["spacing_m"]
+        e0 = prev["grid_rel_error"] + prev["tail_rel_error"]
+        if not (math.isfinite(e0) and math.isfinite(e1) and e1 > 0 and h0 > h1 > 0):
+            continue
+        if e0 <= e1:
+            return ORDER
+        p = math.log(e0 / e1) / math.log(h0 / h1)
+        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))
+    return ORDER
+
+
+def _safety(ratio):
+    """The fraction of the target the next member aims at, for an estimate ``ratio`` x the
+    target: with the spacing scaled by (s / ratio)^(1/p) and a true order q = ORDER_SPREAD p,
+    the estimate lands at ratio (s / ratio)^ORDER_SPREAD x the target; s is the largest that
+    keeps this at AIM, s = AIM^(1/c) ratio^(-(1 - c)/c), c = ORDER_SPREAD, within [SAFETY,
+    AIM] (SAFETY from about 3.7x the target on: the old aim)."""
+    c = ORDER_SPREAD
+    s = AIM ** (1.0 / c) * ratio ** (-(1.0 - c) / c) if ratio > 0 else AIM
+    return min(AIM, max(SAFETY, s))
 
 
 def _radius_needed(steps, tail_target):
