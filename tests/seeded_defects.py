@@ -1332,8 +1332,8 @@ DEFECTS = [
         "            self.spacing) <= 10 * WIDEN_MAX_NODES"),)),
     D("ef_follow_decided_uncapped", "adaptive plan: follow decided by the uncapped static "
       "member's count", "femadh/runner/adaptive.py",
-      (("            if family.count(static) <= FOLLOW_NODES:",
-        "            if family.count(spacing) <= FOLLOW_NODES:"),)),
+      (("    if family.count(0.98 * safe_spacing(problem)) <= FOLLOW_NODES:",
+        "    if family.count(spacing) <= FOLLOW_NODES:"),)),
     D("ef_follow_static_grading", "adaptive plan: the follow band keeps the static family's "
       "grading (2 % per node)", "femadh/runner/adaptive.py",
       (("        fam = GridFamily(family.radius, family.band, FOLLOW_GRADING_SPACINGS * h)",

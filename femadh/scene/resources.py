@@ -93,7 +93,7 @@ ESTIMATE_STATES = 10
 #: (--force)
 MAX_REASONABLE_S = 1800.0
 #: accuracy targets below this cannot be met within the node budget: the error falls like
-#: h^1.5, 1e-3 needs ~630 nodes (README, "Accuracy"), so 1e-5 would need ~13 000 (budget:
+#: h^1.5, 1e-3 needs ~600 nodes (README, "Accuracy"), so 1e-5 would need ~13 000 (budget:
 #: femadh.runner.estimates.MAX_NODES = 3200)
 MIN_REACHABLE_ACCURACY = 1e-5
 
