@@ -98,10 +98,26 @@ def _exchange(sink, old, new):
             setattr(sink, grid_of, new)
     kept = {id(s) for x in (sink.peak, getattr(sink, "_rival", None)) if x is not None
             for s in x[2:5] if s is not None} - {id(s) for s in held}
+    copies = {}
     for b, s in list(sink.last.items()):
         if id(s) in kept:           # (a restart's copy, the peak's own left as it is)
-            sink.last[b] = replace(s)
-    snaps = held + list(sink.last.values())
+            sink.last[b] = copies[id(s)] = replace(s)
+    # the next peak candidate's previous neighbour (a state before the exchange) goes on to
+    # the new grid with it: the last committed state's copy, or a fold's landing (never in
+    # sink.last) - else a later peak's bracket spans two grids (state_between interpolates
+    # node by node: a ValueError on different counts, mismatched nodes on equal ones)
+    moved = held + list(sink.last.values())
+    prev = getattr(sink, "_prev", None)
+    if prev is not None:
+        s = prev[1]
+        if id(s) in copies:
+            sink._prev = (prev[0], copies[id(s)])
+        elif not any(s is x for x in moved):
+            # (a copy: the landing is also a fold record - sink.pieces, sink.folds - and
+            # maybe a completed peak's state, each on its own grid)
+            sink._prev = (prev[0], replace(s))
+            moved.append(sink._prev[1])
+    snaps = moved
     for snap in {id(x): x for x in snaps}.values():
         if getattr(snap, "w", None) is not None and np.ndim(snap.w) == 1 and \
                 snap.w.size == old.grid.n:

@@ -1,0 +1,77 @@
+"""The max-adhesion bracket the sink keeps (femadh.runner.sink.Sink's peak bookkeeping) across
+a grid exchange (femadh.runner.tracing._exchange), a resume (Sink.load) and a failed fold
+re-solve (Sink._fold_fields): synthetic sequences of committed records.
+
+The bracket [prev, best, next] is interpolated node by node (femadh.runner.peak.state_between):
+its states must be on one grid (the peak's problem's) and hold displacements."""
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+
+from femadh.runner.sink import Committed, Sink
+from femadh.runner.tracing import _exchange
+
+
+def _problem(n):
+    """A stand-in problem of n nodes on [0, 1 um] without a gap constraint: what _exchange
+    reads (grid.n, grid.nodes, sigma)."""
+    return SimpleNamespace(grid=SimpleNamespace(n=n, nodes=np.linspace(0.0, 1e-6, n)),
+                           sigma=None)
+
+
+def _sink(problem):
+    s = Sink.__new__(Sink)
+    s.problem, s.writer = problem, None
+    s.peak, s._prev, s._need_next, s._rival = None, None, False, None
+    s.peak_problem = s.rival_problem = problem
+    s.pieces, s.last, s.committed = {}, {}, {}
+    return s
+
+
+def _rec(d, f, n):
+    return Committed(d, np.full(n, -d), np.zeros(n, bool), 0.0, f)
+
+
+def _commit(sink, d, f):
+    snap = _rec(d, f, sink.problem.grid.n)
+    sink._track_peak("retract", snap)
+    return snap
+
+
+def _on_peak_grid(sink):
+    n = sink.peak_problem.grid.n
+    return [np.size(s.w) for s in sink.peak[2:5] if s is not None], n
+
+
+def test_exchange_moves_the_next_candidates_neighbour():
+    """A peak completed on 5 nodes stays there; the next (larger) state, after the exchange
+    to 7 nodes, is bracketed by the last state before the exchange, carried to 7 nodes."""
+    sink = _sink(_problem(5))
+    for d, f in ((1.0e-9, 1.0), (1.1e-9, 3.0), (1.2e-9, 2.0)):
+        _commit(sink, d, f)
+    assert sink.peak[4] is not None         # complete on the old grid
+    old_peak = list(sink.peak)
+    _exchange(sink, sink.problem, _problem(7))
+    assert all(np.size(s.w) == 5 for s in old_peak[2:5])    # the kept peak left as it was
+    _commit(sink, 1.3e-9, 5.0)
+    _commit(sink, 1.4e-9, 4.0)
+    sizes, n = _on_peak_grid(sink)
+    assert n == 7 and sizes == [7, 7, 7], sizes
+
+
+def test_exchange_moves_a_landing_neighbour():
+    """A fold after the completed peak: its landing (never in sink.last) is the next
+    candidate's previous neighbour and must go on to the new grid; the fold record itself
+    stays on its own."""
+    sink = _sink(_problem(5))
+    for d, f in ((1.0e-9, 1.0), (1.1e-9, 3.0), (1.2e-9, 2.0)):
+        _commit(sink, d, f)
+    before, after = _rec(1.25e-9, 2.5, 5), _rec(1.3e-9, 2.0, 5)
+    sink._track_fold("retract", before, after)
+    _exchange(sink, sink.problem, _problem(7))
+    assert np.size(after.w) == 5            # the fold's record on its own grid
+    _commit(sink, 1.4e-9, 5.0)
+    _commit(sink, 1.5e-9, 4.0)
+    sizes, n = _on_peak_grid(sink)
+    assert n == 7 and sizes == [7, 7, 7], sizes
