@@ -75,3 +75,24 @@ def test_exchange_moves_a_landing_neighbour():
     _commit(sink, 1.5e-9, 4.0)
     sizes, n = _on_peak_grid(sink)
     assert n == 7 and sizes == [7, 7, 7], sizes
+
+
+def test_resume_replay_leaves_a_neighbour_with_a_surface():
+    """A resume replays the committed rows and folds as records without displacements and
+    reads back those of the peak's, the rival's and each branch's last state
+    (Sink.load). The last row at its landing's separation is the landing's own state: the
+    next peak's previous neighbour must be that row (read back), not the landing's record
+    (no surface: refine_peak failed on w = None)."""
+    sink = _sink(_problem(5))
+    blank = lambda d, f: Committed(d, None, None, 0.0, f)     # noqa: E731 (a replayed record)
+    for d, f in ((1.0e-9, 3.0), (1.1e-9, 2.0)):
+        sink._track_peak("retract", blank(d, f))
+    sink._track_fold("retract", blank(1.15e-9, 1.5), blank(1.2e-9, 1.0))
+    sink._track_peak("retract", blank(1.2e-9, 1.0))          # the landing's row
+    # what load() reads back: the peak's bracket and the last state of each branch
+    for s in [x for x in sink.peak[2:5] if x is not None] + list(sink.last.values()):
+        s.w = np.full(5, -s.d)
+    _commit(sink, 1.3e-9, 5.0)       # the resumed run's next state: a new peak
+    _commit(sink, 1.4e-9, 4.0)
+    assert all(s.w is not None for s in sink.peak[2:5]), [s.w for s in sink.peak[2:5]]
+    assert sink.peak[2].d == 1.2e-9

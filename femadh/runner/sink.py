@@ -144,6 +144,11 @@ class Sink:
         elif prev is not None and prev.d == snap.d:
             if end:
                 self._close(branch, prev)
+            else:
+                # (a committed state at a landing's separation is the landing's own state:
+                # the next candidate's neighbour from here, as a resume replays it - the
+                # replay's landing record has no surface, the committed row's is read back)
+                self._prev = (branch, snap)
             return
         self._close(branch, snap)
         peak = self.peak
