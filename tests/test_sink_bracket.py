@@ -96,3 +96,75 @@ def test_resume_replay_leaves_a_neighbour_with_a_surface():
     _commit(sink, 1.4e-9, 4.0)
     assert all(s.w is not None for s in sink.peak[2:5]), [s.w for s in sink.peak[2:5]]
     assert sink.peak[2].d == 1.2e-9
+
+
+class _Solve:
+    """Stand-ins for femadh.contact's solve_state and trace and the sink's state_forces: the
+    neighbour's re-solve converges (or not, or raises), the re-trace to the fold state
+    raises (a kill -9 resume whose fold state does not trace again)."""
+
+    def __init__(self, monkeypatch, converged=True, raises=False, force=2.0):
+        import femadh.contact as contact
+        import femadh.runner.sink as sink_mod
+        from femadh.errors import ConvergenceError
+
+        def solve_state(p, d, w, **kw):
+            if raises:
+                raise ConvergenceError("stand-in: no stiffness", d=d)
+            return SimpleNamespace(d=d, w=w, converged=converged, stable=converged)
+
+        def trace(*a, **kw):
+            raise ConvergenceError("stand-in: the step to the fold state failed")
+        monkeypatch.setattr(contact, "solve_state", solve_state)
+        monkeypatch.setattr(contact, "trace", trace)
+        monkeypatch.setattr(sink_mod, "state_forces", lambda p, st: (0.0, 0.0, force))
+
+
+def _resumed(tmp_path, peak_is_fold):
+    """A replayed sink whose peak bracket holds a fold state without displacements (no
+    checkpoint in tmp_path), its committed neighbour the row k = 0 at 1.0 nm."""
+    sink = _sink(_problem(5))
+    sink.scene = SimpleNamespace(tolerance=1e-12, max_iter=10)
+    sink.result = SimpleNamespace(warnings=[])
+    fields = {0: (1.0e-9, np.full(5, -1e-9), None, np.zeros(5))}
+    row = _rec(1.0e-9, 2.0, 5)
+    fold = Committed(1.05e-9, None, None, np.nan, 3.0 if peak_is_fold else 1.0)
+    fold.near = 0
+    if peak_is_fold:        # the fold's last state is the largest F_ex: its own next
+        sink.peak = ["retract", 3.0, row, fold, fold]
+    else:                   # a landing is the peak's previous neighbour
+        sink.peak = ["retract", 4.0, fold, _rec(1.1e-9, 4.0, 5), _rec(1.2e-9, 3.5, 5)]
+    sink._fold_fields(tmp_path, [fold], fields)
+    return sink
+
+
+def test_failed_fold_peak_keeps_its_grid_force(tmp_path, monkeypatch):
+    """The fold's last state is the peak and does not trace again: the largest adhesion is
+    its recorded grid force at its separation (the stand-in neighbour, 2.0, made the
+    bracket one point and the headline its force: below the grid maximum, 3.0)."""
+    from femadh.runner.peak import peak_adhesion
+
+    _Solve(monkeypatch)
+    sink = _resumed(tmp_path, peak_is_fold=True)
+    F, d, _ = peak_adhesion(None, *sink.peak[2:5], sink.scene)
+    assert F >= sink.peak[1] and d == 1.05e-9, (F, d)
+    assert sink.result.warnings
+
+
+def test_failed_neighbour_resolve_is_no_nan(tmp_path, monkeypatch):
+    """The neighbour's re-solve does not converge: no NaN F_ex enters the bracket (the
+    landing side is cut at the best state), and a warning says so."""
+    _Solve(monkeypatch, converged=False)
+    sink = _resumed(tmp_path, peak_is_fold=False)
+    assert all(np.isfinite(s.f_ex) for s in sink.peak[2:5])
+    assert sink.peak[2] is sink.peak[3]
+    assert "did not re-solve" in sink.result.warnings[0]
+
+
+def test_neighbour_resolve_error_is_the_fallbacks(tmp_path, monkeypatch):
+    """The neighbour's re-solve raises a ConvergenceError: the fallback's failure (a
+    warning), not the resume's."""
+    _Solve(monkeypatch, raises=True)
+    sink = _resumed(tmp_path, peak_is_fold=False)
+    assert all(np.isfinite(s.f_ex) for s in sink.peak[2:5])
+    assert sink.result.warnings
