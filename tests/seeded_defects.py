@@ -1307,6 +1307,29 @@ DEFECTS = [
       "the band)", "femadh/runner/tracing.py",
       (("                    zone_gap(problem.effects, floor), floor * (1 + 1e-6),",
         "                    floor * (1 + 2e-6), floor * (1 + 1e-6),"),)),
+    # -- the max-adhesion bracket across a grid exchange, a resume, a failed fold re-solve
+    D("sb_exchange_prev_copy", "grid exchange: the next candidate's neighbour left on the "
+      "old grid (the last state's copy not taken)", "femadh/runner/tracing.py",
+      (("            sink._prev = (prev[0], copies[id(s)])",
+        "            pass"),)),
+    D("sb_exchange_prev_landing", "grid exchange: a landing neighbour left on the old grid",
+      "femadh/runner/tracing.py",
+      (("            sink._prev = (prev[0], replace(s))\n            moved.append(sink._prev[1])",
+        "            pass"),)),
+    D("sb_landing_row_prev", "resume: the landing's record (no surface) stays the next "
+      "candidate's neighbour", "femadh/runner/sink.py",
+      (("                self._prev = (branch, snap)\n            return",
+        "                pass\n            return"),)),
+    D("sb_fold_peak_stand_in", "resume: a fold state that is the peak replaced by its "
+      "smaller neighbour", "femadh/runner/sink.py",
+      (("                if x[3] is s:\n", "                if False:\n"),)),
+    D("sb_nan_stand_in", "resume: a neighbour that did not re-solve stands in with F_ex NaN",
+      "femadh/runner/sink.py",
+      (("math.nan, f0) if math.isfinite(f0) else None", "math.nan, f0) if True else None"),)),
+    D("sb_resolve_error_escapes", "resume: the neighbour's ConvergenceError aborts the resume",
+      "femadh/runner/sink.py",
+      (("            except ConvergenceError:\n                ok = False",
+        "            except ValueError:\n                ok = False"),)),
 ]
 
 
