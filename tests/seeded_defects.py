@@ -1330,6 +1330,13 @@ DEFECTS = [
       "femadh/runner/sink.py",
       (("            except ConvergenceError:\n                ok = False",
         "            except ValueError:\n                ok = False"),)),
+    D("sb_fold_rise_linear", "max at a fold end: the rise to the fold as the secant times the "
+      "resolution", "femadh/runner/estimates.py",
+      (("    rise = abs(best.f_ex - prev.f_ex) * math.sqrt(r) / (math.sqrt(step + r) - "
+        "math.sqrt(r))", "    rise = abs(best.f_ex - prev.f_ex) * r / step"),)),
+    D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
+      "femadh/runner/estimates.py",
+      (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
 ]
 
 

@@ -8,6 +8,7 @@ from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from femadh.runner.sink import Committed, Sink
 from femadh.runner.tracing import _exchange
@@ -168,3 +169,44 @@ def test_neighbour_resolve_error_is_the_fallbacks(tmp_path, monkeypatch):
     sink = _resumed(tmp_path, peak_is_fold=False)
     assert all(np.isfinite(s.f_ex) for s in sink.peak[2:5])
     assert sink.result.warnings
+
+
+def _fold_sink(delta, r, D=0.2e-9, c=1e-3, d_f=1.3e-9, F_f=3e-5):
+    """A retract piece ending at a fold: F = F_f - c sqrt(d_f - d) (a saddle-node's
+    square-root branch, c in N/m^0.5), the last stable state delta before the fold, the
+    committed state before it a grid step D earlier; the jump recorded with resolution r."""
+    F = lambda d: F_f - c * np.sqrt(d_f - d)        # noqa: E731
+    sink = _sink(_problem(5))
+    prev = _rec(d_f - delta - D, F(d_f - delta - D), 5)
+    before = _rec(d_f - delta, F(d_f - delta), 5)
+    sink._track_peak("retract", prev)
+    sink._track_fold("retract", before, _rec(d_f + 0.1e-9, 1e-6, 5))
+    res = SimpleNamespace(jumps=[{"branch": "retract", "resolution_m": r}])
+    return sink, res, F_f - before.f_ex
+
+
+def test_fold_end_error_bounds_the_rise_to_the_fold():
+    """The maximum at a fold's last state: the d error holds the jump's resolution r and the
+    force error bounds the square-root branch's rise to the fold, exactly where the fold is
+    r beyond the state (the bound's worst case) and above it nearer; the secant times r (the
+    linear term) falls short of the rise by ~sqrt(D / r) = 32 at r = D / 1024."""
+    from femadh.runner.estimates import _fold_end
+
+    D = 0.2e-9
+    r = D / 1024                # the stepping's fold resolution, 2^-10 of the grid step
+    for delta, tight in ((r, True), (0.5 * r, False), (0.01 * r, False)):
+        sink, res, rise = _fold_sink(delta, r, D)
+        branch, f, prev, best, nxt = sink.peak
+        assert nxt is best
+        got = _fold_end(sink, res, branch, prev, best, nxt, best.d)
+        assert got is not None and got[0] == r
+        # (tight: equal to round-off, measured 2e-12 relative; 1e-9 allowed)
+        assert got[1] >= rise * (1 - 1e-9), (got, rise)
+        if tight:
+            assert got[1] == pytest.approx(rise, rel=1e-9, abs=0)
+            secant = (best.f_ex - prev.f_ex) / D * r
+            assert secant < rise / 20
+    # a maximum inside the bracket (the search's own d), or no recorded resolution: none
+    assert _fold_end(sink, res, branch, prev, best, nxt, best.d - 1e-12) is None
+    res.jumps[0]["resolution_m"] = 0.0
+    assert _fold_end(sink, res, branch, prev, best, nxt, best.d) is None
