@@ -1,5 +1,5 @@
 """The max-adhesion bracket the sink keeps (femadh.runner.sink.Sink's peak bookkeeping) across
-a grid exchange (femadh.runner.tracing._exchange), a resume (Sink.load) and a failed fold
+a grid exchange (femadh.runner.tracing.exchange_grid), a resume (Sink.load) and a failed fold
 re-solve (Sink._fold_fields): synthetic sequences of committed records.
 
 The bracket [prev, best, next] is interpolated node by node (femadh.runner.peak.state_between):
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from femadh.runner.sink import Committed, Sink
-from femadh.runner.tracing import _exchange
+from femadh.runner.tracing import exchange_grid
 
 
 def _problem(n):
-    """A stand-in problem of n nodes on [0, 1 um] without a gap constraint: what _exchange
+    """A stand-in problem of n nodes on [0, 1 um] without a gap constraint: what exchange_grid
     reads (grid.n, grid.nodes, sigma)."""
     return SimpleNamespace(grid=SimpleNamespace(n=n, nodes=np.linspace(0.0, 1e-6, n)),
                            sigma=None)
@@ -53,7 +53,7 @@ def test_exchange_moves_the_next_candidates_neighbour():
         _commit(sink, d, f)
     assert sink.peak[4] is not None         # complete on the old grid
     old_peak = list(sink.peak)
-    _exchange(sink, sink.problem, _problem(7))
+    exchange_grid(sink, sink.problem, _problem(7))
     assert all(np.size(s.w) == 5 for s in old_peak[2:5])    # the kept peak left as it was
     _commit(sink, 1.3e-9, 5.0)
     _commit(sink, 1.4e-9, 4.0)
@@ -70,7 +70,7 @@ def test_exchange_moves_a_landing_neighbour():
         _commit(sink, d, f)
     before, after = _rec(1.25e-9, 2.5, 5), _rec(1.3e-9, 2.0, 5)
     sink._track_fold("retract", before, after)
-    _exchange(sink, sink.problem, _problem(7))
+    exchange_grid(sink, sink.problem, _problem(7))
     assert np.size(after.w) == 5            # the fold's record on its own grid
     _commit(sink, 1.4e-9, 5.0)
     _commit(sink, 1.5e-9, 4.0)
@@ -190,7 +190,7 @@ def test_fold_end_error_bounds_the_rise_to_the_fold():
     force error bounds the square-root branch's rise to the fold, exactly where the fold is
     r beyond the state (the bound's worst case) and above it nearer; the secant times r (the
     linear term) falls short of the rise by ~sqrt(D / r) = 32 at r = D / 1024."""
-    from femadh.runner.estimates import _fold_end
+    from femadh.runner.estimates import fold_end_error
 
     D = 0.2e-9
     r = D / 1024                # the stepping's fold resolution, 2^-10 of the grid step
@@ -198,7 +198,7 @@ def test_fold_end_error_bounds_the_rise_to_the_fold():
         sink, res, rise = _fold_sink(delta, r, D)
         branch, f, prev, best, nxt = sink.peak
         assert nxt is best
-        got = _fold_end(sink, res, branch, prev, best, nxt, best.d)
+        got = fold_end_error(sink, res, branch, prev, best, nxt, best.d)
         assert got is not None and got[0] == r
         # (tight: equal to round-off, measured 2e-12 relative; 1e-9 allowed)
         assert got[1] >= rise * (1 - 1e-9), (got, rise)
@@ -207,6 +207,6 @@ def test_fold_end_error_bounds_the_rise_to_the_fold():
             secant = (best.f_ex - prev.f_ex) / D * r
             assert secant < rise / 20
     # a maximum inside the bracket (the search's own d), or no recorded resolution: none
-    assert _fold_end(sink, res, branch, prev, best, nxt, best.d - 1e-12) is None
+    assert fold_end_error(sink, res, branch, prev, best, nxt, best.d - 1e-12) is None
     res.jumps[0]["resolution_m"] = 0.0
-    assert _fold_end(sink, res, branch, prev, best, nxt, best.d) is None
+    assert fold_end_error(sink, res, branch, prev, best, nxt, best.d) is None

@@ -116,11 +116,11 @@ def refine_peak(scene, res, problem, sink):
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
-    sink.peak_fold = _fold_end(sink, res, branch, prev, best, nxt, d)
+    sink.peak_fold = fold_end_error(sink, res, branch, prev, best, nxt, d)
     return half
 
 
-def _fold_end(sink, res, branch, prev, best, nxt, d):
+def fold_end_error(sink, res, branch, prev, best, nxt, d):
     """(resolution_m, force_N) when the refined maximum is a fold's last state (the last
     state found stable before a recorded jump), else None.
 
@@ -195,7 +195,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     fold = getattr(sink, "peak_fold", None)
     if fold is not None:
         # the maximum at a fold's last state: the fold (and the branch's F_ex on to it) lies
-        # within the jump's resolution beyond it (:func:`_fold_end`)
+        # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;

@@ -53,7 +53,7 @@ class Sink:
         self._rival = None
         # the problem whose grid the peak's (and the rival's) bracket states are on: a band
         # that follows the edge exchanges grids, and the search solves on the states' own
-        # (femadh.runner.tracing._exchange)
+        # (femadh.runner.tracing.exchange_grid)
         self.peak_problem = self.rival_problem = problem
         # each fold per branch: (committed states of the branch before it, the last state of
         # the departing piece, the landing), the two as Committed records with their F_ex;

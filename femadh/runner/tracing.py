@@ -75,11 +75,11 @@ def _regridded(band, sink, problem, state, scene, landed=False):
             f"grid exchange at d = {state.d * 1e9:.6g} nm (band following the contact edge): "
             "the state carried to the new grid did not converge to a stable state",
             d=state.d, residual=st.residual, n_iter=st.n_iter)
-    _exchange(sink, problem, new)
+    exchange_grid(sink, problem, new)
     return new, st
 
 
-def _exchange(sink, old, new):
+def exchange_grid(sink, old, new):
     """The sink (and its writer) on ``new``'s grid from here on; the committed states the
     peak search and a branch's restart need carried to it (their displacements interpolated:
     the search solves fresh states from them)."""
@@ -145,7 +145,7 @@ def _widened(band, sink, problem, state, scene):
             f"grid exchange at d = {state.d * 1e9:.6g} nm (to the static band after a failed "
             "landing): the carried state did not converge to a stable state", d=state.d,
             residual=st.residual, n_iter=st.n_iter)
-    _exchange(sink, problem, wide)
+    exchange_grid(sink, problem, wide)
     sink.widened = getattr(sink, "widened", 0) + 1
     sink.wide = wide
     return wide, st
