@@ -1347,6 +1347,36 @@ DEFECTS = [
       "spacing, not the trapping cap alone", "femadh/runner/adaptive.py",
       (("if family.count(0.98 * safe_spacing(problem)) <= FOLLOW_NODES:",
         "if family.count(min(h, 0.98 * safe_spacing(problem))) <= FOLLOW_NODES:"),)),
+    # -- the max-adhesion bracket across a grid exchange, a resume, a failed fold re-solve
+    D("sb_exchange_prev_copy", "grid exchange: the next candidate's neighbour left on the "
+      "old grid (the last state's copy not taken)", "femadh/runner/tracing.py",
+      (("            sink._prev = (prev[0], copies[id(s)])",
+        "            pass"),)),
+    D("sb_exchange_prev_landing", "grid exchange: a landing neighbour left on the old grid",
+      "femadh/runner/tracing.py",
+      (("            sink._prev = (prev[0], replace(s))\n            moved.append(sink._prev[1])",
+        "            pass"),)),
+    D("sb_landing_row_prev", "resume: the landing's record (no surface) stays the next "
+      "candidate's neighbour", "femadh/runner/sink.py",
+      (("                self._prev = (branch, snap)\n            return",
+        "                pass\n            return"),)),
+    D("sb_fold_peak_stand_in", "resume: a fold state that is the peak replaced by its "
+      "smaller neighbour", "femadh/runner/sink.py",
+      (("                if x[3] is s:\n", "                if False:\n"),)),
+    D("sb_nan_stand_in", "resume: a neighbour that did not re-solve stands in with F_ex NaN",
+      "femadh/runner/sink.py",
+      (("math.nan, f0) if math.isfinite(f0) else None", "math.nan, f0) if True else None"),)),
+    D("sb_resolve_error_escapes", "resume: the neighbour's ConvergenceError aborts the resume",
+      "femadh/runner/sink.py",
+      (("            except ConvergenceError:\n                ok = False",
+        "            except ValueError:\n                ok = False"),)),
+    D("sb_fold_rise_linear", "max at a fold end: the rise to the fold as the secant times the "
+      "resolution", "femadh/runner/estimates.py",
+      (("    rise = abs(best.f_ex - prev.f_ex) * math.sqrt(r) / (math.sqrt(step + r) - "
+        "math.sqrt(r))", "    rise = abs(best.f_ex - prev.f_ex) * r / step"),)),
+    D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
+      "femadh/runner/estimates.py",
+      (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
 ]
 
 

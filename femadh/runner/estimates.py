@@ -116,7 +116,35 @@ def refine_peak(scene, res, problem, sink):
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
+    sink.peak_fold = fold_end_error(sink, res, branch, prev, best, nxt, d)
     return half
+
+
+def fold_end_error(sink, res, branch, prev, best, nxt, d):
+    """(resolution_m, force_N) when the refined maximum is a fold's last state (the last
+    state found stable before a recorded jump), else None.
+
+    The fold itself lies up to the jump's ``resolution_m`` beyond that state, and the
+    branch's F_ex rises on to it: d_at_max_adhesion is uncertain by the resolution, and
+    max_adhesion by the rise over it. Near a fold (saddle-node) F = F_f - c sqrt(d_f - d):
+    dF/dd diverges there, so the secant's slope times the resolution would understate the
+    rise. With the fold delta <= r beyond the state ``best`` and the grid step D to ``prev``,
+    F_best - F_prev = c (sqrt(D + delta) - sqrt(delta)) >= c (sqrt(D + r) - sqrt(r)), so the
+    rise c sqrt(delta) <= (F_best - F_prev) sqrt(r) / (sqrt(D + r) - sqrt(r)) (~ the secant
+    times sqrt(r D): larger than the secant times r for r < D)."""
+    if d != best.d or nxt.d != best.d or prev.d == best.d:
+        return None                         # not at a fold's last state
+    folds = getattr(sink, "pieces", {}).get(branch, [])
+    k = next((i for i, (_, before, _) in enumerate(folds) if before is best), None)
+    js = [j for j in res.jumps if j["branch"] == branch]
+    if k is None or k >= len(js):
+        return None
+    r = float(js[k]["resolution_m"])
+    if not r > 0:                           # (an arclength fold: located exactly)
+        return None
+    step = abs(best.d - prev.d)
+    rise = abs(best.f_ex - prev.f_ex) * math.sqrt(r) / (math.sqrt(step + r) - math.sqrt(r))
+    return r, float(rise)
 
 
 def _mesh_size_ratio(scene, coarse):
@@ -164,6 +192,12 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     parts = {}
     if half:
         parts.setdefault("d_at_max_adhesion_m", {})["resolution"] = half
+    fold = getattr(sink, "peak_fold", None)
+    if fold is not None:
+        # the maximum at a fold's last state: the fold (and the branch's F_ex on to it) lies
+        # within the jump's resolution beyond it (:func:`fold_end_error`)
+        parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
+        parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
     # a layered body has none: its mesh part is the difference to the next coarser mesh,
     # Richardson with the P2 body's observed order 3 - validation/results/layered_fe.md)

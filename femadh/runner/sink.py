@@ -53,7 +53,7 @@ class Sink:
         self._rival = None
         # the problem whose grid the peak's (and the rival's) bracket states are on: a band
         # that follows the edge exchanges grids, and the search solves on the states' own
-        # (femadh.runner.tracing._exchange)
+        # (femadh.runner.tracing.exchange_grid)
         self.peak_problem = self.rival_problem = problem
         # each fold per branch: (committed states of the branch before it, the last state of
         # the departing piece, the landing), the two as Committed records with their F_ex;
@@ -144,6 +144,11 @@ class Sink:
         elif prev is not None and prev.d == snap.d:
             if end:
                 self._close(branch, prev)
+            else:
+                # (a committed state at a landing's separation is the landing's own state:
+                # the next candidate's neighbour from here, as a resume replays it - the
+                # replay's landing record has no surface, the committed row's is read back)
+                self._prev = (branch, snap)
             return
         self._close(branch, snap)
         peak = self.peak
@@ -315,27 +320,55 @@ class Sink:
                 continue
             d0, w, _, p_el = fields[s.near]
             kw = {} if p.sigma is None else {"active0": p_el != 0}
-            st = solve_state(p, d0, w, tol=sc.tolerance, max_iter=sc.max_iter, **kw)
+            st = None
             try:
-                sw = trace(p, [d0, s.d], branch="retract" if s.d > d0 else "approach",
-                           tol=sc.tolerance, start=st, max_iter=sc.max_iter)
-                ok = st.converged and st.stable and not sw.jumps
+                # (the neighbour's re-solve inside: its failure is this fallback's, not the
+                # resume's)
+                st = solve_state(p, d0, w, tol=sc.tolerance, max_iter=sc.max_iter, **kw)
+                ok = st.converged and st.stable
+                if ok:
+                    sw = trace(p, [d0, s.d], branch="retract" if s.d > d0 else "approach",
+                               tol=sc.tolerance, start=st, max_iter=sc.max_iter)
+                    ok = not sw.jumps
             except ConvergenceError:
                 ok = False
             if ok:
                 s.w, s.active, s.r_c = sw.states[-1].w, sw.states[-1].active, \
                     sw.states[-1].r_c
                 continue
-            # (the committed neighbour stands in: its record from the fields)
-            stand = Committed(d0, w, p_el != 0, math.nan, state_forces(p, st)[2]
-                              if st.converged and st.stable else math.nan)
+            # the committed neighbour stands in for a bracket's end (the bracket the search
+            # had before folds bounded it): its record from the fields, its F_ex only from a
+            # converged stable re-solve - a NaN never enters the bracket; without one the
+            # bracket ends at its best state on that side (nothing searched there)
+            f0 = (state_forces(p, st)[2] if st is not None and st.converged and st.stable
+                  else math.nan)
+            stand = Committed(d0, w, p_el != 0, math.nan, f0) if math.isfinite(f0) else None
+            lost = False
             for x in (self.peak, self._rival):
-                if x is not None:
-                    x[2:5] = [stand if y is s else y for y in x[2:5]]
+                if x is None:
+                    continue
+                if x[3] is s:
+                    # the fold state is the kept maximum itself: nothing to search from it
+                    # without its surface; its recorded F_ex (the grid maximum) stays the
+                    # largest adhesion (a stand-in would put a smaller force in its place)
+                    x[2] = x[4] = s
+                    lost = True
+                else:
+                    x[2:5] = [(x[3] if stand is None else stand) if y is s else y
+                              for y in x[2:5]]
+            if lost:
+                # (the neighbour's surface, a start for Newton near the fold state: the
+                # estimate's members solve theirs from it; the search reads none of it)
+                s.w, s.active = w, p_el != 0
             self.result.warnings.append(
                 f"resume: the fold state at d = {s.d * 1e9:.6g} nm (no checkpoint) did not "
-                f"trace again from the state at {d0 * 1e9:.6g} nm; the largest adhesion is "
-                "searched up to that state instead")
+                f"trace again from the state at {d0 * 1e9:.6g} nm; " + (
+                    "it is the largest adhesion's grid state: the largest adhesion is its "
+                    "recorded grid value, not searched between the states" if lost else
+                    "the largest adhesion is searched up to that state instead"
+                    if stand is not None else
+                    "that state did not re-solve either: the largest adhesion is not "
+                    "searched on the fold's side of the bracket"))
 
 
 #: relative difference of F_ex below which two states at one separation tie (round-off: the

@@ -75,11 +75,11 @@ def _regridded(band, sink, problem, state, scene, landed=False):
             f"grid exchange at d = {state.d * 1e9:.6g} nm (band following the contact edge): "
             "the state carried to the new grid did not converge to a stable state",
             d=state.d, residual=st.residual, n_iter=st.n_iter)
-    _exchange(sink, problem, new)
+    exchange_grid(sink, problem, new)
     return new, st
 
 
-def _exchange(sink, old, new):
+def exchange_grid(sink, old, new):
     """The sink (and its writer) on ``new``'s grid from here on; the committed states the
     peak search and a branch's restart need carried to it (their displacements interpolated:
     the search solves fresh states from them)."""
@@ -98,10 +98,26 @@ def _exchange(sink, old, new):
             setattr(sink, grid_of, new)
     kept = {id(s) for x in (sink.peak, getattr(sink, "_rival", None)) if x is not None
             for s in x[2:5] if s is not None} - {id(s) for s in held}
+    copies = {}
     for b, s in list(sink.last.items()):
         if id(s) in kept:           # (a restart's copy, the peak's own left as it is)
-            sink.last[b] = replace(s)
-    snaps = held + list(sink.last.values())
+            sink.last[b] = copies[id(s)] = replace(s)
+    # the next peak candidate's previous neighbour (a state before the exchange) goes on to
+    # the new grid with it: the last committed state's copy, or a fold's landing (never in
+    # sink.last) - else a later peak's bracket spans two grids (state_between interpolates
+    # node by node: a ValueError on different counts, mismatched nodes on equal ones)
+    moved = held + list(sink.last.values())
+    prev = getattr(sink, "_prev", None)
+    if prev is not None:
+        s = prev[1]
+        if id(s) in copies:
+            sink._prev = (prev[0], copies[id(s)])
+        elif not any(s is x for x in moved):
+            # (a copy: the landing is also a fold record - sink.pieces, sink.folds - and
+            # maybe a completed peak's state, each on its own grid)
+            sink._prev = (prev[0], replace(s))
+            moved.append(sink._prev[1])
+    snaps = moved
     for snap in {id(x): x for x in snaps}.values():
         if getattr(snap, "w", None) is not None and np.ndim(snap.w) == 1 and \
                 snap.w.size == old.grid.n:
@@ -129,7 +145,7 @@ def _widened(band, sink, problem, state, scene):
             f"grid exchange at d = {state.d * 1e9:.6g} nm (to the static band after a failed "
             "landing): the carried state did not converge to a stable state", d=state.d,
             residual=st.residual, n_iter=st.n_iter)
-    _exchange(sink, problem, wide)
+    exchange_grid(sink, problem, wide)
     sink.widened = getattr(sink, "widened", 0) + 1
     sink.wide = wide
     return wide, st
