@@ -17,6 +17,7 @@ numbers.
 import math
 from pathlib import Path
 import shutil
+import sys
 import tempfile
 import time
 
@@ -48,7 +49,8 @@ def stiction_map(out, sigma=None):
     scene = femadh.load_scene(SCENE).replace({"solver.time_limit": POINT_LIMIT})
     t0 = time.perf_counter()
     vary = MAP if sigma is None else {**MAP, "effects.asperity_gap.sigma": [sigma]}
-    points, records = run_study(scene, vary, out, workers=2, progress=True)
+    points, records = run_study(scene, vary, out, workers=2,
+                                progress=sys.stderr.isatty())     # quiet in pipes
     wall = time.perf_counter() - t0
 
     def rel_of(p):
