@@ -134,3 +134,37 @@ def tiny_fe_text():
             / "paper1_fig3_fe.toml").read_text()
     text = text.replace("nodes = 200", "nodes = 40").replace('stop = "-5 nm"', 'stop = "-1 nm"')
     return text.replace('step = "0.2 nm"', 'step = "1 nm"')
+
+
+def adaptive_scene(path="validation/scenes/paper1_fig3.toml", **solver):
+    """A bundled scene (default Fig 3) without its ``[solver] nodes``: the adaptive grid,
+    with ``solver`` entries (e.g. ``accuracy=1e-2``) set."""
+    import copy
+
+    import femadh
+    from femadh.scene import scene_from_dict
+
+    sc = femadh.load_scene(path)
+    raw = copy.deepcopy(sc.raw)
+    raw["solver"].pop("nodes", None)
+    raw["solver"].update(solver)
+    return scene_from_dict(raw, sc.path, bare_numbers=False)
+
+
+def fig4_banded(start, stop):
+    """The Fig 4 slider (sigma = 0.5 nm) on an explicit banded grid (30 nm in a 5.9-um band,
+    a = 12.6 um), swept from ``start`` to ``stop`` (strings with units) in 0.2 nm steps and
+    back."""
+    import copy
+
+    import femadh
+    from femadh.scene import scene_from_dict
+
+    base = femadh.load_scene("validation/scenes/paper1_fig4.toml")
+    raw = copy.deepcopy(base.raw)
+    raw["solver"].pop("accuracy", None)
+    raw["solver"]["analysis_radius"] = "12.6e-6 m"
+    raw["solver"]["grid"] = {"spacing": "30e-9 m", "band": "5.9e-6 m",
+                             "grading": "0.295e-6 m"}
+    raw["sweep"].update(start=start, stop=stop, step="0.2 nm")
+    return scene_from_dict(raw, base.path, bare_numbers=False)

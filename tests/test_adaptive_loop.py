@@ -6,30 +6,22 @@ The loops are driven by a scripted ``run``: each trial's result (status, failure
 estimate) is given, and what the loop asks next (spacing, band, analysis radius, nodes) is
 read off the trials it runs. The real runs at the end check that a guard's refusal reaches
 the result with its kind."""
-import copy
 import math
 
 import numpy as np
 import pytest
 
 import femadh
+from conftest import adaptive_scene
 from femadh.discretisation import family as family_mod
 from femadh.errors import ConvergenceError, Interrupted, MeshResolutionWarning, TimeLimitReached
 from femadh.estimate import (AnalysisRadiusError, BoundError, GuardError, TrappingError,
                              check_state, failure_kind)
 from femadh.runner import accuracy, adaptive
 from femadh.runner.result import ContactResult
-from femadh.scene import scene_from_dict
 
 FIG3 = "validation/scenes/paper1_fig3.toml"
 
-
-def adaptive_scene(**solver):
-    sc = femadh.load_scene(FIG3)
-    raw = copy.deepcopy(sc.raw)
-    raw["solver"].pop("nodes", None)
-    raw["solver"].update(solver)
-    return scene_from_dict(raw, sc.path, bare_numbers=False)
 
 
 def scripted(script):

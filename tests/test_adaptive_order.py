@@ -7,7 +7,6 @@ is closer to it the nearer the estimate is (``_safety``). The loop is driven by 
 estimate is a power law of the trial's band spacing, e(h) = C h^q, so the observed order is
 q and where the loop lands is known in closed form; one real run (the Fig 3 scene at 3e-4)
 counts its runs and checks the second member's spacing against the rule."""
-import copy
 import math
 import warnings
 
@@ -15,20 +14,12 @@ import numpy as np
 import pytest
 
 import femadh
+from conftest import adaptive_scene
 from femadh.errors import MeshResolutionWarning
 from femadh.runner import adaptive
 from femadh.runner.result import ContactResult
-from femadh.scene import scene_from_dict
-
-FIG3 = "validation/scenes/paper1_fig3.toml"
 
 
-def adaptive_scene(**solver):
-    sc = femadh.load_scene(FIG3)
-    raw = copy.deepcopy(sc.raw)
-    raw["solver"].pop("nodes", None)
-    raw["solver"].update(solver)
-    return scene_from_dict(raw, sc.path, bare_numbers=False)
 
 
 def power_law(q, first_ratio, target):

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import femadh
+from conftest import adaptive_scene
 from femadh.discretisation import GridFamily, feature_gap, tail_delta
 from femadh.discretisation import plan as plan_mod
 from femadh.discretisation.plan import reach_floor, tail_force, work_of_adhesion
@@ -18,13 +19,6 @@ from femadh.scene import scene_from_dict
 
 FIG3 = "validation/scenes/paper1_fig3.toml"
 
-
-def adaptive_scene(path=FIG3, **solver):
-    sc = femadh.load_scene(path)
-    raw = copy.deepcopy(sc.raw)
-    raw["solver"].pop("nodes", None)
-    raw["solver"].update(solver)
-    return scene_from_dict(raw, sc.path, bare_numbers=False)
 
 
 def test_family_members_are_refinements_of_one_density():

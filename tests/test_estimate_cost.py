@@ -9,6 +9,7 @@ import warnings
 import pytest
 
 import femadh
+from conftest import fig4_banded
 from femadh.errors import MeshResolutionWarning
 from femadh.runner import estimates, members
 from femadh.scene import scene_from_dict
@@ -146,14 +147,7 @@ def _fig4_folds():
     """The Fig 4 slider (sigma = 0.5 nm) on an explicit banded grid (30 nm in a 5.9-um band,
     a = 12.6 um), swept 1.4 -> 0.8 nm and back: its jump-in (1.11 nm) and pull-off
     (1.18 nm), each a member fold search."""
-    base = femadh.load_scene(f"{SCENES}/paper1_fig4.toml")
-    raw = copy.deepcopy(base.raw)
-    raw["solver"].pop("accuracy", None)
-    raw["solver"]["analysis_radius"] = "12.6e-6 m"
-    raw["solver"]["grid"] = {"spacing": "30e-9 m", "band": "5.9e-6 m",
-                             "grading": "0.295e-6 m"}
-    raw["sweep"].update(start="1.4 nm", stop="0.8 nm", step="0.2 nm")
-    return scene_from_dict(raw, base.path, bare_numbers=False)
+    return fig4_banded("1.4 nm", "0.8 nm")
 
 
 def _counted_run(scene, stall):

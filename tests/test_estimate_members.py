@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import femadh
+from conftest import fig4_banded
 from femadh.errors import MeshResolutionWarning
 from femadh.estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER, discretisation,
                                         observed_order, observed_order_uneven)
@@ -30,14 +31,7 @@ def _fig4_short():
     """The Fig 4 slider on an explicit banded grid (30 nm in a 5.9-um band, a = 12.6 um),
     swept 1.6 -> 0.6 nm and back: its jump-in (1.11 nm), its largest adhesion (0.86 nm) and
     its pull-off (1.18 nm) in 12 states."""
-    base = femadh.load_scene(f"{SCENES}/paper1_fig4.toml")
-    raw = copy.deepcopy(base.raw)
-    raw["solver"].pop("accuracy", None)
-    raw["solver"]["analysis_radius"] = "12.6e-6 m"
-    raw["solver"]["grid"] = {"spacing": "30e-9 m", "band": "5.9e-6 m",
-                             "grading": "0.295e-6 m"}
-    raw["sweep"].update(start="1.6 nm", stop="0.6 nm", step="0.2 nm")
-    return scene_from_dict(raw, base.path, bare_numbers=False)
+    return fig4_banded("1.6 nm", "0.6 nm")
 
 
 @pytest.fixture(scope="module")
