@@ -80,9 +80,9 @@ def test_the_carried_state_converges_to_a_saddle(case):
 
 
 def test_the_member_state_is_its_whole_traces(case, monkeypatch):
-    """The landed member state is the member's own traced state at d = -5 nm (measured:
-    8e-15 nm apart on the full map sweep, 4 -> -5 nm; here the same sweep as the fine run's)
-    and the member without the landing is not reduced."""
+    """The landed member state is the member's own traced state at d = -5 nm (the member
+    traced whole over the fine run's sweep; on the full map sweep, 4 -> -5 nm, measured
+    8e-15 nm apart) and the member without the landing is not reduced."""
     sc, fine, sink, member = case
     m = members._Member(member, fine, member, build_problem(member))
     snaps = sink.committed["approach"]
@@ -93,7 +93,7 @@ def test_the_member_state_is_its_whole_traces(case, monkeypatch):
     assert whole.d == st.d
     gap = m.problem.contour(st.d) - whole.w
     # the same equilibrium to the solver's tolerance: every node within 1e-6 of its gap
-    # (measured 1.7e-12 nm on gaps >= sigma = 0.489 nm)
+    # (measured 2.3e-12 of the gap, 1.3e-12 nm)
     assert np.max(np.abs(st.w - whole.w) / gap) <= 1e-6
     monkeypatch.setattr(members, "LAND_SADDLE", False)
     m2 = members._Member(member, fine, member, build_problem(member))
