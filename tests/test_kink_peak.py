@@ -50,7 +50,7 @@ def _members_peaks(kink):
         return out
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(peak, "KINK_PEAK", kink)
+        mp.setattr(members, "KINK_PEAK", kink)
         mp.setattr(peak, "state_between", counted)
         mp.setattr(peak, "peak_adhesion", bracket)
         mp.setattr(members, "_peak", recorded)

@@ -53,6 +53,12 @@ PEAK_WINDOW = 0.125
 #: by energy descent (:meth:`_Member._off_saddle`) and kept where it stays on the fine run's
 #: branch (False: the member is traced whole, as before)
 LAND_SADDLE = True
+#: where a member's windowed peak search misses, the rest of the bracket is searched by the
+#: kink model (femadh.runner.peak.kink_peak: F_ex(d) as smooth pieces joined at the kinks
+#: where a node joins or leaves the contact) from every state the window's search solved,
+#: which stops at the window's edge (WINDOW_EDGE_STOP). False: the windowed search runs to
+#: its end and the whole bracket is searched again by the bounded search (as before)
+KINK_PEAK = True
 #: a member's windowed peak search stops as soon as its best fresh state lies within this
 #: fraction of the window's width of its edge (femadh.runner.peak.WindowMiss), and the whole
 #: bracket is searched by the kink model from the states it solved
@@ -223,7 +229,7 @@ def _peak(m, sink, snaps, d_fine=None):
     same piece of the branch (between the folds: :func:`femadh.runner.peak.pieces`), then
     the bounded search between the states around it - a fold's landing or last state where
     the piece ends there, as the fine run's bracket."""
-    from .peak import KINK_PEAK, WindowMiss, kink_peak, peak_adhesion, pieces
+    from .peak import WindowMiss, kink_peak, peak_adhesion, pieces
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]

@@ -151,28 +151,13 @@ def pieces(sink, branch):
     A piece holds its landing (the fold's state after the snap), the branch's committed
     states up to the next fold and that fold's last state; a state at the separation of the
     one before it is that state and is left out (a landing on a grid separation, a fold
-    right at a committed state), as the sink's peak bookkeeping does
-    (:meth:`femadh.runner.sink.Sink._element`)."""
-    states = sink.committed.get(branch, [])
-    folds = list(getattr(sink, "pieces", {}).get(branch, []))
-    out, cur, starts = [], [], False
-    for i in range(len(states) + 1):
-        while folds and folds[0][0] == i:
-            _, before, after = folds.pop(0)
-            if not (cur and cur[-1].d == before.d):
-                cur.append(before)
-            out.append((cur, starts, True))
-            cur, starts = [after], True
-        if i < len(states) and not (cur and cur[-1].d == states[i].d):
-            cur.append(states[i])
-    out.append((cur, starts, False))
-    return out
+    right at a committed state). The sink records them as the states arrive, by the rule of
+    its peak bookkeeping (:meth:`femadh.runner.sink.Sink._piece`), and a resumed run's
+    replay records them again."""
+    return [(list(states), starts, ends)
+            for states, starts, ends in getattr(sink, "curve_pieces", {}).get(branch, [])]
 
 
-#: an estimate member's largest adhesion by :func:`kink_peak` (a search that models F_ex(d)
-#: as smooth pieces joined at kinks) instead of the bounded Brent search of
-#: :func:`peak_adhesion` (False: the windowed Brent search, the whole bracket on a miss)
-KINK_PEAK = True
 #: fresh states a :func:`kink_peak` may solve (the bounded search's maxiter)
 KINK_MAX_EVALS = 40
 
