@@ -1377,6 +1377,47 @@ DEFECTS = [
     D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
       "femadh/runner/estimates.py",
       (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
+    # -- session 8 (member19): the members' kink search, a member state on a saddle, the
+    # curve's pieces recorded by the sink
+    D("kink_intersection_sign", "kink model: the secants' intersection with the slopes' "
+      "difference of the wrong sign", "femadh/runner/peak.py",
+      (("ds[j1]) / (s_in - s_out)", "ds[j1]) / (s_out - s_in)"),)),
+    D("kink_no_validity", "kink model: the two secants taken as the pieces without checking "
+      "they pass above each other's samples", "femadh/runner/peak.py",
+      (("                fs[i] + s_in * (ds[j1] - ds[i]) < fs[j1] - slack or s_in == s_out:",
+        "                False or s_in == s_out:"),)),
+    D("kink_no_straddle", "kink search: a proposal next to the best sample is not moved to "
+      "xatol / 2 (the bracket never closed by a straddle)", "femadh/runner/peak.py",
+      (("            if abs(x - b) < xatol / 2:\n                x = b + math.copysign(",
+        "            if False:\n                x = b + math.copysign("),)),
+    D("kink_one_side", "window miss: only the side below the window searched",
+      "femadh/runner/peak.py",
+      (("            refine(s_lo, s_hi)\n", "            refine(s_lo, s_hi)\n            break\n"),)),
+    D("kink_stop_loose", "kink search: stops once the bracket is 10 xatol wide",
+      "femadh/runner/peak.py",
+      (("            if c - a <= xatol:\n                return b",
+        "            if c - a <= 10 * xatol:\n                return b"),)),
+    D("window_stop_at_centre", "windowed member search: stops when its best state is far "
+      "from the window's edge", "femadh/runner/peak.py",
+      (("min(top - lo, hi - top) <= edge_stop * (hi - lo)",
+        "min(top - lo, hi - top) >= edge_stop * (hi - lo)"),)),
+    D("saddle_keeps_saddle", "member state: the landing from the carried state discarded "
+      "(the saddle kept)", "femadh/runner/members.py",
+      (("            return st\n        return landed", "            return st\n        return st"),)),
+    D("saddle_land_from_fine_grid", "member state: landed from the saddle's own surface "
+      "shifted by the carried state's largest gap change", "femadh/runner/members.py",
+      (("        landed = land(self.problem, st.d, w0, tol=self.scene.tolerance,",
+        "        landed = land(self.problem, st.d, 2 * st.w - w0, tol=self.scene.tolerance,"),)),
+    D("pieces_same_d_kept", "sink pieces: a state at the separation of the piece's last one "
+      "kept as a second state", "femadh/runner/sink.py",
+      (("        elif not (ps[-1][0] and ps[-1][0][-1].d == snap.d):",
+        "        elif True:"),)),
+    D("pieces_no_end", "sink pieces: a fold's last state does not close its piece",
+      "femadh/runner/sink.py",
+      (("        if end:\n            ps[-1][2] = True", "        if False:\n            ps[-1][2] = True"),)),
+    D("pieces_landing_joins", "sink pieces: a landing joins the piece before the fold",
+      "femadh/runner/sink.py",
+      (("        if start or not ps:\n            ps.append(", "        if not ps:\n            ps.append("),)),
 ]
 
 
