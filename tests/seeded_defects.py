@@ -1382,10 +1382,13 @@ DEFECTS = [
     D("kink_intersection_sign", "kink model: the secants' intersection with the slopes' "
       "difference of the wrong sign", "femadh/runner/peak.py",
       (("ds[j1]) / (s_in - s_out)", "ds[j1]) / (s_out - s_in)"),)),
-    D("kink_no_validity", "kink model: the two secants taken as the pieces without checking "
-      "they pass above each other's samples", "femadh/runner/peak.py",
-      (("                fs[i] + s_in * (ds[j1] - ds[i]) < fs[j1] - slack or s_in == s_out:",
-        "                False or s_in == s_out:"),)),
+    D("kink_meets_anywhere", "kink model: the secants' meeting point kept wherever it lies "
+      "(not only between the two samples)", "femadh/runner/peak.py",
+      (("                not lo - xatol / 2 <= x <= hi + xatol / 2:",
+        "                not -math.inf <= x:"),)),
+    D("kink_never_smooth", "kink search: a smooth maximum searched by the secants' meeting "
+      "point (the parabola's vertex only as a fallback)", "femadh/runner/peak.py",
+      (("            if _smooth_here(ds, fs, i):", "            if False:"),)),
     D("kink_no_straddle", "kink search: a proposal next to the best sample is not moved to "
       "xatol / 2 (the bracket never closed by a straddle)", "femadh/runner/peak.py",
       (("            if abs(x - b) < xatol / 2:\n                x = b + math.copysign(",

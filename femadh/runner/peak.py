@@ -237,9 +237,17 @@ def kink_peak(problem, prev, best, nxt, scene, known=(), window=None, reuse=Fals
             c = inside[k + 1] if k + 1 < len(inside) else b
             if c - a <= xatol:
                 return b
-            x = _kink_proposal(ds, fs, i, a, c, xatol)
-            if x is None:
+            # a smooth maximum where the parabola through the best sample and its
+            # neighbours predicts the next samples out (the secants of a concave curve
+            # also meet above it, but away from its maximum), else a kink
+            if _smooth_here(ds, fs, i):
                 x = _vertex_proposal(ds, fs, i, a, c)
+                if x is None:
+                    x = _kink_proposal(ds, fs, i, a, c, xatol)
+            else:
+                x = _kink_proposal(ds, fs, i, a, c, xatol)
+                if x is None:
+                    x = _vertex_proposal(ds, fs, i, a, c)
             if x is None:
                 x = 0.5 * (a + b) if b - a > c - b else 0.5 * (b + c)
             # not closer to the best sample than xatol / 2 (the straddle that closes the
@@ -285,11 +293,11 @@ def _kink_proposal(ds, fs, i, a, c, xatol):
     the lower of the two pieces' lines, F = min(L_in, L_out). For the kink between ds[i] and
     its neighbour on one side, L_in is the secant through ds[i] and its neighbour on the
     other side (the best sample's piece), L_out the secant through the neighbour on that side
-    and the next one beyond it. The model holds only where each line passes at or above the
-    other piece's sample it was not drawn through (L_out(ds[i]) >= F_i, L_in(ds[j1]) >=
-    F_j1, to what a kink within xatol / 2 of the sample makes); its kink is where they meet, moved to at least xatol / 2 from either sample
-    (once both states straddling it are that close the bracket is closed). Of the two sides,
-    the higher kink."""
+    and the next one beyond it; its kink is where they meet. A meeting point beyond the two
+    samples (by more than xatol / 2: the lines drawn through samples on other pieces) is no
+    kink between them; one inside is moved to at least xatol / 2 from either sample (once
+    both states straddling it are that close the bracket is closed). Of the two sides, the
+    higher kink."""
     best = None
     for side in (-1, 1):
         j0, j1, j2 = i - side, i + side, i + 2 * side
@@ -297,11 +305,7 @@ def _kink_proposal(ds, fs, i, a, c, xatol):
             continue
         s_in = (fs[i] - fs[j0]) / (ds[i] - ds[j0])
         s_out = (fs[j2] - fs[j1]) / (ds[j2] - ds[j1])
-        # (the lines' own error allowed: what a kink within xatol / 2 of either sample
-        # would make - the curvature of the pieces and a neighbour on another piece)
-        slack = abs(s_in - s_out) * xatol / 2
-        if fs[j1] + s_out * (ds[i] - ds[j1]) < fs[i] - slack or \
-                fs[i] + s_in * (ds[j1] - ds[i]) < fs[j1] - slack or s_in == s_out:
+        if s_in == s_out:
             continue
         # F = fs[i] + s_in (x - ds[i]) = fs[j1] + s_out (x - ds[j1])
         x = (fs[j1] - fs[i] + s_in * ds[i] - s_out * ds[j1]) / (s_in - s_out)
@@ -314,6 +318,31 @@ def _kink_proposal(ds, fs, i, a, c, xatol):
         if best is None or f > best[1]:
             best = (x, f)
     return None if best is None else best[0]
+
+
+#: a parabola through three samples that predicts the next sample out on each side to this
+#: fraction of the samples' rise to the best one is read as a smooth maximum
+SMOOTH_FIT = 0.1
+
+
+def _smooth_here(ds, fs, i):
+    """Whether the parabola through the best sample ds[i] and its neighbours predicts the
+    next sample out on either side (where there is one) to SMOOTH_FIT of the rise from the
+    lowest of the five to the best: a smooth maximum. A kink between the samples bends
+    the curve at one point, which no parabola through three of them follows."""
+    if not (0 < i < len(ds) - 1):
+        return False
+    (x0, x1, x2), (f0, f1, f2) = ds[i - 1:i + 2], fs[i - 1:i + 2]
+
+    def parabola(x):
+        return (f0 * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
+                + f1 * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
+                + f2 * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1)))
+    outer = [j for j in (i - 2, i + 2) if 0 <= j < len(ds)]
+    if not outer:
+        return False
+    rise = fs[i] - min(fs[j] for j in range(max(i - 2, 0), min(i + 3, len(ds))))
+    return all(abs(parabola(ds[j]) - fs[j]) <= SMOOTH_FIT * rise for j in outer)
 
 
 def _vertex_proposal(ds, fs, i, a, c):
