@@ -12,7 +12,9 @@ only, each by Newton from the fine run's committed state there carried to the me
   its contact edge (:func:`deepest_locked`) give those numbers' grid part;
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
-  the fine run's (:func:`femadh.runner.peak.peak_adhesion`);
+  the fine run's (:func:`femadh.runner.peak.peak_adhesion`), first in a window around the
+  fine run's peak; where the window misses, the kink model searches the rest of the bracket
+  (:func:`femadh.runner.peak.kink_peak`);
 - each fold: continued on the fine run's lattice of smallest steps (the stepping's own in
   that grid step) from a few lattice steps before the fine run's fold, with the stepping's
   acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
@@ -25,8 +27,10 @@ A member state is the member's equilibrium on the fine run's branch at that sepa
 whole trace reaches the same state where its branch is the same (measured on the Fig 3 scene's
 family, spacings 15-240 nm: F_LJ at the deepest separation identical to the last digit; Fig 3
 and Fig 4 at their defaults: every grid part within 1.4e-6 of its number of the whole
-trace's, folds and hysteresis identical). Anything the reduced member cannot reproduce - a
-state that does not converge, is unstable or refused by a guard, a fold that is not near the
+trace's, folds and hysteresis identical). A state where Newton from the carried state ends
+on a saddle (a node at the contact edge between its two minima) is landed from the carried
+state onto the minimum of its basin (:meth:`_Member._off_saddle`). Anything the reduced
+member cannot reproduce - a state that does not converge, is unstable or refused by a guard, a fold that is not near the
 fine run's, a landing elsewhere than the fine run's, a sign change that moved - is not
 guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
 uniform grid's members (N/2, N/4 may resolve the contact so coarsely that their branches

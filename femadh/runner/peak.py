@@ -173,17 +173,26 @@ def kink_peak(problem, prev, best, nxt, scene, known=(), window=None, reuse=Fals
     either side, each side's slope changing 1 % in 2e-3 nm).
 
     Each step proposes the maximum of a model of the samples around the best one: the
-    intersection of the secants on either side (a kink), else the vertex of the parabola
-    through the best sample and its neighbours (a smooth maximum), else the midpoint of
-    the wider side; a proposal within PEAK_XTOL_FRACTION / 2 of the best sample is moved to
-    that distance on its side, so that once the model has found the kink, two states
-    straddle it and close the bracket. A bounded Brent search spends its evaluations
-    narrowing a golden-section bracket on such a curve (~15-19 fresh states per search; the
-    kink model ~5-8). ``seeds``: separations to solve first (the fine run's peak, where the
-    member's lies near it). Fresh states as :func:`state_between` (``reuse``, warm starts
-    from the nearest fresh state as :func:`peak_adhesion`); a state that is not found
-    counts as no larger than the best. ``f_of``: F_ex of a grid state (default its
-    ``f_ex``, else :func:`~femadh.contact.forces.state_forces`). Returns (F, d, xatol) as
+    vertex of the parabola through the best sample and its neighbours where that parabola
+    predicts the next samples out (a smooth maximum, :func:`_smooth_here`), else the point
+    where the secants on either side meet (a kink, :func:`_kink_proposal`), each the other's
+    fallback, else the midpoint of the wider side; a proposal within xatol / 2 of the best
+    sample is moved to that distance on its side, so that once the model has found the
+    maximum two states straddle it and close the bracket. A bounded Brent search spends its
+    evaluations narrowing a golden-section bracket on such a curve (~15-19 fresh states per
+    search; this search on the analytic kink of tests/test_kink_peak.py 14 from a cold
+    start, on a parabola 4).
+
+    ``known``: [(d, F or None, state or None)] solved already (a windowed search's). With
+    ``window`` = (lo, hi), a window around the fine run's peak that missed (its best state
+    at its edge): its ends are solved, and each side of the bracket outside it is searched
+    where the curve rises away from the window or holds a state above the window's end there
+    (both sides where the window holds a valley between two kinks); the best state found
+    anywhere is the result. Fresh states as :func:`state_between` (``reuse``; warm starts
+    from the nearest fresh state as :func:`peak_adhesion`); a state that is not found counts
+    as no larger than the best and bounds the bracket. ``f_of``: F_ex of a grid state
+    (default its ``f_ex``, else :func:`~femadh.contact.forces.state_forces`). Returns
+    (F, d, xatol) as
     :func:`peak_adhesion`."""
     from ..contact.forces import state_forces
 
