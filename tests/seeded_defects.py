@@ -1287,9 +1287,10 @@ DEFECTS = [
       (("if p[2] is None or p[4] is None or _extent(r) > _extent(p) or (",
         "if p[2] is None or p[4] is None or _extent(r) < _extent(p) or ("),)),
     D("peakfold_pieces_unsplit", "members: the fine run's branch walked as one piece (the "
-      "folds ignored)", "femadh/runner/peak.py",
-      (('    folds = list(getattr(sink, "pieces", {}).get(branch, []))',
-        "    folds = []"),)),
+      "folds ignored; re-pointed in session 8: the sink records the pieces)",
+      "femadh/runner/sink.py",
+      (("        if start or not ps:\n", "        if not ps:\n"),
+       ("        if end:\n            ps[-1][2] = True", "        if False:\n            ps[-1][2] = True"))),
     D("peakfold_checkpoint_dropped", "checkpoint: the fold states of the peak's bracket not "
       "saved (a resumed search from re-solved ones)", "femadh/runner/checkpoint.py",
       (("    data.update(_fold_data(sink))\n", ""),)),
