@@ -30,9 +30,9 @@ and Fig 4 at their defaults: every grid part within 1.4e-6 of its number of the 
 trace's, folds and hysteresis identical). A state where Newton from the carried state ends
 on a saddle (a node at the contact edge between its two minima) is landed from the carried
 state onto the minimum of its basin (:meth:`_Member._off_saddle`). Anything the reduced
-member cannot reproduce - a state that does not converge, is unstable or refused by a guard, a fold that is not near the
-fine run's, a landing elsewhere than the fine run's, a sign change that moved - is not
-guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
+member cannot reproduce - a state that does not converge, is unstable or refused by a
+guard, a fold that is not near the fine run's, a landing elsewhere than the fine run's, a
+sign change that moved - is not guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
 uniform grid's members (N/2, N/4 may resolve the contact so coarsely that their branches
 differ from the fine one's: folds the fine run does not have, which no state of it shows).
 
