@@ -1287,9 +1287,10 @@ DEFECTS = [
       (("if p[2] is None or p[4] is None or _extent(r) > _extent(p) or (",
         "if p[2] is None or p[4] is None or _extent(r) < _extent(p) or ("),)),
     D("peakfold_pieces_unsplit", "members: the fine run's branch walked as one piece (the "
-      "folds ignored)", "femadh/runner/peak.py",
-      (('    folds = list(getattr(sink, "pieces", {}).get(branch, []))',
-        "    folds = []"),)),
+      "folds ignored; re-pointed in session 8: the sink records the pieces)",
+      "femadh/runner/sink.py",
+      (("        if start or not ps:\n", "        if not ps:\n"),
+       ("        if end:\n            ps[-1][2] = True", "        if False:\n            ps[-1][2] = True"))),
     D("peakfold_checkpoint_dropped", "checkpoint: the fold states of the peak's bracket not "
       "saved (a resumed search from re-solved ones)", "femadh/runner/checkpoint.py",
       (("    data.update(_fold_data(sink))\n", ""),)),
@@ -1377,6 +1378,50 @@ DEFECTS = [
     D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
       "femadh/runner/estimates.py",
       (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
+    # -- session 8 (member19): the members' kink search, a member state on a saddle, the
+    # curve's pieces recorded by the sink
+    D("kink_intersection_sign", "kink model: the secants' intersection with the slopes' "
+      "difference of the wrong sign", "femadh/runner/peak.py",
+      (("ds[j1]) / (s_in - s_out)", "ds[j1]) / (s_out - s_in)"),)),
+    D("kink_meets_anywhere", "kink model: the secants' meeting point kept wherever it lies "
+      "(not only between the two samples)", "femadh/runner/peak.py",
+      (("                not lo - xatol / 2 <= x <= hi + xatol / 2:",
+        "                not -math.inf <= x:"),)),
+    D("kink_never_smooth", "kink search: a smooth maximum searched by the secants' meeting "
+      "point (the parabola's vertex only as a fallback)", "femadh/runner/peak.py",
+      (("            if _smooth_here(ds, fs, i):", "            if False:"),)),
+    D("kink_no_straddle", "kink search: a proposal next to the best sample is not moved to "
+      "xatol / 2 (the bracket never closed by a straddle)", "femadh/runner/peak.py",
+      (("            if abs(x - b) < xatol / 2:\n                x = b + math.copysign(",
+        "            if False:\n                x = b + math.copysign("),)),
+    D("kink_one_side", "window miss: only the side below the window searched",
+      "femadh/runner/peak.py",
+      (("            refine(s_lo, s_hi)\n", "            refine(s_lo, s_hi)\n            break\n"),)),
+    D("kink_stop_loose", "kink search: stops once the bracket is 10 xatol wide",
+      "femadh/runner/peak.py",
+      (("            if c - a <= xatol:\n                return b",
+        "            if c - a <= 10 * xatol:\n                return b"),)),
+    D("window_stop_at_centre", "windowed member search: stops when its best state is far "
+      "from the window's edge", "femadh/runner/peak.py",
+      (("min(top - lo, hi - top) <= edge_stop * (hi - lo)",
+        "min(top - lo, hi - top) >= edge_stop * (hi - lo)"),)),
+    D("saddle_keeps_saddle", "member state: the landing from the carried state discarded "
+      "(the saddle kept)", "femadh/runner/members.py",
+      (("            return st\n        return landed", "            return st\n        return st"),)),
+    D("saddle_land_from_fine_grid", "member state: landed from the saddle's own surface "
+      "shifted by the carried state's largest gap change", "femadh/runner/members.py",
+      (("        landed = land(self.problem, st.d, w0, tol=self.scene.tolerance,",
+        "        landed = land(self.problem, st.d, 2 * st.w - w0, tol=self.scene.tolerance,"),)),
+    D("pieces_same_d_kept", "sink pieces: a state at the separation of the piece's last one "
+      "kept as a second state", "femadh/runner/sink.py",
+      (("        elif not (ps[-1][0] and ps[-1][0][-1].d == snap.d):",
+        "        elif True:"),)),
+    D("pieces_no_end", "sink pieces: a fold's last state does not close its piece",
+      "femadh/runner/sink.py",
+      (("        if end:\n            ps[-1][2] = True", "        if False:\n            ps[-1][2] = True"),)),
+    D("pieces_landing_joins", "sink pieces: a landing joins the piece before the fold",
+      "femadh/runner/sink.py",
+      (("        if start or not ps:\n            ps.append(", "        if not ps:\n            ps.append("),)),
 ]
 
 

@@ -23,6 +23,7 @@ from femadh.scene import scene_from_dict
 from femadh.contact import solve_state
 from femadh.contact.forces import state_forces
 from femadh.runner.contact import solve_sweeps
+from femadh.runner.peak import pieces
 from femadh.runner.sink import Committed, Sink
 
 from validation.fault_matrix import cli, phase, summary
@@ -110,6 +111,7 @@ def test_a_fold_bounds_the_peak_bracket():
         s = Sink.__new__(Sink)
         s.peak, s._prev, s._need_next, s._rival, s.pieces, s.committed, s.last = \
             None, None, False, None, {}, {}, {}
+        s.curve_pieces = {}
         s.problem = s.peak_problem = s.rival_problem = None
         return s
 
@@ -127,6 +129,12 @@ def test_a_fold_bounds_the_peak_bracket():
         s._track_peak("approach", c)
         s._track_peak("approach", d)
         assert s.peak[2:] == ([land, land, c] if f_next < 9.0 else [land, c, d])
+        # the curve's pieces as recorded: the fold's last state ends the first, the landing
+        # starts the second and the committed state on its separation is that state
+        first, second = pieces(s, "approach")
+        assert [x.d for x in first[0]] == [1.7, 1.2, 1.11] and first[1:] == (False, True)
+        assert second[0] == [land, c, d] and second[0][0] is land and second[1:] == (True,
+                                                                                  False)
     # the retract through the same contact state: its tie at 0.7 spans 0.2 .. 1.2 nm, more
     # than the approach's 0.2 .. 1.109: it takes the peak's place (not with equal spans)
     for top, wider in ((1.2, True), (1.109, False)):
@@ -144,6 +152,13 @@ def test_a_fold_bounds_the_peak_bracket():
     b2, l2 = rec(1.18, 4.0), rec(1.181, 0.5)
     s._track_fold("retract", b2, l2)
     assert s.peak[2:] == [e[0], e[1], b2]
+    assert pieces(s, "retract") == [(e + [b2], False, True), ([l2], True, False)]
+    # a fold right at a committed state: that state ends its piece (one state, not two)
+    s = sink()
+    for x in e:
+        s._track_peak("retract", x)
+    s._track_fold("retract", rec(0.7, 5.0), l2)
+    assert pieces(s, "retract") == [(e, False, True), ([l2], True, False)]
     # the fold's last state leads: it is its own next neighbour (never the landing)
     s = sink()
     for x in e:

@@ -26,7 +26,7 @@ def _sink(problem):
     s.problem, s.writer = problem, None
     s.peak, s._prev, s._need_next, s._rival = None, None, False, None
     s.peak_problem = s.rival_problem = problem
-    s.pieces, s.last, s.committed = {}, {}, {}
+    s.pieces, s.last, s.committed, s.curve_pieces = {}, {}, {}, {}
     return s
 
 

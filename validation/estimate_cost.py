@@ -1,7 +1,9 @@
 """What the error estimate costs, and where its time goes: the adaptive rows of
 validation/accuracy.py, each run with the estimate's reductions off ("before": every member
 solves the deepest state and four states around each zero-force crossing, and its fold
-decisions run to max_iter) and on ("after"),
+decisions run to max_iter), on as session 7 left them ("after") and with session 8's
+("kink": a member's windowed peak search that misses stops at the window's edge and the kink
+model searches the rest of the bracket; a member state Newton ends on a saddle is landed),
 counting the members' work by part - states, corrector solves, Newton iterations,
 factorisations, folds, landings, peak searches (windowed and over the whole bracket) and the
 fresh states they solve - and timing the estimate against the sweep it judges (median of
@@ -30,9 +32,14 @@ from .accuracy import CASES, SCENES, _adaptive, _timed
 RESULTS = Path(__file__).resolve().parent / "results"
 #: the settings compared: module flags of femadh.runner.members / estimates
 SETTINGS = {"before": {"ZERO_FORCE_PAIR_FIRST": False, "LOCKED_DEEPEST_ONLY": False,
-                       "FOLD_DECISION_STALL": False},
+                       "FOLD_DECISION_STALL": False, "KINK_PEAK": False,
+                       "LAND_SADDLE": False},
             "after": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True,
-                      "FOLD_DECISION_STALL": True}}
+                      "FOLD_DECISION_STALL": True, "KINK_PEAK": False, "LAND_SADDLE": False},
+            # session 8: a window that misses stops at its edge and the kink model searches
+            # the rest of the bracket; a member state on a saddle is landed
+            "kink": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True,
+                     "FOLD_DECISION_STALL": True, "KINK_PEAK": True, "LAND_SADDLE": True}}
 PARTS = ("deepest", "peak grid states", "peak search", "folds", "zero force", "edge-placed")
 
 
@@ -176,6 +183,7 @@ def counting():
     patch(cs, "solve_complementarity", solves)       # the sweep's and a traced step's
     patch(cl, "land", counted("landings"))
     patch(pk, "peak_adhesion", lambda f: _peak_counted(f, cnt))
+    patch(pk, "kink_peak", counted("kink searches", "peak search"))
     patch(pk, "state_between", counted("fresh states"))
     patch(members, "_peak", in_part("peak grid states"))
     patch(members, "_lattice_fold", counted("folds", "folds"))
@@ -194,11 +202,16 @@ def counting():
 
 
 def _peak_counted(f, cnt):
-    def g(problem, prev, best, nxt, scene, within=None, reuse=False):
+    import femadh.runner.peak as pk
+
+    def g(problem, prev, best, nxt, scene, within=None, reuse=False, **kw):
         cnt.enter("peak search")
         cnt.add("windowed searches" if within is not None else "whole-bracket searches")
         try:
-            return f(problem, prev, best, nxt, scene, within=within, reuse=reuse)
+            return f(problem, prev, best, nxt, scene, within=within, reuse=reuse, **kw)
+        except pk.WindowMiss:
+            cnt.add("windows stopped at their edge")
+            raise
         finally:
             cnt.leave()
     return g
@@ -291,7 +304,8 @@ def main(argv=None):
                                   f"{out[n][1]['sweep']['iterations']}" for n in names)
                      + " |")
     keys = ("states", "fresh states", "solves", "iterations", "factorisations", "folds",
-            "landings", "windowed searches", "whole-bracket searches")
+            "landings", "windowed searches", "windows stopped at their edge",
+            "whole-bracket searches", "kink searches")
     lines += ["", f"## Work by part ({arrow})", "",
               "| scene | request | part | " + " | ".join(keys) + " |",
               "|---|---|---|" + "---|" * len(keys)]

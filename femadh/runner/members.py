@@ -12,7 +12,9 @@ only, each by Newton from the fine run's committed state there carried to the me
   its contact edge (:func:`deepest_locked`) give those numbers' grid part;
 - the largest adhesion: the grid states around the fine run's peak (walked on while the
   member's own grid maximum lies further out), then the same bounded search between them as
-  the fine run's (:func:`femadh.runner.peak.peak_adhesion`);
+  the fine run's (:func:`femadh.runner.peak.peak_adhesion`), first in a window around the
+  fine run's peak; where the window misses, the kink model searches the rest of the bracket
+  (:func:`femadh.runner.peak.kink_peak`);
 - each fold: continued on the fine run's lattice of smallest steps (the stepping's own in
   that grid step) from a few lattice steps before the fine run's fold, with the stepping's
   acceptance rules, landing and lattice-snap test (:func:`_lattice_fold`): the same fold
@@ -25,10 +27,12 @@ A member state is the member's equilibrium on the fine run's branch at that sepa
 whole trace reaches the same state where its branch is the same (measured on the Fig 3 scene's
 family, spacings 15-240 nm: F_LJ at the deepest separation identical to the last digit; Fig 3
 and Fig 4 at their defaults: every grid part within 1.4e-6 of its number of the whole
-trace's, folds and hysteresis identical). Anything the reduced member cannot reproduce - a
-state that does not converge, is unstable or refused by a guard, a fold that is not near the
-fine run's, a landing elsewhere than the fine run's, a sign change that moved - is not
-guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
+trace's, folds and hysteresis identical). A state where Newton from the carried state ends
+on a saddle (a node at the contact edge between its two minima) is landed from the carried
+state onto the minimum of its basin (:meth:`_Member._off_saddle`). Anything the reduced
+member cannot reproduce - a state that does not converge, is unstable or refused by a
+guard, a fold that is not near the fine run's, a landing elsewhere than the fine run's, a
+sign change that moved - is not guessed: :func:`reduced_member` says why and the member is traced whole, as before. So are a
 uniform grid's members (N/2, N/4 may resolve the contact so coarsely that their branches
 differ from the fine one's: folds the fine run does not have, which no state of it shows).
 
@@ -49,6 +53,23 @@ PEAK_WALK = 3
 #: members' peaks lie 0.02 grid steps from the fine run's, Fig 3's 0.06); an optimum at the
 #: window's edge is searched again over the whole bracket
 PEAK_WINDOW = 0.125
+#: a member state that Newton from the fine run's carried state ends on a saddle is landed
+#: by energy descent (:meth:`_Member._off_saddle`) and kept where it stays on the fine run's
+#: branch (False: the member is traced whole, as before)
+LAND_SADDLE = True
+#: where a member's windowed peak search misses, the rest of the bracket is searched by the
+#: kink model (femadh.runner.peak.kink_peak: F_ex(d) as smooth pieces joined at the kinks
+#: where a node joins or leaves the contact) from every state the window's search solved,
+#: which stops at the window's edge (WINDOW_EDGE_STOP). False: the windowed search runs to
+#: its end and the whole bracket is searched again by the bounded search (as before)
+KINK_PEAK = True
+#: a member's windowed peak search stops as soon as its best fresh state lies within this
+#: fraction of the window's width of its edge (femadh.runner.peak.WindowMiss), and the whole
+#: bracket is searched by the kink model from the states it solved
+#: (femadh.runner.peak.kink_peak; with KINK_PEAK): the slider meniscus scene's members
+#: peak 0.25-0.35 of a grid step from the fine run's, beyond the window, whose search
+#: walked 16 fresh states to its edge and the whole bracket's Brent search 19 more
+WINDOW_EDGE_STOP = 0.1
 #: a member's fold is continued on the fine run's lattice from near the fine run's fold
 #: (False: the fine run's grid step that holds it is traced, halvings and all)
 LATTICE_FOLDS = True
@@ -136,12 +157,40 @@ class _Member:
         st = solve_state(self.problem, c.d, w0, tol=self.scene.tolerance,
                          max_iter=self.scene.max_iter, **kw)
         self.solves += 1
+        if st.converged and not st.stable and LAND_SADDLE:
+            st = self._off_saddle(st, w0)
         if not (st.converged and st.stable):
             raise _NotReduced(f"the state at d = {c.d * 1e9:.6g} nm ({branch}) did not "
                               "converge to a stable state from the fine run's")
         check_state(self.problem, st, self.member)     # GuardError: traced whole (refused)
         self.cache[key] = st
         return st
+
+    def _off_saddle(self, st, w0):
+        """The stable state an energy descent reaches from the fine run's state carried to
+        the member's grid (``w0``), where Newton from it converged to the saddle ``st``:
+        the minimum in whose basin the carried state lies, kept where it stays on that
+        branch (within a quarter of every gap of w0); else ``st``.
+
+        Near the contact edge a free node whose gap sits just above sigma (the member's
+        nodes 1.41x further apart than the fine run's, the LJ softening steeper over a
+        node's share) has two minima, the node nearer sigma and further out, and Newton's
+        full steps from the carried state can overshoot onto the saddle between them: the
+        stiction map's sigma = 0.489 nm, p/psat 0.15 at d = -5 nm on its 19.06-nm member
+        (one negative Hessian eigenvalue, its mode on the first free nodes; the first's gap
+        0.5435 nm at the saddle, 0.5628 carried, 0.5768 at the minimum). The descent
+        (:func:`~femadh.contact.landing.land`, the stepping's own landing) from the carried
+        state reaches the member's whole trace's deepest state there to 8e-15 nm
+        (tests/test_member_saddle.py)."""
+        from ..contact.landing import land
+
+        landed = land(self.problem, st.d, w0, tol=self.scene.tolerance,
+                      max_iter=self.scene.max_iter)
+        self.solves += 1
+        if not (landed.converged and landed.stable) or \
+                off_branch(self.problem, st.d, landed.w, w0):
+            return st
+        return landed
 
     def near(self, snap, d, branch=True):
         """The member's stable equilibrium at separation d by Newton from the fine run's state
@@ -184,7 +233,7 @@ def _peak(m, sink, snaps, d_fine=None):
     same piece of the branch (between the folds: :func:`femadh.runner.peak.pieces`), then
     the bounded search between the states around it - a fold's landing or last state where
     the piece ends there, as the fine run's bracket."""
-    from .peak import peak_adhesion, pieces
+    from .peak import WindowMiss, kink_peak, peak_adhesion, pieces
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]
@@ -236,9 +285,22 @@ def _peak(m, sink, snaps, d_fine=None):
         # bracket where the member's optimum ends at the window's edge
         half = PEAK_WINDOW * (abs(piece[j_hi].d - piece[i].d)
                               or abs(piece[i].d - piece[j_lo].d))
-        F, d, tol = peak_adhesion(m.problem, *around, m.scene,
-                                  within=(d_fine - half, d_fine + half), reuse=True)
-        if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:
+        known = []
+        try:
+            F, d, tol = peak_adhesion(m.problem, *around, m.scene,
+                                      within=(d_fine - half, d_fine + half), reuse=True,
+                                      record=known,
+                                      edge_stop=WINDOW_EDGE_STOP if KINK_PEAK else None)
+            if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:
+                return F, d
+        except WindowMiss:
+            pass
+        if KINK_PEAK:
+            # a miss: the whole bracket by the kink model, from every state the window's
+            # search solved (femadh.runner.peak.kink_peak)
+            F, d, _ = kink_peak(m.problem, *around, m.scene, known=known,
+                                window=(d_fine - half, d_fine + half), reuse=True,
+                                f_of=m.f_ex)
             return F, d
     F, d, _ = peak_adhesion(m.problem, *around, m.scene, reuse=True)
     return F, d

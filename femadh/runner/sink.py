@@ -59,6 +59,10 @@ class Sink:
         # the departing piece, the landing), the two as Committed records with their F_ex;
         # a landing starts a new piece of the branch (femadh.runner.peak.piece)
         self.pieces = {}
+        # the curve's pieces per branch as the states arrive, in the sweep's order:
+        # [states, starts at a landing, ends at a fold] (femadh.runner.peak.pieces; recorded
+        # by the same rule as the peak's bracket, _element, and replayed with it on resume)
+        self.curve_pieces = {}
         # the last committed state of each branch (a resumed branch restarts from it), and
         # the last one whole (state number, branch, State: the checkpoint of a stopped run)
         self.last = {}
@@ -137,6 +141,7 @@ class Sink:
         Ties (the same separation and F_ex within TIE_REL, e.g. approach and retract through
         one contact state): the first is kept unless the other's bracket is wider (it holds
         a part of the curve the first's does not: the first's is cut by a fold)."""
+        self._piece(branch, snap, start, end)
         f = snap.f_ex
         prev = self._prev[1] if self._prev is not None and self._prev[0] == branch else None
         if start:
@@ -163,6 +168,19 @@ class Sink:
             self._need_next = not end
             self._rival = None
         self._prev = (branch, snap)
+
+    def _piece(self, branch, snap, start, end):
+        """``snap`` joins the curve's pieces of ``branch``: a landing (``start``) or a
+        branch's first state opens a piece; a state at the separation of the piece's last
+        one is that state (left out, as in :meth:`_element`); a fold's last state (``end``)
+        closes its piece."""
+        ps = self.curve_pieces.setdefault(branch, [])
+        if start or not ps:
+            ps.append([[snap], bool(start), False])
+        elif not (ps[-1][0] and ps[-1][0][-1].d == snap.d):
+            ps[-1][0].append(snap)
+        if end:
+            ps[-1][2] = True
 
     def _close(self, branch, snap):
         """``snap`` is the next neighbour of the kept peak (and of its rival) still waiting
