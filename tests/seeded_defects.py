@@ -576,7 +576,10 @@ DEFECTS = [
       (("np.full(1, _contact_gap(problem))", "np.full(1, 2 * _contact_gap(problem))"),)),
     D("est_peak_bracket", "peak search to 1e-3 of its bracket (resolution 10x coarser)",
       "femadh/runner/peak.py",
-      (("xatol = PEAK_XTOL_FRACTION * (hi - lo)", "xatol = 1e-3 * (hi - lo)"),)),
+      (("state_forces(problem, best)[2]\n    lo, hi = sorted((prev.d, nxt.d))\n"
+        "    xatol = PEAK_XTOL_FRACTION * (hi - lo)",
+        "state_forces(problem, best)[2]\n    lo, hi = sorted((prev.d, nxt.d))\n"
+        "    xatol = 1e-3 * (hi - lo)"),)),
     D("est_uniform_members", "uniform family: members N/2 and N/3 at the ratio 2",
       "femadh/runner/estimates.py",
       (("for n in (scene.nodes // 2, scene.nodes // 4) if n >= 8]",
