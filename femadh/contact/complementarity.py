@@ -151,18 +151,26 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     n_factor, res_it = 0, math.inf
     mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
     stagnated = None
+    # (h, P, K w) after the last step: the next iteration's own when its active set is the
+    # same (w on the set is then already b - sigma, so w, h and the products are those bits)
+    carried = None
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
         # this state is on disk yet (femadh.interrupt)
         safe_point()
-        if sigma is not None:
-            w[A] = b[A] - sigma
         I = ~A
-        h = b - w
+        if carried is not None:
+            h, P, Kw = carried
+        else:
+            if sigma is not None:
+                w[A] = b[A] - sigma
+            h = b - w
         if np.any(h[I] <= 0):
             break  # the guess put the surfaces through each other: hopeless, report failure
-        P = problem.pressure(h)
-        F_I = (K @ w)[I] - P[I]
+        if carried is None:
+            P = problem.pressure(h)
+            Kw = K @ w
+        F_I = Kw[I] - P[I]
         m = disk_size(A)
         dw = None
         if m is not None and KRYLOV and not adhesion and n - m > KRYLOV_MIN_FREE:
@@ -181,8 +189,10 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         h = b - w
         P = problem.pressure(h)
         pc = np.zeros(n)
+        carried = None
         if sigma is not None:
-            pc[A] = P[A] - (K @ w)[A]
+            Kw = K @ w
+            pc[A] = P[A] - Kw[A]
             # a contact node stays while its asperities push (lambda = pc + P_LJa > 0: with
             # eq 20 on the contact set it holds a net tension up to P_LJa) ...
             new_A = (A & (pc + adhesion > 0)) | (I & (h < sigma))
@@ -203,6 +213,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # additions/removals adjacent to the current contact boundary to break the cycle.
             new_A = _restrict_change(A, new_A)
         seen.add(key)
+        if sigma is not None and np.array_equal(new_A, A):
+            carried = (h, P, Kw)
         if not np.array_equal(new_A, A):
             # a new active set: its first residual is not comparable with the last one, so
             # the next step is not a stall (a trailing LU that covers the new disk is reused
