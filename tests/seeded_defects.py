@@ -1377,6 +1377,31 @@ DEFECTS = [
     D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
       "femadh/runner/estimates.py",
       (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
+    # -- fig4fast3: the stability certificate and the corrector's carried products
+    D("cert_tail_dropped", "stability certificate: the nodes outside the edge block left out "
+      "of the bound", "femadh/contact/stability.py",
+      (("room = CERT_LIMIT - self.tail(e, b)", "room = CERT_LIMIT"),)),
+    D("cert_limit_above_one", "stability certificate: bound limit 1.2 (certifies saddles)",
+      "femadh/contact/stability.py", (("CERT_LIMIT = 0.9\n", "CERT_LIMIT = 1.2\n"),)),
+    D("cert_far_block", "stability certificate: the block taken from the axis, not the edge",
+      "femadh/contact/stability.py",
+      (("X = self.rinv[k - b:k, k - b:k] * np.sqrt(e[k - b:])[:, None]",
+        "X = self.rinv[:b, :b] * np.sqrt(e[k - b:])[:, None]"),)),
+    D("cert_not_reversed", "stability certificate: softening in natural node order",
+      "femadh/contact/stability.py",
+      (("return cert.certifies(np.maximum(-D[::-1], 0.0))",
+        "return cert.certifies(np.maximum(-D, 0.0))"),)),
+    D("cert_sign", "stability certificate: the stiffening taken as the softening",
+      "femadh/contact/stability.py",
+      (("return cert.certifies(np.maximum(-D[::-1], 0.0))",
+        "return cert.certifies(np.maximum(D[::-1], 0.0))"),)),
+    D("cert_q_column", "stability certificate: the trace read one column short",
+      "femadh/contact/stability.py",
+      (("self.q[:k - b, k - 1]", "self.q[:k - b, k - b - 1]"),)),
+    D("carried_on_set_change", "corrector: the step's h, P, K w carried into an iteration "
+      "whose contact set changed", "femadh/contact/complementarity.py",
+      (("if sigma is not None and np.array_equal(new_A, A):\n            carried",
+        "if sigma is not None:\n            carried"),)),
 ]
 
 

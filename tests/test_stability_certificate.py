@@ -62,6 +62,24 @@ def test_certificate_is_an_upper_bound_on_the_softening_eigenvalue(fig4):
     assert yes >= len(states[::3])
 
 
+def test_the_trace_part_is_the_diagonal_of_the_inverse_elastic_block(fig4):
+    """trace(M_RR) = sum_i e_i (S_II^-1)_ii, with S_II^-1 from a dense inverse of the trailing
+    block itself (not from the full factor's cumulated squares): equal to round-off
+    (measured relative difference 1.8e-15 at most; tolerance 2e-14, about ten times that)
+    for every free-set size and block."""
+    p, cert, states = fig4
+    rng = np.random.default_rng(7)
+    n = p.grid.n
+    for m in (0, 17, 60, 150):
+        k = n - m
+        Sk = p.S_sym[m:, m:][::-1, ::-1]
+        dinv = np.diag(np.linalg.inv(Sk))
+        e = rng.uniform(0, 1, k) * np.diag(Sk)
+        for b in (1, 8, 64):
+            exact = float(e[:k - b] @ dinv[:k - b])
+            assert cert.tail(e, b) == pytest.approx(exact, rel=2e-14, abs=0)
+
+
 def test_certificate_with_a_small_edge_block_stays_a_bound(fig4, monkeypatch):
     """With an edge block of 8 nodes most of the softening enters by the trace of the rest:
     still a bound (it certifies less, never more)."""
@@ -133,25 +151,26 @@ def test_saddles_are_never_certified(monkeypatch):
 
 
 def test_a_certified_state_has_the_margin_on_random_softenings():
-    """Random softenings on a 150-node disk (free sets of every size, edge to axis): whatever
-    the certificate certifies has H_II >= 0.1 S_II; both answers occur."""
+    """Random softenings on a 150-node disk (free sets of every size), concentrated at the
+    first free node and decaying inward, each scaled so that the exact lambda_max of
+    E^1/2 S_II^-1 E^1/2 is x, uniform in [0.5, 1.5] (x > 1: a saddle). A certified state has
+    x < 0.9 - the margin H_II >= 0.1 S_II the module states (the literal here, not its
+    constant) - so no saddle is ever certified; both answers occur, and the bound is tight
+    where the softening sits at the edge (measured: certified up to x = 0.8997, the
+    smallest x turned down 0.905)."""
     p = fig4_problem(150)
     cert = ElasticCertificate(p.S_sym)
     rng = np.random.default_rng(3)
     kdiag = np.diag(p.S_sym)
-    answers = []
-    for _ in range(60):
+    yes, no = [], []
+    for _ in range(80):
         m = int(rng.integers(0, 40))
         k = p.grid.n - m
-        # softening concentrated at the edge (the first free node), decaying inward, of a
-        # random strength up to twice the nodes' own stiffness
-        decay = np.exp(-np.arange(k) / rng.uniform(2, 40))
-        e = (rng.uniform(0, 2) * kdiag[m:] * decay)[::-1]
-        ok = cert.certifies(e)
-        answers.append(ok)
-        if ok:
-            H = p.S_sym[m:, m:] - np.diag(e[::-1])
-            mu = float(linalg.eigh(H, p.S_sym[m:, m:], eigvals_only=True,
-                                   subset_by_index=[0, 0])[0])
-            assert mu >= 1 - CERT_LIMIT - 1e-12
-    assert any(answers) and not all(answers)
+        decay = np.exp(-np.arange(k) / rng.uniform(1, 20))
+        e0 = (kdiag[m:] * decay)[::-1]
+        Sk = p.S_sym[m:, m:][::-1, ::-1]
+        lam = float(linalg.eigh(np.diag(e0), Sk, eigvals_only=True,
+                                subset_by_index=[k - 1, k - 1])[0])
+        x = rng.uniform(0.5, 1.5)
+        (yes if cert.certifies(x / lam * e0) else no).append(x)
+    assert 0.85 < max(yes) < 0.9 and no

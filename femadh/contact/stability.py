@@ -90,6 +90,12 @@ class ElasticCertificate:
         # q[i, j] = sum_{l <= j} rinv[i, l]^2; column k - 1 read per test: Fortran order
         self.q = np.asfortranarray(np.cumsum(rinv * rinv, axis=1))
 
+    def tail(self, e, b):
+        """trace(M_RR) = sum_i e_i (S_k^-1)_ii over the nodes outside the edge block (the
+        first k - b in reversed order), k = e.size."""
+        k = e.size
+        return float(e[:k - b] @ self.q[:k - b, k - 1]) if k > b else 0.0
+
     def certifies(self, e):
         """True if S_k - diag(e) is positive definite with lambda_max(M) < CERT_LIMIT.
 
@@ -97,8 +103,7 @@ class ElasticCertificate:
         (e[k - 1] is node m, the first free node)."""
         k = e.size
         b = min(EDGE_BLOCK, k)
-        tail = float(e[:k - b] @ self.q[:k - b, k - 1]) if k > b else 0.0
-        room = CERT_LIMIT - tail
+        room = CERT_LIMIT - self.tail(e, b)
         if not room > 0:
             return False
         X = self.rinv[k - b:k, k - b:k] * np.sqrt(e[k - b:])[:, None]
