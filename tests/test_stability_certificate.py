@@ -84,7 +84,7 @@ def test_certificate_with_a_small_edge_block_stays_a_bound(fig4, monkeypatch):
     """With an edge block of 8 nodes most of the softening enters by the trace of the rest:
     still a bound (it certifies less, never more)."""
     p, cert, states = fig4
-    monkeypatch.setattr(stability, "EDGE_BLOCK", 8)
+    monkeypatch.setattr(stability, "EDGE_BLOCKS", (8,))
     for st in states[::4]:
         m = int(st.active.sum())
         mu = _generalised_min(p, st.h, m)

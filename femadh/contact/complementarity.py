@@ -37,7 +37,7 @@ from scipy import linalg
 
 from ..interrupt import check as safe_point
 from .linalg import TrailingCholesky, TrailingLU, disk_size, gmres
-from .stability import is_stable
+from .stability import is_stable, refuted_positive_definite
 from .state import State
 from .subgrid import add_jacobian, apply_jacobian, jacobian_row_sums
 
@@ -270,6 +270,15 @@ def _krylov_step(problem, h, A, m, F_I, pre):
             # held nodes of the margin enter with D = 0 (they are fixed; when released the
             # Krylov iteration corrects their stiffness)
             m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            if refuted_positive_definite(problem, D, m):
+                # the refreshed factor would cover no block from m (the Hessian at h is not
+                # positive definite on the free nodes): made only if a smaller free set
+                # asks for it later and is not refuted the same way, as it would have been
+                # made here
+                pre = TrailingCholesky(
+                    problem.S_sym, problem.areas, _held_zero(D, A), m0, not_pd=n - m,
+                    refutes=lambda k: refuted_positive_definite(problem, D, n - k))
+                return None, pre, n_factor
             pre = TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0)
             n_factor += 1
             if not pre.covers(m):

@@ -35,10 +35,18 @@ from ..errors import ConvergenceError
 #: tests/test_stability_certificate.py)
 CERT_LIMIT = 0.9
 #: the nodes next to the contact edge (or the axis, without contact) whose softening the
-#: bound takes exactly (a dense EDGE_BLOCK x EDGE_BLOCK test); the others enter by the trace
-#: of their part. Measured on the Fig 4 scene at accuracy 1e-3 (383 tests): 64 certifies 310,
-#: 128 certifies 338 and the exact largest eigenvalue (any block) 341 at this limit
-EDGE_BLOCK = 128
+#: bound takes exactly (a dense test of the block); the others enter by the trace of their
+#: part. Tried in turn, each only if the smaller one could not prove the bound: the softening
+#: zone spans more nodes on a finer grid. Measured on the Fig 4 scene at accuracy 1e-3 (383
+#: tests, 595 nodes): a block of 64 certifies 310, 128 certifies 338 and the exact largest
+#: eigenvalue (any block) 341 at this limit; at 1e-4 (2904 nodes) 128 alone certified 180
+#: of 387
+EDGE_BLOCKS = (128, 512, 1024)
+#: :meth:`ElasticCertificate.refutes` answers "not positive definite" only when the edge
+#: block's lambda_max exceeds 1 by this: a negative curvature of 1e-4 of the elastic
+#: stiffness along its direction, against a Cholesky's relative round-off of ~n eps kappa(S)
+#: (3e-13 x 1e5 at most here)
+REFUTE_MARGIN = 1e-4
 #: free nodes below which the Cholesky is as cheap as the certificate's bookkeeping
 CERT_MIN_FREE = 96
 #: Cholesky tests of one problem before its certificate is built (the build is a Cholesky
@@ -64,12 +72,12 @@ class ElasticCertificate:
     R^-1 (triangular). With E = diag(max(-area P', 0)) the softening (E_+ the stiffening,
     dropped: it only helps), S_k - E = R_k^T (I - R_k^-T E R_k^-1) R_k, which is positive
     definite iff lambda_max(M) < 1 for M = X X^T, X = E^1/2 R_k^-1 (k x k, upper triangular).
-    Split the nodes into B, the EDGE_BLOCK ones next to the contact edge (the last indices in
+    Split the nodes into B, the b (EDGE_BLOCKS) next to the contact edge (the last indices in
     reversed order: the smallest gaps, where the softening is), and the rest: for a positive
     semi-definite M, lambda_max(M) <= lambda_max(M_BB) + trace(M_RR). M_BB = X_B X_B^T with
     X_B = E_B^1/2 R^-1[B, B] (rows B of the triangular inverse start at B), and
     trace(M_RR) = sum_i e_i q_i(k), q_i(k) = sum_{j <= k-1} (R^-1)_ij^2 (cumulated once per
-    grid). So one test costs O(k + EDGE_BLOCK^3) against the Cholesky's k^3/3.
+    grid). So one test costs O(k + 2 b^3 / 3) against the Cholesky's k^3/3.
 
     Memory: R^-1 and its cumulated squares, 2 n^2 doubles (135 MB at 2900 nodes).
     """
@@ -96,37 +104,83 @@ class ElasticCertificate:
         k = e.size
         return float(e[:k - b] @ self.q[:k - b, k - 1]) if k > b else 0.0
 
+    def _edge_test(self, e, b, room):
+        """True iff room I - M_BB is positive definite (LAPACK potrf), M_BB = X_B X_B^T for
+        the last b nodes: X_B X_B^T by LAPACK lauum (the product of a triangular matrix with
+        its transpose, b^3/3 flops), then a Cholesky (b^3/3)."""
+        k = e.size
+        X = np.array(self.rinv[k - b:k, k - b:k], order="F")
+        X *= np.sqrt(e[k - b:])[:, None]
+        G, _ = lapack.dlauum(X, lower=False, overwrite_c=True)
+        G *= -1.0
+        G[np.diag_indices_from(G)] += room
+        _, info = lapack.dpotrf(G, lower=False, clean=False, overwrite_a=True)
+        return info == 0
+
+    def refutes(self, e):
+        """True if S_k - diag(e) restricted to the edge block is not positive definite with a
+        margin: lambda_max(M_BB) > 1 + REFUTE_MARGIN. Then S_k - diag(e) has a direction of
+        negative curvature (-REFUTE_MARGIN relative to S_k along it), and so has every
+        H_II <= S_k - diag(e) (a Hessian whose free nodes all soften, e its softening or
+        any part of it): the Cholesky of H_II fails."""
+        return not self._edge_test(e, min(EDGE_BLOCKS[0], e.size), 1.0 + REFUTE_MARGIN)
+
     def certifies(self, e):
         """True if S_k - diag(e) is positive definite with lambda_max(M) < CERT_LIMIT.
 
         e : ndarray (k,), >= 0, the softening (N/m) of the free nodes in *reversed* order
-        (e[k - 1] is node m, the first free node)."""
+        (e[k - 1] is node m, the first free node). The edge blocks of EDGE_BLOCKS are tried
+        in turn (a larger one only while it is at most half the free nodes: its test then
+        costs at most a quarter of the Cholesky of H_II); the first that proves the bound
+        answers."""
         k = e.size
-        b = min(EDGE_BLOCK, k)
-        room = CERT_LIMIT - self.tail(e, b)
-        if not room > 0:
-            return False
-        X = self.rinv[k - b:k, k - b:k] * np.sqrt(e[k - b:])[:, None]
-        G = -(X @ X.T)
-        G[np.diag_indices_from(G)] += room
-        _, info = lapack.dpotrf(G, lower=False, clean=False, overwrite_a=True)
-        return info == 0
+        for i, size in enumerate(EDGE_BLOCKS):
+            b = min(size, k)
+            if i and 2 * b > k:
+                break
+            room = CERT_LIMIT - self.tail(e, b)
+            if room > 0 and self._edge_test(e, b, room):
+                return True
+            if b == k:
+                break
+        return False
 
 
 #: per problem: [Cholesky tests so far, its ElasticCertificate or None]
 _CERTIFICATES = weakref.WeakKeyDictionary()
 
 
-def _certificate(problem):
-    """The problem's certificate once it has had CERT_BUILD_AFTER Cholesky tests, else None."""
+def _certificate(problem, count=True):
+    """The problem's certificate once it has had CERT_BUILD_AFTER stability tests, else None
+    (``count``: this call is one more test)."""
     entry = _CERTIFICATES.get(problem)
     if entry is None:
         entry = _CERTIFICATES[problem] = [0, None]
     if entry[1] is None and entry[0] >= CERT_BUILD_AFTER:
         entry[1] = ElasticCertificate(problem.S_sym)
-    entry[0] += 1
+    entry[0] += count
     cert = entry[1]
     return cert if cert is not None and cert.ok else None
+
+
+def refuted_positive_definite(problem, D, m):
+    """True when the energy Hessian sym(S) + diag(area D) on the free nodes m..n-1 (a disk's
+    complement; D the collocated law Jacobian P'(h), Pa/m, on every node) is proven not
+    positive definite by its edge block (:meth:`ElasticCertificate.refutes`); False when it
+    cannot tell (not a verdict). Only where every free node softens (D <= 0), and only once
+    the problem's certificate exists (its stability tests built it)."""
+    if D.ndim != 1 or getattr(problem, "banded", True) is not False:
+        return False
+    k = D.size - m
+    if k < CERT_MIN_FREE:
+        return False
+    cert = _certificate(problem, count=False)
+    if cert is None:
+        return False
+    aD = problem.areas[m:] * D[m:]
+    if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):
+        return False
+    return cert.refutes(-aD[::-1])
 
 
 def certified_stable(problem, h, free):
