@@ -1402,6 +1402,21 @@ DEFECTS = [
       "whose contact set changed", "femadh/contact/complementarity.py",
       (("if sigma is not None and np.array_equal(new_A, A):\n            carried",
         "if sigma is not None:\n            carried"),)),
+    D("refute_no_margin", "edge-block refutation at lambda_max > 0.5 (refutes positive "
+      "definite Hessians)", "femadh/contact/stability.py",
+      (("1.0 + REFUTE_MARGIN)", "0.5 + REFUTE_MARGIN)"),)),
+    D("refute_stiffening_kept", "edge-block refutation where some free node stiffens",
+      "femadh/contact/stability.py",
+      (("if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):",
+        "if not np.all(np.isfinite(aD)):"),
+       ("return cert.refutes(-aD[::-1])", "return cert.refutes(np.maximum(-aD[::-1], 0.0))"))),
+    D("deferred_block_off_by_one", "deferred refresh: the block one node smaller than the "
+      "refuted one also reported not covered", "femadh/contact/linalg.py",
+      (("            if self.n - m >= not_pd:", "            if self.n - m >= not_pd - 1:"),)),
+    D("deferred_refutes_own_block", "deferred refresh: a smaller free set refuted by the "
+      "refresh's own block", "femadh/contact/complementarity.py",
+      (("refutes=lambda k: refuted_positive_definite(problem, D, n - k))",
+        "refutes=lambda k: refuted_positive_definite(problem, D, m))"),)),
 ]
 
 

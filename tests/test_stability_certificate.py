@@ -174,3 +174,130 @@ def test_a_certified_state_has_the_margin_on_random_softenings():
         x = rng.uniform(0.5, 1.5)
         (yes if cert.certifies(x / lam * e0) else no).append(x)
     assert 0.85 < max(yes) < 0.9 and no
+
+
+def test_refuted_edge_blocks_are_saddles_of_the_elastic_energy():
+    """The same random edge softenings, scaled to lambda_max = x in [0.5, 1.5]: where the
+    edge-block test refutes positive definiteness, x > 1 (the exact generalised eigenvalue:
+    S_II - E has a negative direction) and the Cholesky of S_II - E fails; it refutes some
+    (measured: 32 of 80, down to x = 1.0017; the edge block of 128 of up to 150 free nodes
+    holds nearly all the softening)."""
+    p = fig4_problem(150)
+    cert = ElasticCertificate(p.S_sym)
+    rng = np.random.default_rng(5)
+    kdiag = np.diag(p.S_sym)
+    refuted = []
+    for _ in range(80):
+        m = int(rng.integers(0, 40))
+        k = p.grid.n - m
+        e0 = (kdiag[m:] * np.exp(-np.arange(k) / rng.uniform(1, 20)))[::-1]
+        Sk = p.S_sym[m:, m:][::-1, ::-1]
+        lam = float(linalg.eigh(np.diag(e0), Sk, eigvals_only=True,
+                                subset_by_index=[k - 1, k - 1])[0])
+        x = rng.uniform(0.5, 1.5)
+        if cert.refutes(x / lam * e0):
+            refuted.append(x)
+            assert x > 1
+            assert not is_positive_definite(Sk - np.diag(x / lam * e0))
+    assert refuted and min(refuted) < 1.1
+
+
+def test_a_deferred_refresh_covers_what_the_factor_covers(monkeypatch):
+    """A Krylov refresh deferred because the Hessian on the free nodes m.. is refuted answers
+    covers(m') for every m' as the factorised one does, and where it covers, its kept factor
+    is the factorised one's bit for bit (the same arrays, factorised later). Measured: 27 of
+    the 30 random softenings refuted, each factor covering a smaller block (k_valid 149-209
+    of 161-214 free nodes), so both answers of covers() are compared. A Jacobian that
+    stiffens every free node (a positive definite Hessian) is never refuted."""
+    from femadh.contact.complementarity import deferred_refresh
+    from femadh.contact.linalg import TrailingCholesky
+
+    monkeypatch.setattr(stability, "CERT_BUILD_AFTER", 0)
+    p = fig4_problem(220)
+    n = p.grid.n
+    kdiag = np.diag(p.K)
+    rng = np.random.default_rng(11)
+    deferred = 0
+    for _ in range(30):
+        m = int(rng.integers(5, 60))
+        A = np.arange(n) < m
+        # a law Jacobian softening the free nodes next to the edge by up to 3 x their own
+        # stiffness, decaying inward: refuted for the stronger ones
+        D = np.zeros(n)
+        D[m:] = -rng.uniform(0.2, 3.0) * kdiag[m:] * np.exp(-np.arange(n - m)
+                                                            / rng.uniform(1, 8))
+        D[:m] = -rng.uniform(0, 3) * kdiag[:m]       # the contact nodes' (held: not used)
+        assert not stability.refuted_positive_definite(p, -D, m)
+        m0 = max(0, m - 11)
+        if not stability.refuted_positive_definite(p, D, m):
+            continue
+        deferred += 1
+        lazy = deferred_refresh(p, D, A, m0, m)
+        full = TrailingCholesky(p.S_sym, p.areas, np.where(A, 0.0, D), m0)
+        assert not full.covers(m)
+        for mm in range(m0, n):
+            assert lazy.covers(mm) == full.covers(mm), (m, mm)
+        if full.k_valid > 0:
+            assert np.array_equal(lazy.kept, full.kept)
+    assert deferred >= 20
+
+
+def test_sweeps_are_bit_identical_with_and_without_the_certificate(monkeypatch):
+    """The Fig 4 approach and retract on 220 nodes (folds included), once as femadh runs it
+    and once with every stability test a Cholesky and every Krylov refresh factorised: the
+    same states to the bit (displacements, contact sets, stability), and the certificate and
+    the deferral both acted (measured: 41 of 52 stability tests certified, 30 refreshes
+    deferred)."""
+    import femadh.contact.linalg as la
+
+    made = {"deferred": 0}
+    real_init = la.TrailingCholesky.__init__
+
+    def spy(self, *a, **k):
+        made["deferred"] += k.get("not_pd") is not None
+        real_init(self, *a, **k)
+    monkeypatch.setattr(la.TrailingCholesky, "__init__", spy)
+    certified = []
+    real_cert = stability.certified_stable
+
+    def cert_spy(*a):
+        certified.append(real_cert(*a))
+        return certified[-1]
+    monkeypatch.setattr(stability, "certified_stable", cert_spy)
+    fast = fig4_sweeps(fig4_problem(220))
+    monkeypatch.setattr(stability, "certified_stable", lambda *a: False)
+    monkeypatch.setattr(stability, "refuted_positive_definite", lambda *a: False)
+    import femadh.contact.complementarity as cm
+    monkeypatch.setattr(cm, "refuted_positive_definite", lambda *a: False)
+    plain = fig4_sweeps(fig4_problem(220))
+    for sf, sp in zip(fast, plain):
+        assert len(sf.states) == len(sp.states) and len(sf.jumps) == len(sp.jumps)
+        for a, b in zip(sf.states, sp.states):
+            assert np.array_equal(a.w, b.w) and np.array_equal(a.active, b.active)
+            assert a.stable == b.stable and a.d == b.d
+    assert sum(certified) >= 30 and made["deferred"] >= 10
+
+
+def test_a_stiffening_node_is_never_read_as_softening(monkeypatch):
+    """Random law Jacobians that soften the edge and stiffen a random half of the free nodes
+    (up to 30 x their stiffness): whatever is refuted has a Hessian the Cholesky rejects. The
+    stiffening cannot be dropped from the bound: the softening alone refutes 44 of the 64
+    positive definite Hessians here (measured)."""
+    monkeypatch.setattr(stability, "CERT_BUILD_AFTER", 0)
+    p = fig4_problem(220)
+    n = p.grid.n
+    kdiag = np.diag(p.K)
+    rng = np.random.default_rng(2)
+    definite = 0
+    for _ in range(200):
+        m = int(rng.integers(5, 60))
+        k = n - m
+        D = np.zeros(n)
+        D[m:] = -rng.uniform(0.2, 3.0) * kdiag[m:] * np.exp(-np.arange(k) / rng.uniform(1, 8))
+        stiff = rng.random(k) < 0.5
+        D[m:][stiff] = rng.uniform(1, 30) * kdiag[m:][stiff]
+        pd = is_positive_definite(p.S_sym[m:, m:] + np.diag(p.areas[m:] * D[m:]))
+        definite += pd
+        if stability.refuted_positive_definite(p, D, m):
+            assert not pd
+    assert definite >= 30

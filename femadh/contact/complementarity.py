@@ -275,10 +275,7 @@ def _krylov_step(problem, h, A, m, F_I, pre):
                 # positive definite on the free nodes): made only if a smaller free set
                 # asks for it later and is not refuted the same way, as it would have been
                 # made here
-                pre = TrailingCholesky(
-                    problem.S_sym, problem.areas, _held_zero(D, A), m0, not_pd=n - m,
-                    refutes=lambda k: refuted_positive_definite(problem, D, n - k))
-                return None, pre, n_factor
+                return None, deferred_refresh(problem, D, A, m0, m), n_factor
             pre = TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0)
             n_factor += 1
             if not pre.covers(m):
@@ -287,6 +284,17 @@ def _krylov_step(problem, h, A, m, F_I, pre):
         if ok:
             return dw, pre, n_factor
     return None, pre, n_factor
+
+
+def deferred_refresh(problem, D, A, m0, m):
+    """The Krylov preconditioner's refresh at an iterate whose Hessian on the free nodes
+    m..n-1 is refuted positive definite (:func:`refuted_positive_definite`; D the law
+    Jacobian at the iterate, A its contact set): a :class:`TrailingCholesky` of the same
+    arrays from m0 whose factorisation waits until a smaller free set asks for it and is
+    not refuted in turn."""
+    n = D.shape[0]
+    return TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0, not_pd=n - m,
+                            refutes=lambda k: refuted_positive_definite(problem, D, n - k))
 
 
 def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chord_rate):
