@@ -301,3 +301,17 @@ def test_a_stiffening_node_is_never_read_as_softening(monkeypatch):
         if stability.refuted_positive_definite(p, D, m):
             assert not pd
     assert definite >= 30
+
+
+def test_no_mask_means_every_node_free(fig4, monkeypatch):
+    """free = None (every node free, as energy_hessian reads it): the same decision and the
+    same certificate as the all-True mask, on the states without contact."""
+    monkeypatch.setattr(stability, "CERT_BUILD_AFTER", 0)
+    p, cert, states = fig4
+    open_states = [st for st in states if not st.active.any()]
+    assert open_states
+    for st in open_states:
+        every = np.ones(p.grid.n, bool)
+        assert stability.certified_stable(p, st.h, None) == \
+            stability.certified_stable(p, st.h, every)
+        assert stability.is_stable(p, st.h, None) == stability.is_stable(p, st.h, every)

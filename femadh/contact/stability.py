@@ -189,6 +189,8 @@ def certified_stable(problem, h, free):
     least CERT_MIN_FREE free nodes are tried."""
     if getattr(problem, "banded", True) is not False:
         return False
+    if free is None:            # every node free (as in ContactProblem.energy_hessian)
+        free = np.ones(h.size, bool)
     n = free.size
     k = int(np.count_nonzero(free))
     m = n - k
@@ -204,7 +206,8 @@ def certified_stable(problem, h, free):
 
 
 def is_stable(problem, h, free):
-    """Whether the state with gaps h (m) is an energy minimum on the nodes ``free`` (bool mask)."""
+    """Whether the state with gaps h (m) is an energy minimum on the nodes ``free`` (bool mask;
+    None: every node)."""
     if certified_stable(problem, h, free):
         return True
     H = problem.energy_hessian(h, free)
