@@ -394,7 +394,7 @@ DEFECTS = [
     # -- runs: signals at safe points, checked resume, checkpoints, the lock
     D("interrupt_no_safe_point_in_newton", "complementarity Newton never checks for a signal",
       "femadh/contact/complementarity.py",
-      (("        safe_point()\n        if sigma is not None:", "        if sigma is not None:"),)),
+      (("        safe_point()\n        I = ~A", "        I = ~A"),)),
     D("resume_checksum_ignored", "resume: a row whose checksum does not match is accepted",
       "femadh/io/resume_check.py", (('        return "checksum"', "        pass"),)),
     D("resume_no_checkpoint", "a sweep stopped by a signal saves no checkpoint",
@@ -1425,6 +1425,46 @@ DEFECTS = [
     D("pieces_landing_joins", "sink pieces: a landing joins the piece before the fold",
       "femadh/runner/sink.py",
       (("        if start or not ps:\n            ps.append(", "        if not ps:\n            ps.append("),)),
+    # -- fig4fast3: the stability certificate and the corrector's carried products
+    D("cert_tail_dropped", "stability certificate: the nodes outside the edge block left out "
+      "of the bound", "femadh/contact/stability.py",
+      (("room = CERT_LIMIT - self.tail(e, b)", "room = CERT_LIMIT"),)),
+    D("cert_limit_above_one", "stability certificate: bound limit 1.2 (certifies saddles)",
+      "femadh/contact/stability.py", (("CERT_LIMIT = 0.9\n", "CERT_LIMIT = 1.2\n"),)),
+    D("cert_far_block", "stability certificate: the block taken from the axis, not the edge",
+      "femadh/contact/stability.py",
+      (("X = np.array(self.rinv[k - b:k, k - b:k], order=\"F\")",
+        "X = np.array(self.rinv[:b, :b], order=\"F\")"),)),
+    D("cert_not_reversed", "stability certificate: softening in natural node order",
+      "femadh/contact/stability.py",
+      (("return cert.certifies(np.maximum(-D[::-1], 0.0))",
+        "return cert.certifies(np.maximum(-D, 0.0))"),)),
+    D("cert_sign", "stability certificate: the stiffening taken as the softening",
+      "femadh/contact/stability.py",
+      (("return cert.certifies(np.maximum(-D[::-1], 0.0))",
+        "return cert.certifies(np.maximum(D[::-1], 0.0))"),)),
+    D("cert_q_column", "stability certificate: the trace read one column short",
+      "femadh/contact/stability.py",
+      (("self.q[:k - b, k - 1]", "self.q[:k - b, k - b - 1]"),)),
+    D("carried_on_set_change", "corrector: the step's h, P, K w carried into an iteration "
+      "whose contact set changed", "femadh/contact/complementarity.py",
+      (("if sigma is not None and np.array_equal(new_A, A):\n            carried",
+        "if sigma is not None:\n            carried"),)),
+    D("refute_no_margin", "edge-block refutation at lambda_max > 0.5 (refutes positive "
+      "definite Hessians)", "femadh/contact/stability.py",
+      (("1.0 + REFUTE_MARGIN)", "0.5 + REFUTE_MARGIN)"),)),
+    D("refute_stiffening_kept", "edge-block refutation where some free node stiffens",
+      "femadh/contact/stability.py",
+      (("if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):",
+        "if not np.all(np.isfinite(aD)):"),
+       ("return cert.refutes(-aD[::-1])", "return cert.refutes(np.maximum(-aD[::-1], 0.0))"))),
+    D("deferred_block_off_by_one", "deferred refresh: the block one node smaller than the "
+      "refuted one also reported not covered", "femadh/contact/linalg.py",
+      (("            if self.n - m >= not_pd:", "            if self.n - m >= not_pd - 1:"),)),
+    D("deferred_refutes_own_block", "deferred refresh: a smaller free set refuted by the "
+      "refresh's own block", "femadh/contact/complementarity.py",
+      (("refutes=lambda k: refuted_positive_definite(problem, D, n - k))",
+        "refutes=lambda k: refuted_positive_definite(problem, D, m))"),)),
 ]
 
 

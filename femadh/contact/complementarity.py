@@ -37,7 +37,7 @@ from scipy import linalg
 
 from ..interrupt import check as safe_point
 from .linalg import TrailingCholesky, TrailingLU, disk_size, gmres
-from .stability import is_stable
+from .stability import is_stable, refuted_positive_definite
 from .state import State
 from .subgrid import add_jacobian, apply_jacobian, jacobian_row_sums
 
@@ -151,18 +151,26 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     n_factor, res_it = 0, math.inf
     mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
     stagnated = None
+    # (h, P, K w) after the last step: the next iteration's own when its active set is the
+    # same (w on the set is then already b - sigma, so w, h and the products are those bits)
+    carried = None
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
         # this state is on disk yet (femadh.interrupt)
         safe_point()
-        if sigma is not None:
-            w[A] = b[A] - sigma
         I = ~A
-        h = b - w
+        if carried is not None:
+            h, P, Kw = carried
+        else:
+            if sigma is not None:
+                w[A] = b[A] - sigma
+            h = b - w
         if np.any(h[I] <= 0):
             break  # the guess put the surfaces through each other: hopeless, report failure
-        P = problem.pressure(h)
-        F_I = (K @ w)[I] - P[I]
+        if carried is None:
+            P = problem.pressure(h)
+            Kw = K @ w
+        F_I = Kw[I] - P[I]
         m = disk_size(A)
         dw = None
         if m is not None and KRYLOV and not adhesion and n - m > KRYLOV_MIN_FREE:
@@ -181,8 +189,10 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         h = b - w
         P = problem.pressure(h)
         pc = np.zeros(n)
+        carried = None
         if sigma is not None:
-            pc[A] = P[A] - (K @ w)[A]
+            Kw = K @ w
+            pc[A] = P[A] - Kw[A]
             # a contact node stays while its asperities push (lambda = pc + P_LJa > 0: with
             # eq 20 on the contact set it holds a net tension up to P_LJa) ...
             new_A = (A & (pc + adhesion > 0)) | (I & (h < sigma))
@@ -203,6 +213,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # additions/removals adjacent to the current contact boundary to break the cycle.
             new_A = _restrict_change(A, new_A)
         seen.add(key)
+        if sigma is not None and np.array_equal(new_A, A):
+            carried = (h, P, Kw)
         if not np.array_equal(new_A, A):
             # a new active set: its first residual is not comparable with the last one, so
             # the next step is not a stall (a trailing LU that covers the new disk is reused
@@ -258,6 +270,12 @@ def _krylov_step(problem, h, A, m, F_I, pre):
             # held nodes of the margin enter with D = 0 (they are fixed; when released the
             # Krylov iteration corrects their stiffness)
             m0 = max(0, m - max(4, int(DISK_MARGIN_FRACTION * n)))
+            if refuted_positive_definite(problem, D, m):
+                # the refreshed factor would cover no block from m (the Hessian at h is not
+                # positive definite on the free nodes): made only if a smaller free set
+                # asks for it later and is not refuted the same way, as it would have been
+                # made here
+                return None, deferred_refresh(problem, D, A, m0, m), n_factor
             pre = TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0)
             n_factor += 1
             if not pre.covers(m):
@@ -266,6 +284,17 @@ def _krylov_step(problem, h, A, m, F_I, pre):
         if ok:
             return dw, pre, n_factor
     return None, pre, n_factor
+
+
+def deferred_refresh(problem, D, A, m0, m):
+    """The Krylov preconditioner's refresh at an iterate whose Hessian on the free nodes
+    m..n-1 is refuted positive definite (:func:`refuted_positive_definite`; D the law
+    Jacobian at the iterate, A its contact set): a :class:`TrailingCholesky` of the same
+    arrays from m0 whose factorisation waits until a smaller free set asks for it and is
+    not refuted in turn."""
+    n = D.shape[0]
+    return TrailingCholesky(problem.S_sym, problem.areas, _held_zero(D, A), m0, not_pd=n - m,
+                            refutes=lambda k: refuted_positive_definite(problem, D, n - k))
 
 
 def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chord_rate):

@@ -96,30 +96,64 @@ class TrailingCholesky:
     and by the change of D since it was built: a preconditioner for :func:`gmres`, not a solver.
     """
 
-    def __init__(self, S_sym, areas, D, m0):
+    def __init__(self, S_sym, areas, D, m0, not_pd=None, refutes=None):
+        self.n, self.m0 = S_sym.shape[0], m0
+        self._kept = None
+        self._block = (None, None)
+        self._deferred = None
+        if not_pd is not None:
+            # the leading block of size not_pd (the free nodes of the iterate that asked for
+            # this refresh) is known not to be positive definite (the edge-block test of
+            # :meth:`femadh.contact.stability.ElasticCertificate.refutes`): no block that
+            # contains it is covered, and the factorisation is made only when a smaller block
+            # is asked for - from the same arrays, so the same factor, bit for bit. Near a
+            # fold most refreshes are such (109 of 219 on the Fig 4 scene at accuracy 1e-3),
+            # and most are never asked for another block. ``refutes(k)``, if given, tells
+            # the same of a smaller leading block k (True: proven not positive definite)
+            self._deferred = (S_sym, areas, D, not_pd, refutes)
+            return
+        self._factorise(S_sym, areas, D)
+
+    def _factorise(self, S_sym, areas, D):
         from scipy.linalg import lapack
 
-        n = S_sym.shape[0]
+        n, m0 = self.n, self.m0
+        self._deferred = None
         M = np.array(S_sym[m0:, m0:][::-1, ::-1], order="F")
         if D.ndim == 2:     # a sub-grid law: area x its Jacobian is the symmetric df/dh
             M += (areas[m0:, None] * D[m0:, m0:])[::-1, ::-1]
         else:
             M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
-        self.n, self.m0 = n, m0
-        self.k_valid = n - m0 if info == 0 else int(info) - 1
+        self._k_valid = n - m0 if info == 0 else int(info) - 1
         # the factor in the kept precision is taken when a block is first asked for
         # (:meth:`covers`): a factor that covers no block the corrector needs - the Hessian
         # of an iterate off the stable branch, not positive definite at the contact edge,
         # which near a fold is most of the refreshes (91 of 97 on the Fig 4 scene's 631-node
         # sweep) - costs its Cholesky alone
-        self._u = u[:self.k_valid, :self.k_valid] if self.k_valid > 0 else None
-        self._kept = None
-        self._block = (None, None)
+        self._u = u[:self._k_valid, :self._k_valid] if self._k_valid > 0 else None
+
+    @property
+    def deferred(self):
+        """True while the factorisation has not been made (see ``not_pd``)."""
+        return self._deferred is not None
+
+    @property
+    def k_valid(self):
+        """The largest leading block (reversed node order) that is positive definite."""
+        if self._deferred is not None:
+            self._factorise(*self._deferred[:3])
+        return self._k_valid
+
+    @k_valid.setter
+    def k_valid(self, value):
+        self._k_valid = value
 
     def _keep(self):
         """U (reversed node order, upper) in PRECONDITIONER_DTYPE; k_valid drops to 0 where
         a diagonal entry is not a finite positive number in that precision."""
+        if self._deferred is not None:
+            self._factorise(*self._deferred[:3])
         u, self._u = self._u, None
         self._kept = np.zeros((0, 0), PRECONDITIONER_DTYPE, order="F")
         if u is None or self.k_valid <= 0:
@@ -144,13 +178,21 @@ class TrailingCholesky:
     def from_kept(cls, kept, n, m0, k_valid):
         """The preconditioner from its kept factor (a checkpoint's arrays)."""
         out = cls.__new__(cls)
-        out.n, out.m0, out.k_valid = n, m0, k_valid
+        out.n, out.m0, out._k_valid = n, m0, k_valid
+        out._deferred = None
         out._u = None
         out._kept = np.asfortranarray(kept, dtype=PRECONDITIONER_DTYPE)
         out._block = (None, None)
         return out
 
     def covers(self, m):
+        if self._deferred is not None and m >= self.m0:
+            S_sym, areas, D, not_pd, refutes = self._deferred
+            if self.n - m >= not_pd:
+                return False        # contains the block known not positive definite
+            if refutes is not None and refutes(self.n - m):
+                self._deferred = (S_sym, areas, D, self.n - m, refutes)
+                return False
         if not (m >= self.m0 and self.n - m <= self.k_valid):
             return False
         if self._kept is None:
