@@ -49,7 +49,7 @@ import numpy as np
 from ..errors import ConvergenceError
 from .complementarity import STALL_ITER, solve_complementarity, tangent
 from .linalg import disk_size
-from .landing import land
+from .landing import land, land_next_node
 
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
@@ -365,6 +365,70 @@ class _Bracket:
         return a + self.dir * (n // 2) * h
 
 
+#: a contact unzipping node by node (issue 21): after two lattice snaps the next one is
+#: expected as far past the last as the last was past the one before (:class:`_SnapRhythm`);
+#: the first trial aims SNAP_MARGIN resolution steps short of it, then the branch is crept
+#: one resolution step at a time (each the decision of a fold, whole budget: 1-2 iterations
+#: while the branch continues) until SNAP_CREEP steps past it, where the doubling resumes.
+#: Measured on the sigma = 0.489 nm, p/psat 0.15 slider's retract (532 nodes, the grid step
+#: 1.2 -> 1.4 nm, validation/results/snap_cost.md): 85 nodes released at folds 28, 28, 26, 25,
+#: 23, ... 3, 2, 1 resolution steps apart, each found by doubling and bisection in ~10 solves
+SNAP_RHYTHM = True
+SNAP_MARGIN, SNAP_CREEP = 2, 4
+#: ... only while the snaps are at most this many resolution steps apart (a rhythm, not two
+#: snaps far apart on the branch)
+SNAP_RHYTHM_MAX = 128
+#: a single node's snap landed first by the corrector from the disk moved by a node or two
+#: (:func:`femadh.contact.landing.land_next_node`), the energy descent only where that fails
+#: or is not plainly the descent's landing
+NEXT_NODE_LANDING = True
+
+
+class _SnapRhythm:
+    """Where the next lattice snap of a contact unzipping node by node is expected.
+
+    Records the last two lattice-snap folds (the last stable separations before them, m);
+    their distance s (in resolution steps) predicts the next fold at F + s past the last one
+    F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
+    SNAP_MARGIN steps short of it, then one resolution step at a time up to SNAP_CREEP steps
+    past it (the fold is then located by a decision solve one step past its last stable
+    lattice point - the same point the doubling and bisection find on a connected branch
+    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback."""
+
+    def __init__(self):
+        self.clear()
+
+    def clear(self):
+        self.folds, self.target, self.creep_to = [], None, None
+
+    def snapped(self, d_fold, min_step, direction):
+        """A lattice snap whose departing branch was last stable at ``d_fold`` (m)."""
+        self.folds = (self.folds + [d_fold])[-2:]
+        self.target = self.creep_to = None
+        if len(self.folds) < 2:
+            return
+        s = int(round((self.folds[1] - self.folds[0]) * direction / min_step))
+        if 1 <= s <= SNAP_RHYTHM_MAX:
+            self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step
+            self.creep_to = d_fold + direction * (s + SNAP_CREEP) * min_step
+
+    def aim(self, d, d_try, min_step, direction):
+        """The trial separation from the state at ``d`` instead of ``d_try`` (m): the
+        expected fold's lattice point short of it, the next resolution step while creeping
+        past it, else ``d_try`` (the rhythm is then forgotten)."""
+        if self.target is None:
+            return d_try
+        ahead = int(round((self.target - d) * direction / min_step))
+        if ahead >= 1:
+            # straight to the lattice point short of the expected fold (the step after a
+            # landing would be the smallest, doubled from there)
+            return d + direction * ahead * min_step
+        if (self.creep_to - d) * direction > 0.5 * min_step:
+            return d + direction * min_step
+        self.target = self.creep_to = None
+        return d_try
+
+
 def _tangent(problem, state):
     """dw/dd (m/m) of ``state`` with its active set frozen, or None without a factorisation
     (the predictor then takes the state itself); computed once per state, not per trial."""
@@ -513,6 +577,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
     t_state = _tangent(problem, state)
+    rhythm = _SnapRhythm()
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -553,6 +618,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             solves_here += 1
             if fold.far is None or halving:
                 d_try = state.d + step
+                if SNAP_RHYTHM and not halving:
+                    d_try = rhythm.aim(state.d, d_try, min_step, math.copysign(1.0, grid_step))
                 if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
                         abs(d_next - d_try) < 0.5 * min_step:
                     d_try = d_next
@@ -657,8 +724,22 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                         continue
                 d_try = fold.far
             # Fold: no stable state continues the branch beyond state.d.
-            landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
-            sweep.n_solves += 1
+            landed = None
+            if NEXT_NODE_LANDING and not halving:
+                # a node snapping across the lattice: the corrector from the disk a node or
+                # two further (the way the edge goes: it recedes on a retract), used only if
+                # it is plainly the descent's landing and a lattice snap
+                near = land_next_node(problem, d_try, state,
+                                      -1 if grid_step > 0 else 1, tol=tol)
+                sweep.n_solves += 1
+                if near is not None and lattice_snap(problem, state, near, g_state,
+                                                     total_force(problem, near)):
+                    landed = near
+                    sweep.work["next_node_landings"] = \
+                        sweep.work.get("next_node_landings", 0) + 1
+            if landed is None:
+                landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
+                sweep.n_solves += 1
             if not (landed.converged and landed.stable) and beyond is not None:
                 # the descent stalled (a steep law's landing polished onto a saddle); the
                 # corrector already found the branch beyond the fold: start Newton there
@@ -673,6 +754,7 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # step was passed on yet: no jump, no state)
                 sweep.work["fold_fallbacks"] = sweep.work.get("fold_fallbacks", 0) + 1
                 halving, beyond = True, None
+                rhythm.clear()
                 state, g_state, t_state = start_here
                 fold.restart(state, t_state, problem)
                 step = grid_step
@@ -684,10 +766,12 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 step = math.copysign(min_step, grid_step)
             if lattice_snap(problem, state, landed, g_state, g_landed):
                 sweep.work["lattice_snaps"] = sweep.work.get("lattice_snaps", 0) + 1
+                rhythm.snapped(state.d, min_step, math.copysign(1.0, grid_step))
                 state, g_state, beyond = landed, g_landed, None
                 t_state = _tangent(problem, state)
                 fold.restart(state, t_state, problem)
                 continue
+            rhythm.clear()
             sweep.jumps.append(Jump(branch, state.d, d_try, abs(d_try - state.d), state, landed))
             if on_jump:
                 on_jump(sweep.jumps[-1])
