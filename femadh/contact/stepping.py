@@ -365,8 +365,9 @@ class _Bracket:
         return a + self.dir * (n // 2) * h
 
 
-#: a contact unzipping node by node (issue 21): after two lattice snaps the next one is
-#: expected as far past the last as the last was past the one before (:class:`_SnapRhythm`);
+#: a contact unzipping node by node (issue 21): after three lattice snaps in a rhythm the next
+#: one is expected as far past the last as the last was past the one before
+#: (:class:`_SnapRhythm`);
 #: the first trial aims SNAP_MARGIN resolution steps short of it, then the branch is crept
 #: one resolution step at a time (each the decision of a fold, whole budget: 1-2 iterations
 #: while the branch continues) until SNAP_CREEP steps past it, where the doubling resumes.
@@ -387,9 +388,11 @@ NEXT_NODE_LANDING = True
 class _SnapRhythm:
     """Where the next lattice snap of a contact unzipping node by node is expected.
 
-    Records the last two lattice-snap folds (the last stable separations before them, m);
-    their distance s (in resolution steps) predicts the next fold at F + s past the last one
-    F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
+    Records the last three lattice-snap folds (the last stable separations before them, m);
+    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm:
+    on the Fig 4 disk at 100 nodes three snaps 2-3x apart in spacing are none, and aiming at
+    them cost 9 more fold solves), the last distance s predicts the next fold at F + s past
+    the last one F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
     SNAP_MARGIN steps short of it, then one resolution step at a time up to SNAP_CREEP steps
     past it (the fold is then located by a decision solve one step past its last stable
     lattice point - the same point the doubling and bisection find on a connected branch
@@ -403,12 +406,13 @@ class _SnapRhythm:
 
     def snapped(self, d_fold, min_step, direction):
         """A lattice snap whose departing branch was last stable at ``d_fold`` (m)."""
-        self.folds = (self.folds + [d_fold])[-2:]
+        self.folds = (self.folds + [d_fold])[-3:]
         self.target = self.creep_to = None
-        if len(self.folds) < 2:
+        if len(self.folds) < 3:
             return
-        s = int(round((self.folds[1] - self.folds[0]) * direction / min_step))
-        if 1 <= s <= SNAP_RHYTHM_MAX:
+        s0, s = (int(round((b - a) * direction / min_step))
+                 for a, b in zip(self.folds, self.folds[1:]))
+        if 1 <= s <= SNAP_RHYTHM_MAX and 0.5 * s0 <= s <= 2 * s0:
             self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step
             self.creep_to = d_fold + direction * (s + SNAP_CREEP) * min_step
 
