@@ -1413,6 +1413,16 @@ DEFECTS = [
       "(a fold located to two steps)", "femadh/contact/stepping.py",
       (("            return d + direction * min_step\n",
         "            return d + direction * 2 * min_step\n"),)),
+    D("snap_cycle_any_residual", "stepping: a decision whose residual falls by orders of "
+      "magnitude taken for a cycle", "femadh/contact/stepping.py",
+      (("CYCLE_RTOL = 1e-3", "CYCLE_RTOL = 1.0"),)),
+    D("snap_cycle_nodes_ignored", "stepping: the cycle told by the residuals alone",
+      "femadh/contact/stepping.py",
+      (("    return all(last[i][1] == last[i + CYCLE_PERIOD][1]\n               and abs(",
+        "    return all(True\n               and abs("),)),
+    D("snap_decision_cut_always", "stepping: every unconverged decision probe taken as the "
+      "decision", "femadh/contact/stepping.py",
+      (("    if _cycling(probe[\"history\"]):", "    if True:"),)),
 ]
 
 

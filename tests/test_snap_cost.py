@@ -116,12 +116,14 @@ def test_the_snap_rhythm_aims_at_the_next_fold():
 
 
 def test_the_unzipping_folds_and_states_are_those_of_the_old_path(unzip, monkeypatch):
-    """With the rhythm and the next-node landing off (the path before them): the same folds
+    """With the rhythm, the next-node landing and the decision's cycle probe off (the path
+    before them): the same folds
     at the same lattice points (to the round-off of d, 1e-6 of a resolution step), the same
     grid states to the tolerance."""
     p, ap, re, _ = unzip
     monkeypatch.setattr(stepping, "SNAP_RHYTHM", False)
     monkeypatch.setattr(stepping, "NEXT_NODE_LANDING", False)
+    monkeypatch.setattr(stepping, "CYCLE_PROBE_ITER", 0)
     ap0, re0 = fig4_sweeps(p)
     for new, old in ((ap, ap0), (re, re0)):
         assert [round(j.d_fold / H, 6) for j in new.jumps] == \
@@ -187,3 +189,51 @@ def test_every_next_node_landing_taken_is_a_lattice_snap(monkeypatch):
     ap, re = fig4_sweeps(p)
     assert len(re.jumps) == 1 and not re.jumps[0].after.active.any()
     assert re.work["next_node_landings"] == re.work["lattice_snaps"] == 3
+
+
+#: a decision's corrector history on the sigma = 0.489 nm slider's retract (532 nodes, the
+#: micro-fold at 1.2884 nm; validation/results/snap_cost.md): (residual (m), contact nodes,
+#: set unchanged) per iteration - the disk of 73 and 72 nodes in turn from the second
+#: iteration on, each residual repeating to 6e-6 relative from the third
+CYCLE = [(2.6511e-21, 73, False), (1.3992e-15, 72, False), (1.5452737311835257e-15, 73, False),
+         (1.3988823954798885e-15, 72, False), (1.5452641917231115e-15, 73, False),
+         (1.3988824008565625e-15, 72, False), (1.5452641915163163e-15, 73, False),
+         (1.3988823985818158e-15, 72, False)]
+
+
+def test_a_corrector_going_round_a_cycle_of_contact_sets_is_told():
+    """The measured cycle is one; a corrector whose residual falls by orders of magnitude
+    while its set still changes is not (a Newton converging as the edge settles), nor one
+    whose set stood still at an iteration, nor one alternating between other node counts
+    at the same residuals, nor fewer than three rounds."""
+    assert stepping._cycling(CYCLE)
+    falling = [(10.0 ** -(10 + 2 * k), 72 + k % 2, False) for k in range(8)]
+    assert not stepping._cycling(falling)
+    assert not stepping._cycling(CYCLE[:-1] + [(CYCLE[-1][0], 72, True)])
+    assert not stepping._cycling(CYCLE[:-1] + [(CYCLE[-1][0], 71, False)])
+    assert not stepping._cycling(CYCLE[3:])
+
+
+def test_a_decision_not_cut_short_is_the_whole_budgets_solve():
+    """Where the probe neither converges nor cycles (the Fig 4 jump-in's decision one
+    resolution step past its fold: 40 iterations without converging, tests/test_newton.py)
+    and where it converges (a step on the branch), the decision returns the very state the
+    whole budget gives - to the last bit - and counts the work of both attempts."""
+    p = fig4_problem(100)
+    ap, _ = fig4_sweeps(p)
+    j = ap.jumps[0]
+    seen = []
+    for before, d in ((j.before, j.d_land), (ap.states[-1], ap.states[-1].d - 0.05e-9)):
+        w, act = stepping._predict(p, before, d)
+        full = stepping.solve_complementarity(p, d, w, tol=TOL, max_iter=40, active0=act,
+                                              factor=before.lu)
+        work = {}
+        got = stepping._decide(p, d, w, TOL, 40, act, before.lu, work)
+        assert got.converged == full.converged and got.n_iter == full.n_iter
+        assert np.array_equal(got.w, full.w) and np.array_equal(got.active, full.active)
+        probe = min(stepping.CYCLE_PROBE_ITER, full.n_iter)
+        assert work["iterations"] == full.n_iter + (0 if full.converged else probe)
+        assert "decisions_cycling" not in work
+        seen.append((full.converged, full.n_iter))
+    assert seen[0] == (False, 40)
+    assert seen[1][0] and seen[1][1] <= stepping.CYCLE_PROBE_ITER

@@ -69,7 +69,9 @@ class Counter:
 class Compare:
     """Runs the energy-descent landing next to every landing the corrector found from the
     disk a node or two further (:func:`landing.land_next_node`) and records how far apart
-    they are: (d, contact nodes of each, max |w_next - w_descent| (m), energies (J))."""
+    they are: (d, contact nodes of each, max |w_next - w_descent| (m), energies (J)); and
+    the whole-budget corrector next to every fold decision cut short in a cycle
+    (:func:`stepping._decide`): (d, converged, iterations)."""
 
     def __init__(self):
         self.rows = []
@@ -88,10 +90,26 @@ class Compare:
             return st
 
         stepping.land_next_node = compared
+        decide = self._decide = stepping._decide
+
+        def checked(problem, d, w_pred, tol, budget, act, factor, work):
+            n0 = work.get("decisions_cycling", 0)
+            new = decide(problem, d, w_pred, tol, budget, act, factor, work)
+            if work.get("decisions_cycling", 0) > n0:
+                # a decision cut short in a cycle: the whole budget must fail as well
+                full = complementarity.solve_complementarity(
+                    problem, d, w_pred, tol=tol, max_iter=budget, active0=act,
+                    factor=factor)
+                self.cycles.append((d, full.converged, full.n_iter))
+            return new
+
+        self.cycles = []
+        stepping._decide = checked
         return self
 
     def __exit__(self, *exc):
         stepping.land_next_node = self._orig
+        stepping._decide = self._decide
 
 
 def first_trial_problem(sigma="0.488888888889 nm", rel=0.15, start="4 nm"):
@@ -139,18 +157,21 @@ def main():
     ap.add_argument("--sigma", default="0.488888888889 nm")
     ap.add_argument("--off", action="store_true",
                     help="the path before issue 21's snap work (SNAP_RHYTHM, "
-                    "NEXT_NODE_LANDING off)")
+                    "NEXT_NODE_LANDING, CYCLE_PROBE_ITER off)")
     ap.add_argument("--compare", action="store_true",
                     help="run the descent landing next to every next-node landing")
     args = ap.parse_args()
     if args.off:
         stepping.SNAP_RHYTHM = stepping.NEXT_NODE_LANDING = False
+        stepping.CYCLE_PROBE_ITER = 0
     print("load:", os.getloadavg())
     scene, problem = first_trial_problem(args.sigma, args.rel)
     print(f"nodes {problem.grid.n}")
     if args.compare:
         with Compare() as cmp:
             rows, states = sweep(scene, problem)
+        print(f"decisions cut short in a cycle: {len(cmp.cycles)}; the whole budget "
+              f"converged at {sum(c[1] for c in cmp.cycles)} of them")
         for r in cmp.rows:
             print(f"compare d {r[0] * 1e9:.6f} nm: nodes {r[1]} vs descent {r[2]}, "
                   f"max|dw| {r[3]:.3g} m, descent ok {r[4]}, E {r[5]:.12e} vs {r[6]:.12e}")

@@ -433,6 +433,65 @@ class _SnapRhythm:
         return d_try
 
 
+#: a fold's decision solve (the smallest step, whole budget) is first run for this many
+#: corrector iterations; one that has not converged by then and whose last iterations go
+#: round a cycle of contact sets (:func:`_cycling`) is decided there as turned down (else the
+#: whole budget from the start: the same solve as without the probe). Measured on the
+#: sigma = 0.489 nm slider's retract (validation/results/snap_cost.md): every decision that
+#: turned a micro-fold down alternated between the disk of m and of m - 1 nodes from its
+#: second iteration to its 40th (the edge node tensile on m, below sigma on m - 1), the
+#: residual of each set repeating to 6e-6 relative or closer from the third iteration on (to
+#: the last bit in some); the whole budget run beside every decision cut short converged at none
+#: (snap_cost.md). Only after a lattice snap since the last jump (a contact unzipping):
+#: elsewhere a turned-down decision (a jump-in, a pull-off) runs its whole budget without
+#: a cycle and the probe's iterations would be spent again. 0: no probe
+CYCLE_PROBE_ITER = 8
+#: ... the cycle's length in iterations (a node in and out of the contact)
+CYCLE_PERIOD = 2
+#: ... and how closely the residual of an iteration must repeat the one CYCLE_PERIOD before
+#: it (relative; measured 6e-6 at most on the cycles above, 4e-9 to 1e-7 on most, while a
+#: corrector on its way to converge cuts its residual by orders of magnitude per iteration)
+CYCLE_RTOL = 1e-3
+
+
+def _decide(problem, d, w_pred, tol, budget, act, factor, work):
+    """The decision solve at the smallest step: the corrector with the whole ``budget``,
+    cut short after CYCLE_PROBE_ITER iterations where it cycles (:func:`_cycling`); the
+    work of both attempts is added to ``work``."""
+    probe = {"history": []}
+    new = solve_complementarity(problem, d, w_pred, tol=tol,
+                                max_iter=min(budget, CYCLE_PROBE_ITER), active0=act,
+                                factor=factor, stall_iter=None, stats=probe)
+    for key in ("solves", "iterations", "factorisations", "stagnated"):
+        work[key] = work.get(key, 0) + probe.get(key, 0)
+    if new.converged or budget <= CYCLE_PROBE_ITER:
+        return new      # the very solve the whole budget runs (nothing else depends on it)
+    if _cycling(probe["history"]):
+        work["decisions_cycling"] = work.get("decisions_cycling", 0) + 1
+        return new
+    return solve_complementarity(problem, d, w_pred, tol=tol, max_iter=budget, active0=act,
+                                 factor=factor, stall_iter=None, stats=work)
+
+
+def _cycling(history):
+    """True if the corrector's last 3 CYCLE_PERIOD iterations go round one cycle three
+    times: each with the contact nodes and, to CYCLE_RTOL, the residual of the iteration
+    CYCLE_PERIOD before it, the contact set changing at every one of them - a node let go
+    and taken back, its residual not falling (the first two iterations, from the
+    prediction, are not on the cycle: CYCLE_PROBE_ITER = 8 sees it three times).
+    ``history``: (residual (m), contact nodes, set unchanged) per iteration
+    (:func:`solve_complementarity`'s stats)."""
+    n = 2 * CYCLE_PERIOD
+    if len(history) < n + CYCLE_PERIOD:
+        return False
+    last = history[-n - CYCLE_PERIOD:]
+    if any(same for _, _, same in last):
+        return False
+    return all(last[i][1] == last[i + CYCLE_PERIOD][1]
+               and abs(last[i][0] - last[i + CYCLE_PERIOD][0]) <= CYCLE_RTOL * last[i][0]
+               for i in range(n))
+
+
 def _tangent(problem, state):
     """dw/dd (m/m) of ``state`` with its active set frozen, or None without a factorisation
     (the predictor then takes the state itself); computed once per state, not per trial."""
@@ -656,9 +715,14 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 stall = None if smallest or trapped else STALL_ITER
                 budget = max_iter if smallest or trapped or TRIAL_MAX_ITER is None \
                     else min(max_iter, TRIAL_MAX_ITER)
-                new = solve_complementarity(problem, d_try, w_pred, tol=tol,
-                                            max_iter=budget, active0=act, factor=state.lu,
-                                            stall_iter=stall, stats=sweep.work)
+                if smallest and not trapped and CYCLE_PROBE_ITER and rhythm.folds:
+                    new = _decide(problem, d_try, w_pred, tol, budget, act, state.lu,
+                                  sweep.work)
+                else:
+                    new = solve_complementarity(problem, d_try, w_pred, tol=tol,
+                                                max_iter=budget, active0=act,
+                                                factor=state.lu, stall_iter=stall,
+                                                stats=sweep.work)
                 sweep.n_solves += 1
                 if edge and not _accept(new, w_pred, d_try, problem, act):
                     # the extrapolated edge did not lead to an acceptable state: the step is
