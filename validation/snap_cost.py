@@ -35,9 +35,12 @@ class Counter:
 
         def counted_solve(*a, **k):
             stats = k.pop("stats", None)
-            own = {}
+            # (a caller's iteration history, which the fold decision reads, is kept)
+            own = {"history": stats["history"]} if stats and "history" in stats else {}
             st = solve(*a, stats=own, **k)
             for key, v in own.items():
+                if key == "history":
+                    continue
                 self.work[key] = self.work.get(key, 0) + v
                 if stats is not None:
                     stats[key] = stats.get(key, 0) + v
@@ -134,18 +137,19 @@ def first_trial_problem(sigma="0.488888888889 nm", rel=0.15, start="4 nm"):
 
 def sweep(scene, problem, window=None):
     """Trace the scene's branches; per branch (solves, iterations, factorisations, landings,
-    landing wall, sweep wall, jumps, lattice snaps) and the states' (d, contact nodes)."""
+    landing wall, sweep wall, jumps, lattice snaps, the sweep's work dict, sweep cpu) and
+    the states' (d, contact nodes, w)."""
     from femadh.runner.tracing import branch_plan
 
     rows, start, states = {}, None, {}
     for branch, d_vals in branch_plan(scene):
         with Counter() as c:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             sw = stepping.trace_steps(problem, d_vals, branch=branch, tol=scene.tolerance,
                                       start=start, max_iter=scene.max_iter)
-            wall = time.perf_counter() - t0
+            wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         rows[branch] = c.row() + (wall, len(sw.jumps), sw.work.get("lattice_snaps", 0),
-                                  dict(sw.work))
+                                  dict(sw.work), cpu)
         states[branch] = [(s.d, int(s.active.sum()), s.w) for s in sw.states]
         start = sw.states[-1]
     return rows, states
@@ -179,7 +183,7 @@ def main():
         rows, states = sweep(scene, problem)
     for b, r in rows.items():
         print(f"{b}: solves {r[0]} iterations {r[1]} factorisations {r[2]} landings {r[3]} "
-              f"({r[4]:.1f} s) wall {r[5]:.1f} s jumps {r[6]} snaps {r[7]}")
+              f"({r[4]:.1f} s) wall {r[5]:.1f} s cpu {r[9]:.1f} s jumps {r[6]} snaps {r[7]}")
         print("   work", r[8])
     for b, s in states.items():
         print(b, [(round(d * 1e9, 3), m) for d, m, _ in s])
