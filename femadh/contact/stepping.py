@@ -39,6 +39,15 @@ The same balance sorts the landings at the smallest step: one that releases less
 step's work is a node snapping across the lattice (:func:`lattice_snap`), stepped over; a
 contact's snap (jump-in, pull-off) releases ~150x it and is a jump. A trial step's corrector
 gives up when it stagnates (the smallest step's, which decides a fold, has its whole budget).
+
+A contact unzipping node by node near a pull-off (issue 21) makes a micro-fold of every node
+it releases. Three things keep that cheap without moving a fold or a state
+(validation/results/snap_cost.md): a single node's snap is landed first by the corrector
+from the disk a node or two further (:func:`femadh.contact.landing.land_next_node`, taken
+only where it is plainly the descent's landing and a lattice snap); after a lattice snap a
+fold's decision that goes round a cycle of contact sets (m <-> m - 1) is turned down after
+CYCLE_PROBE_ITER iterations, not the whole budget (:func:`_decide`); and after three snaps
+in a rhythm the next is expected one spacing past the last (:class:`_SnapRhythm`).
 """
 from dataclasses import dataclass, field
 import math
