@@ -5,10 +5,11 @@ factorisations, landings and wall of the sweep (issue 21; validation/results/sna
 point's first trial (the 2-mm slider + meniscus, validation/scenes/paper1_slider_meniscus.toml
 from 4 nm, the adaptive loop's first member, 532 nodes) and runs its sweep without the error
 estimate, counting the work of the corrector (every :func:`solve_complementarity`) and of the
-landings (:func:`femadh.contact.landing.land`), per branch and in the retract's grid step
-1.2 -> 1.4 nm where the contact unzips. ``--small`` runs the suite's small case instead
-(tests/test_snap_cost.py). A few minutes on a quiet machine; the counts are exact, the times
-depend on the load (printed).
+landings (:func:`femadh.contact.landing.land`), per branch; the retract unzips 85 nodes in its
+grid step 1.2 -> 1.4 nm. ``--off``: the path before issue 21's snap work;
+``--compare``: the descent's landing beside every next-node landing and the whole budget
+beside every decision cut short. A minute or two on a quiet machine; the counts are exact,
+the times depend on the load (printed).
 """
 import argparse
 import os
