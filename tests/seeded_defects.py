@@ -1465,6 +1465,52 @@ DEFECTS = [
       "refresh's own block", "femadh/contact/complementarity.py",
       (("refutes=lambda k: refuted_positive_definite(problem, D, n - k))",
         "refutes=lambda k: refuted_positive_definite(problem, D, m))"),)),
+    # -- stepping/landing: a contact unzipping node by node (issue 21, test_snap_cost.py)
+    D("snap_next_no_lattice_check", "stepping: a next-node landing taken without the "
+      "lattice-snap test (a contact's snap landed by the corrector)",
+      "femadh/contact/stepping.py",
+      (("if near is not None and lattice_snap(problem, state, near, g_state,\n"
+        "                                                     total_force(problem, near)):",
+        "if near is not None:"),)),
+    D("snap_next_shift_sign", "stepping: the next-node landing's disk moved against the edge "
+      "(grown on a retract)", "femadh/contact/stepping.py",
+      (("-1 if grid_step > 0 else 1, tol=tol)", "1 if grid_step > 0 else -1, tol=tol)"),)),
+    D("snap_next_unstable", "landing: a next-node candidate taken without its stability",
+      "femadh/contact/landing.py",
+      (("if not (st.stable and m_new is not None", "if not (m_new is not None"),)),
+    D("snap_next_edge_either_way", "landing: a next-node candidate whose edge kept its place "
+      "or moved against the edge's way taken", "femadh/contact/landing.py",
+      (("1 <= (m_new - m) * sign <= 2", "-2 <= (m_new - m) * sign <= 2"),)),
+    D("snap_next_no_downhill", "landing: a next-node candidate taken without the downhill "
+      "test (its energy may lie above the descent's start)", "femadh/contact/landing.py",
+      (("if not _downhill(problem, d, start, e_start, st.w):",
+        "if False and not _downhill(problem, d, start, e_start, st.w):"),)),
+    D("snap_downhill_loose", "landing: the downhill test lets the energy rise by its own size",
+      "femadh/contact/landing.py",
+      (("if not np.isfinite(e) or e > e_prev + noise:",
+        "if not np.isfinite(e) or e > e_prev + abs(e_prev) + noise:"),)),
+    D("snap_rhythm_past", "stepping: the rhythm's first trial aimed past the expected fold",
+      "femadh/contact/stepping.py",
+      (("self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step",
+        "self.target = d_fold + direction * (s + SNAP_MARGIN) * min_step"),)),
+    D("snap_rhythm_any_spacing", "stepping: any three snaps taken for a rhythm",
+      "femadh/contact/stepping.py",
+      (("if 1 <= s <= SNAP_RHYTHM_MAX and 0.5 * s0 <= s <= 2 * s0:",
+        "if 1 <= s <= SNAP_RHYTHM_MAX:"),)),
+    D("snap_rhythm_creep_two", "stepping: the rhythm creeps two resolution steps at a time "
+      "(a fold located to two steps)", "femadh/contact/stepping.py",
+      (("            return d + direction * min_step\n",
+        "            return d + direction * 2 * min_step\n"),)),
+    D("snap_cycle_any_residual", "stepping: a decision whose residual falls by orders of "
+      "magnitude taken for a cycle", "femadh/contact/stepping.py",
+      (("CYCLE_RTOL = 1e-3", "CYCLE_RTOL = 1.0"),)),
+    D("snap_cycle_nodes_ignored", "stepping: the cycle told by the residuals alone",
+      "femadh/contact/stepping.py",
+      (("    return all(last[i][1] == last[i + CYCLE_PERIOD][1]\n               and abs(",
+        "    return all(True\n               and abs("),)),
+    D("snap_decision_cut_always", "stepping: every unconverged decision probe taken as the "
+      "decision", "femadh/contact/stepping.py",
+      (("    if _cycling(probe[\"history\"]):", "    if True:"),)),
 ]
 
 

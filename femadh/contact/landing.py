@@ -4,7 +4,7 @@ import numpy as np
 from scipy import linalg as sla
 
 from ..interrupt import check as safe_point
-from .complementarity import MAX_GAP_CLOSURE, solve_complementarity
+from .complementarity import MAX_GAP_CLOSURE, STALL_ITER, solve_complementarity
 from .subgrid import add_jacobian
 
 #: descent steps in a row that lower the energy by no more than its round-off after which the
@@ -32,6 +32,20 @@ RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
 #: past that ghost for its 400 steps (residual ~1e-15 m); from 151 nodes Newton converged in
 #: 6 iterations on a stable state
 EDGE_SHIFTS = (1, -1, 2, -2)
+#: a single node's snap (a contact unzipping node by node, issue 21) landed first by the
+#: corrector from the last state's surface with its contact disk moved by this many nodes the
+#: way the edge goes (:func:`land_next_node`), before the energy descent. Measured on the
+#: sigma = 0.3 nm slider's flat retract (issue 21, sigma03_follow.md): from the disk two nodes
+#: smaller Newton reached the descent's own landing in 5-8 iterations at 7 of 9 micro-folds
+#: whose descent and relaxation took 8.7-18 s, from one node smaller it ran to its budget;
+#: on the sigma = 0.489 nm slider (validation/results/snap_cost.md) two nodes smaller
+#: converged in 5-6 iterations (re-adding one), one smaller stalled after 9
+NEXT_NODE_SHIFTS = (2, 1)
+#: corrector iterations each of those starts may take (the converged ones took 2-8)
+NEXT_NODE_ITER = 12
+#: points of the straight path from the descent's start to a candidate landing at which the
+#: energy must fall monotonically (no barrier: the descent's surface can slide there)
+PATH_SAMPLES = 16
 
 
 def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
@@ -198,6 +212,69 @@ def _next_edges(problem, d, w, active, *, tol, max_iter):
             if e < e_best:
                 best, e_best = st, e
     return best
+
+
+def land_next_node(problem, d, state, sign, *, tol):
+    """The landing of a single node's snap at separation d (m) found by the corrector alone,
+    or None (then the energy descent, :func:`land`, decides).
+
+    ``state`` is the last stable state before the fold (its contact set a disk); ``sign`` is
+    +1 where the contact edge advances (nodes join), -1 where it recedes. For k in
+    NEXT_NODE_SHIFTS the corrector starts from ``state.w`` with the disk moved by k nodes that
+    way (NEXT_NODE_ITER iterations, stagnation exit); the first converged state is the
+    candidate. It is taken only if it is the descent's landing as far as a cheap test can
+    tell: stable (the Hessian's inertia on its free nodes, like every state), its contact set
+    a disk whose edge moved by 1 or 2 nodes the way the edge goes, its total energy no
+    higher than at the descent's start (``state.w`` at d, projected onto the floor h >= sigma:
+    the descent never climbs), and that energy falling monotonically along the straight path
+    from the start to it at PATH_SAMPLES points (no barrier between them that would send the
+    descent into another basin). The caller still classifies it as a lattice snap (the energy
+    it released, :func:`femadh.contact.stepping.lattice_snap`) before it is used."""
+    from .linalg import disk_size
+
+    if problem.sigma is None or not np.any(state.active):
+        return None
+    m = disk_size(state.active)
+    if m is None:
+        return None
+    b, n = problem.contour(d), state.w.size
+    start = np.minimum(state.w, b - problem.sigma)
+    e_start = problem.energy(start, d)
+    for k in NEXT_NODE_SHIFTS:
+        mk = m + sign * k
+        if not 0 < mk < n:
+            continue
+        A = np.zeros(n, bool)
+        A[:mk] = True
+        w0 = np.array(state.w, float)
+        w0[A] = b[A] - problem.sigma
+        st = solve_complementarity(problem, d, w0, tol=tol, max_iter=NEXT_NODE_ITER,
+                                   active0=A, stall_iter=STALL_ITER)
+        if not st.converged:
+            continue
+        m_new = disk_size(st.active)
+        if not (st.stable and m_new is not None and 1 <= (m_new - m) * sign <= 2):
+            return None
+        if not _downhill(problem, d, start, e_start, st.w):
+            return None
+        return st
+    return None
+
+
+def _downhill(problem, d, start, e_start, w_end):
+    """True if the total energy falls monotonically (beyond its round-off) from ``start``
+    (energy ``e_start``, J) to ``w_end`` along the straight path between them, sampled at
+    PATH_SAMPLES points."""
+    e_prev = e_start
+    for t in np.linspace(0.0, 1.0, PATH_SAMPLES + 1)[1:]:
+        w = start + t * (w_end - start)
+        e = problem.energy(w, d)
+        elastic = 0.5 * w @ (problem.S_sym @ w)
+        noise = ROUNDOFF_ULPS * np.finfo(float).eps * (abs(elastic) + abs(e - elastic))
+        if not np.isfinite(e) or e > e_prev + noise:
+            return False
+        e_prev = e
+    return True
 
 
 def _relax(problem, d, w, active, *, tol, max_steps=None):
