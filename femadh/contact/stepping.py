@@ -425,6 +425,11 @@ class _SnapRhythm:
             self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step
             self.creep_to = d_fold + direction * (s + SNAP_CREEP) * min_step
 
+    def forget_aim(self):
+        """The aimed trial was turned down as too far for the predictor: no aim until the
+        next snap (the halving takes over; the snaps seen are kept)."""
+        self.target = self.creep_to = None
+
     def aim(self, d, d_try, min_step, direction):
         """The trial separation from the state at ``d`` instead of ``d_try`` (m): the
         expected fold's lattice point short of it, the next resolution step while creeping
@@ -461,6 +466,41 @@ CYCLE_PERIOD = 2
 #: it (relative; measured 6e-6 at most on the cycles above, 4e-9 to 1e-7 on most, while a
 #: corrector on its way to converge cuts its residual by orders of magnitude per iteration)
 CYCLE_RTOL = 1e-3
+
+
+#: a single node's snap landed by the corrector (:func:`land_next_node`) is kept only where the
+#: branch goes on from it for this many resolution steps (each a stable state accepted as a
+#: healthy smallest step); else the energy descent lands it. The descent can leave the
+#: contact from the same start (a pull-off) where the corrector found a stable state one
+#: node in, downhill of the start and a lattice snap by its energy - a metastable state
+#: beside its own fold. Measured on the Fig 4 disk (tests/test_snap_cost.py): at 110, 200
+#: and 270 nodes the candidate's branch ended at the very next resolution step (the fold
+#: moved by one step, F_ex before it by up to 5.4 %); on 50..400 nodes every candidate
+#: that held for 2 steps was the descent's landing
+NEXT_NODE_HOLD_STEPS = 2
+
+
+def _next_node_holds(problem, landed, d_land, min_step, direction, tol, max_iter, work):
+    """True if the branch continues from the next-node landing ``landed`` (at ``d_land``, m)
+    for NEXT_NODE_HOLD_STEPS resolution steps ``min_step`` (m) in ``direction``: each a
+    converged stable state close to its prediction that releases no more than the lattice
+    bound (the test of a healthy smallest step). Its solves are added to ``work``; none of
+    their states is kept (the sweep goes on from ``landed`` as before)."""
+    st, g = landed, total_force(problem, landed)
+    t = _tangent(problem, st)
+    for k in range(1, NEXT_NODE_HOLD_STEPS + 1):
+        d = d_land + direction * k * min_step
+        w_pred, act = _predict(problem, st, d, t)
+        new = solve_complementarity(problem, d, w_pred, tol=tol, max_iter=max_iter,
+                                    active0=act, factor=st.lu, stall_iter=STALL_ITER,
+                                    stats=work)
+        if not _accept(new, w_pred, d, problem, act):
+            return False
+        g_new = total_force(problem, new)
+        if crossed_fold(problem, st, new, g, g_new, FOLD_ENERGY_SHARE_MIN_STEP):
+            return False
+        st, g, t = new, g_new, _tangent(problem, new)
+    return True
 
 
 def _decide(problem, d, w_pred, tol, budget, act, factor, work):
@@ -688,10 +728,13 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 exc.sweep = sweep
                 raise exc
             solves_here += 1
+            aimed = False       # the trial is the rhythm's (:meth:`_SnapRhythm.aim`)
             if fold.far is None or halving:
                 d_try = state.d + step
                 if SNAP_RHYTHM and not halving:
+                    plain = d_try
                     d_try = rhythm.aim(state.d, d_try, min_step, math.copysign(1.0, grid_step))
+                    aimed = d_try != plain
                 if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
                         abs(d_next - d_try) < 0.5 * min_step:
                     d_try = d_next
@@ -791,6 +834,10 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                     continue
             else:
                 k = int(round(abs(d_try - state.d) / min_step))
+                if why == "rejected_predictor" and aimed:
+                    # the rhythm's trial was too far for the predictor: the halving below
+                    # must take over (the aim would repeat the same trial to the stall)
+                    rhythm.forget_aim()
                 if (why == "rejected_predictor" or edge) and k > 1:
                     # half the distance, in whole resolution steps (the trials' lattice)
                     step = math.copysign(max(1, k // 2) * min_step, grid_step)
@@ -805,15 +852,24 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             if NEXT_NODE_LANDING and not halving:
                 # a node snapping across the lattice: the corrector from the disk a node or
                 # two further (the way the edge goes: it recedes on a retract), used only if
-                # it is plainly the descent's landing and a lattice snap
+                # it is plainly the descent's landing, a lattice snap, and the branch goes
+                # on from it (:func:`_next_node_holds`: else it may be a metastable state
+                # one node in where the descent pulls off)
+                n0 = sweep.work.get("solves", 0)
                 near = land_next_node(problem, d_try, state,
-                                      -1 if grid_step > 0 else 1, tol=tol)
-                sweep.n_solves += 1
+                                      -1 if grid_step > 0 else 1, tol=tol, stats=sweep.work)
                 if near is not None and lattice_snap(problem, state, near, g_state,
                                                      total_force(problem, near)):
-                    landed = near
-                    sweep.work["next_node_landings"] = \
-                        sweep.work.get("next_node_landings", 0) + 1
+                    if _next_node_holds(problem, near, d_try, min_step,
+                                        math.copysign(1.0, grid_step), tol, max_iter,
+                                        sweep.work):
+                        landed = near
+                        sweep.work["next_node_landings"] = \
+                            sweep.work.get("next_node_landings", 0) + 1
+                    else:
+                        sweep.work["next_node_refused_short"] = \
+                            sweep.work.get("next_node_refused_short", 0) + 1
+                sweep.n_solves += sweep.work.get("solves", 0) - n0
             if landed is None:
                 landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
                 sweep.n_solves += 1
