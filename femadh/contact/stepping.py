@@ -41,10 +41,15 @@ contact's snap (jump-in, pull-off) releases ~150x it and is a jump. A trial step
 gives up when it stagnates (the smallest step's, which decides a fold, has its whole budget).
 
 A contact unzipping node by node near a pull-off (issue 21) makes a micro-fold of every node
-it releases. Three things keep that cheap without moving a fold or a state
-(validation/results/snap_cost.md): a single node's snap is landed first by the corrector
-from the disk a node or two further (:func:`femadh.contact.landing.land_next_node`, taken
-only where it is plainly the descent's landing and a lattice snap); after a lattice snap a
+it releases. Three things keep that cheap; measured on the Fig 4 disk at 50, 60, ..., 400
+nodes and on the 532-node slider (validation/results/snap_cost.md) they move no fold off
+its lattice point and no state's contact set, and the surfaces agree with the old path's to
+1e-18 m (the polishes stop at different iterates within the tolerance): a single node's
+snap is landed first by the corrector from the disk a node or two further
+(:func:`femadh.contact.landing.land_next_node`, taken only where it is plainly the
+descent's landing, a lattice snap, and the branch goes on from it for
+NEXT_NODE_HOLD_STEPS resolution steps: beside a pull-off the corrector can find a
+metastable state one node in where the descent leaves the contact); after a lattice snap a
 fold's decision that goes round a cycle of contact sets (m <-> m - 1) is turned down after
 CYCLE_PROBE_ITER iterations, not the whole budget (:func:`_decide`); and after three snaps
 in a rhythm the next is expected one spacing past the last (:class:`_SnapRhythm`).
@@ -398,14 +403,21 @@ class _SnapRhythm:
     """Where the next lattice snap of a contact unzipping node by node is expected.
 
     Records the last three lattice-snap folds (the last stable separations before them, m);
-    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm:
-    on the Fig 4 disk at 100 nodes three snaps 2-3x apart in spacing are none, and aiming at
-    them cost 9 more fold solves), the last distance s predicts the next fold at F + s past
+    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm;
+    measured on the Fig 4 disk at 90 nodes: snaps 261, 88, 59 and 31 steps apart, the
+    first pair 3x apart is none, the later ones are; at 100 nodes 58 and 36 steps apart,
+    a rhythm that aims at a fourth snap which does not come: the pull-off), the last
+    distance s predicts the next fold at F + s past
     the last one F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
     SNAP_MARGIN steps short of it, then one resolution step at a time up to SNAP_CREEP steps
     past it (the fold is then located by a decision solve one step past its last stable
     lattice point - the same point the doubling and bisection find on a connected branch
-    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback."""
+    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback; its aim
+    is dropped when the aimed trial is too far for the predictor (:meth:`forget_aim`). Not
+    kept beyond one trace (a checkpoint stores no rhythm): a resume, a regrid or a widening
+    starts without it, which moves only where trials go - the retract resumed from each
+    grid state reaches the same folds and states (tests/test_snap_cost.py), though not
+    always to the last bit (another path of trials)."""
 
     def __init__(self):
         self.clear()
@@ -456,9 +468,11 @@ class _SnapRhythm:
 #: second iteration to its 40th (the edge node tensile on m, below sigma on m - 1), the
 #: residual of each set repeating to 6e-6 relative or closer from the third iteration on (to
 #: the last bit in some); the whole budget run beside every decision cut short converged at none
-#: (snap_cost.md). Only after a lattice snap since the last jump (a contact unzipping):
-#: elsewhere a turned-down decision (a jump-in, a pull-off) runs its whole budget without
-#: a cycle and the probe's iterations would be spent again. 0: no probe
+#: (snap_cost.md). Only after a lattice snap since the last jump or fallback (a contact
+#: unzipping): a turned-down decision elsewhere (a jump-in, a pull-off with no snap before
+#: it) runs its whole budget without a cycle and the probe's iterations would be spent
+#: again. The pull-off that ends an unzipping is probed too, and pays them again (its
+#: decision does not cycle). 0: no probe
 CYCLE_PROBE_ITER = 8
 #: ... the cycle's length in iterations (a node in and out of the contact)
 CYCLE_PERIOD = 2
