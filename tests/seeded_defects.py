@@ -1474,8 +1474,8 @@ DEFECTS = [
         "if near is not None:"),)),
     D("snap_next_shift_sign", "stepping: the next-node landing's disk moved against the edge "
       "(grown on a retract)", "femadh/contact/stepping.py",
-      (("-1 if grid_step > 0 else 1, tol=tol, stats=sweep.work)",
-        "1 if grid_step > 0 else -1, tol=tol, stats=sweep.work)"),)),
+      (("-1 if grid_step > 0 else 1, tol=tol, stats=sweep.work,",
+        "1 if grid_step > 0 else -1, tol=tol, stats=sweep.work,"),)),
     D("snap_next_unstable", "landing: a next-node candidate taken without its stability",
       "femadh/contact/landing.py",
       (("if not (st.stable and m_new is not None", "if not (m_new is not None"),)),

@@ -30,8 +30,8 @@ def unzip():
     seen = []
     orig = stepping.land_next_node
 
-    def compared(problem, d, state, sign, *, tol, stats=None):
-        st = orig(problem, d, state, sign, tol=tol, stats=stats)
+    def compared(problem, d, state, sign, *, tol, **k):
+        st = orig(problem, d, state, sign, tol=tol, **k)
         ref = landing.land(problem, d, state.w, tol=tol, max_iter=40)
         seen.append((d, state, st, ref, sign))
         return st
@@ -326,8 +326,8 @@ def test_every_next_node_landing_taken_is_a_lattice_snap(monkeypatch):
     p = fig4_problem(100)
     orig = stepping.land_next_node
 
-    def pull_off_too(problem, d, state, sign, *, tol, stats=None):
-        st = orig(problem, d, state, sign, tol=tol, stats=stats)
+    def pull_off_too(problem, d, state, sign, *, tol, **k):
+        st = orig(problem, d, state, sign, tol=tol, **k)
         if st is None and state.active.any():
             st = landing.land(problem, d, state.w, tol=tol, max_iter=40)
         return st

@@ -871,7 +871,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 # one node in where the descent pulls off)
                 n0 = sweep.work.get("solves", 0)
                 near = land_next_node(problem, d_try, state,
-                                      -1 if grid_step > 0 else 1, tol=tol, stats=sweep.work)
+                                      -1 if grid_step > 0 else 1, tol=tol, stats=sweep.work,
+                                      stall_iter=STALL_ITER)
                 if near is not None and lattice_snap(problem, state, near, g_state,
                                                      total_force(problem, near)):
                     if _next_node_holds(problem, near, d_try, min_step,
