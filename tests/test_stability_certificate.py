@@ -375,3 +375,26 @@ def test_a_deferred_refresh_factorised_later_is_counted(fig4, monkeypatch):
         assert stats["factorisations"] == made["cholesky"] + made["lu"], (stats, made)
         cases += 1
     assert cases >= 5
+
+
+def test_the_certificate_build_holds_two_dense_arrays():
+    """The certificate keeps R^-1 and its cumulated squares (2 n^2 doubles) and its build
+    needs no more at its peak (femadh.scene.resources.GREEN_ARRAYS counts them): peak traced
+    memory of ElasticCertificate(sym(S)) on the Fig 4 problem's 600 nodes, in units of
+    8 n^2 bytes. Measured 2.000 (3.000 with a squared temporary and its cumulated copy);
+    the cumulated squares are np.cumsum(R^-1 * R^-1, axis=1) to the bit."""
+    import tracemalloc
+
+    p = fig4_problem(600)
+    n = p.grid.n
+    S = np.array(p.S_sym)
+    tracemalloc.start()
+    try:
+        cert = ElasticCertificate(S)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert cert.ok
+    assert peak / (8.0 * n * n) <= 2.01, peak / (8.0 * n * n)
+    assert np.array_equal(cert.q, np.cumsum(cert.rinv * cert.rinv, axis=1))
+    assert cert.q.flags.f_contiguous
