@@ -107,8 +107,8 @@ class TrailingCholesky:
             # :meth:`femadh.contact.stability.ElasticCertificate.refutes`): no block that
             # contains it is covered, and the factorisation is made only when a smaller block
             # is asked for - from the same arrays, so the same factor, bit for bit. Near a
-            # fold half the refreshes are such (109 of 219 on the Fig 4 scene at accuracy
-            # 1e-3); 33 of those are never asked for a smaller block, 76 are factorised
+            # fold half the refreshes are such (a whole Fig 4 run at accuracy 1e-3: 147 of
+            # 270); 53 of those are never asked for a smaller block, 94 are factorised
             # later (counted by the solve that asks: complementarity._krylov_step).
             # ``refutes(k)``, if given, tells the same of a smaller leading block k (True:
             # proven not positive definite)
