@@ -1548,10 +1548,10 @@ DEFECTS = [
     D("rev1_late_factor_always_counted", "complementarity: a deferred refresh counted whether "
       "or not covers() factorised it", "femadh/contact/complementarity.py",
       (("    n_factor += int(late and not pre.deferred)", "    n_factor += int(late)"),)),
-    D("rev1_refute_stiffening", "stability: refutation where some free nodes stiffen "
-      "(the all-softening guard dropped)", "femadh/contact/stability.py",
+    D("rev1_refute_stiffening", "stability: refutation where some free nodes stiffen, "
+      "their stiffening dropped", "femadh/contact/stability.py",
       (("    if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):",
-        "    if not np.all(np.isfinite(aD)):"),)),
+        "    aD = np.minimum(aD, 0.0)\n    if not np.all(np.isfinite(aD)):"),)),
 ]
 
 
