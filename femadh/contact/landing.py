@@ -32,6 +32,16 @@ RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
 #: past that ghost for its 400 steps (residual ~1e-15 m); from 151 nodes Newton converged in
 #: 6 iterations on a stable state
 EDGE_SHIFTS = (1, -1, 2, -2)
+#: ... and where none of those polishes, the edges farther out, EDGE_SHIFTS' largest + 1 up
+#: to this many nodes (both ways, nearest first; the first distance that gives a stable
+#: state is kept). Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05 (512 nodes,
+#: 1.71-nm follow band, the retract's micro-fold at d = 1.76836 nm, 157 contact nodes before
+#: it, validation/results/sigma03_follow.md): the descent settled on 156 nodes and Newton
+#: cycled at a residual of 2.3e-16 m from every disk of 153-159 nodes (the landing failed and
+#: ended the run); from 151 nodes (the descent's - 5) it converged in 6 iterations on a
+#: stable state of 155 nodes, from 149 and 150 on others farther off. An empty EDGE_SHIFTS
+#: turns this scan off with the neighbouring edges
+EDGE_SCAN = 8
 
 
 def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
@@ -184,19 +194,31 @@ def _next_edges(problem, d, w, active, *, tol, max_iter):
     if m is None:
         return None
     b, n = problem.contour(d), w.size
-    best, e_best = None, np.inf
-    for k in EDGE_SHIFTS:
-        if not 0 < m + k < n:
-            continue
-        A = np.zeros(n, bool)
-        A[:m + k] = True
-        w0 = np.array(w, float)
-        w0[A] = b[A] - problem.sigma
-        st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter, active0=A)
-        if st.converged and st.stable:
-            e = problem.energy(st.w, d)
-            if e < e_best:
-                best, e_best = st, e
+
+    def least(shifts):
+        best, e_best = None, np.inf
+        for k in shifts:
+            if not 0 < m + k < n:
+                continue
+            A = np.zeros(n, bool)
+            A[:m + k] = True
+            w0 = np.array(w, float)
+            w0[A] = b[A] - problem.sigma
+            st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter,
+                                       active0=A)
+            if st.converged and st.stable:
+                e = problem.energy(st.w, d)
+                if e < e_best:
+                    best, e_best = st, e
+        return best
+    best = least(EDGE_SHIFTS)
+    if best is None and EDGE_SHIFTS:
+        # the collocation form's equilibria may have vanished on several edges about the
+        # descent's (EDGE_SCAN): the nearest edges farther out on which one exists
+        for k in range(max(abs(x) for x in EDGE_SHIFTS) + 1, EDGE_SCAN + 1):
+            best = least((k, -k))
+            if best is not None:
+                break
     return best
 
 
