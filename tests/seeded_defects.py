@@ -1377,6 +1377,21 @@ DEFECTS = [
     D("sb_fold_end_landing", "max at a fold end: the fold looked up by its landing",
       "femadh/runner/estimates.py",
       (("enumerate(folds) if before is best)", "enumerate(folds) if _ is best)"),)),
+    # -- the landing's scan of farther contact edges (pull03, issue 21 goal 1)
+    D("scan_one_way", "landing scan: farther edges tried only towards a smaller contact",
+      "femadh/contact/landing.py",
+      (("            best = least((k, -k))", "            best = least((-k,))"),)),
+    D("scan_skips_nearest", "landing scan: starts one node beyond the nearest farther edge",
+      "femadh/contact/landing.py",
+      (("range(max(abs(x) for x in EDGE_SHIFTS) + 1, EDGE_SCAN + 1)",
+        "range(max(abs(x) for x in EDGE_SHIFTS) + 2, EDGE_SCAN + 1)"),)),
+    D("scan_goes_on", "landing scan: does not stop at the first distance with a landing",
+      "femadh/contact/landing.py",
+      (("            if best is not None:\n                break\n",
+        "            if best is not None:\n                pass\n"),)),
+    D("scan_without_shifts", "landing scan: runs with the neighbouring edges turned off",
+      "femadh/contact/landing.py",
+      (("    if best is None and EDGE_SHIFTS:", "    if best is None:"),)),
 ]
 
 
