@@ -1392,6 +1392,10 @@ DEFECTS = [
     D("scan_without_shifts", "landing scan: runs with the neighbouring edges turned off",
       "femadh/contact/landing.py",
       (("    if best is None and EDGE_SHIFTS:", "    if best is None:"),)),
+    D("sep_climbs", "pull-off landing: the separated state taken even above the descent's "
+      "energy", "femadh/contact/landing.py",
+      (("            problem.energy(st.w, d) < problem.energy(w, d):",
+        "            problem.energy(st.w, d) < problem.energy(w, d) + 1.0:"),)),
 ]
 
 

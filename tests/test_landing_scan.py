@@ -115,3 +115,35 @@ def test_without_the_scan_the_landing_has_no_edge(case, monkeypatch):
     monkeypatch.setattr(landing, "EDGE_SHIFTS", ())
     assert landing._next_edges(p, d, w, active, tol=scene.tolerance,
                                max_iter=scene.max_iter) is None
+
+
+def test_a_pull_off_lands_on_the_separated_state(case):
+    """_separated: on the slider's member at d = 1.3 nm (between the approach's jump-in at
+    1.11 nm and the retract's pull-off) the surface at the approach's deepest contact state
+    carried there, a surface in contact with more energy than the separated state (the
+    descent's minimum of a pull-off, measured at full size: -4.5569e-12 J in contact,
+    -4.5815e-12 J separated), lands on the separated state: a stable equilibrium with no
+    node in contact (checked independently); from a surface of lower energy than that
+    state it is refused (a landing never climbs)."""
+    from femadh.contact.complementarity import solve_complementarity
+
+    scene, p, d_fold, _, before = case
+    d = 1.3e-9
+    free = landing._separated(p, d, np.zeros(p.grid.n), tol=scene.tolerance,
+                              max_iter=scene.max_iter)
+    # the undeformed surface itself lies above the separated state's energy (the laws pull
+    # the surface down by a little): a landing from it
+    assert free is not None and not free.active.any()
+    _check_landing(p, free, scene.tolerance)
+    e_free = p.energy(free.w, d)
+    # a surface of lower energy: the contact state at that separation (the retract's
+    # branch, reached by Newton from the fold's departing surface): no landing from it
+    b = p.contour(d)
+    A = before.active.copy()
+    w0 = np.where(A, b - p.sigma, before.w)
+    held = solve_complementarity(p, d, w0, tol=scene.tolerance, max_iter=scene.max_iter,
+                                 active0=A)
+    assert held.converged and held.stable and held.active.any()
+    assert p.energy(held.w, d) < e_free
+    assert landing._separated(p, d, held.w, tol=scene.tolerance,
+                              max_iter=scene.max_iter) is None
