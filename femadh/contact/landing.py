@@ -24,6 +24,19 @@ RELAX_STEPS = 400
 #: first pseudo-time damping mu (relative to the diagonal of S) and its bounds; mu follows
 #: the residual (switched evolution relaxation: mu_k+1 = mu_k r_k / r_k-1)
 RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
+#: where none of the neighbouring edges (EDGE_SHIFTS, below) polishes a landing, the edges
+#: farther out, EDGE_SHIFTS' largest + 1 up to this many nodes (both ways, nearest first;
+#: the first distance that gives a stable state is kept). Measured on the 2-mm slider at
+#: sigma = 0.3 nm, p/psat = 0.05 (512 nodes, 1.71-nm follow band, the retract's micro-fold
+#: at d = 1.76836 nm, 157 contact nodes before it, validation/results/sigma03_pulloff.md):
+#: the descent settled on 156 nodes and Newton cycled at a residual of 2.3e-16 m from every
+#: disk of 153-159 nodes (the landing failed and ended the run); from 151 nodes (the
+#: descent's - 5) it converged in 6 iterations on a stable state of 155 nodes, from 149 and
+#: 150 on others farther off. An empty EDGE_SHIFTS turns this scan off with the neighbouring
+#: edges
+EDGE_SCAN = 8
+#: and where none of those polishes either, the separated state (:func:`_separated`)
+SEPARATED = True
 #: contact edges next to the descent's (nodes added or released at the edge of a disk-shaped
 #: contact set, in this order) from which the corrector polishes a landing that neither the
 #: descent's own set nor the relaxation polished. Measured on the sigma = 0.3 nm slider (507
@@ -32,18 +45,6 @@ RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
 #: past that ghost for its 400 steps (residual ~1e-15 m); from 151 nodes Newton converged in
 #: 6 iterations on a stable state
 EDGE_SHIFTS = (1, -1, 2, -2)
-#: ... and where none of those polishes, the edges farther out, EDGE_SHIFTS' largest + 1 up
-#: to this many nodes (both ways, nearest first; the first distance that gives a stable
-#: state is kept). Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05 (512 nodes,
-#: 1.71-nm follow band, the retract's micro-fold at d = 1.76836 nm, 157 contact nodes before
-#: it, validation/results/sigma03_follow.md): the descent settled on 156 nodes and Newton
-#: cycled at a residual of 2.3e-16 m from every disk of 153-159 nodes (the landing failed and
-#: ended the run); from 151 nodes (the descent's - 5) it converged in 6 iterations on a
-#: stable state of 155 nodes, from 149 and 150 on others farther off. An empty EDGE_SHIFTS
-#: turns this scan off with the neighbouring edges
-EDGE_SCAN = 8
-#: ... and where none of those polishes either, the separated state (:func:`_separated`)
-SEPARATED = True
 
 
 def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
