@@ -164,8 +164,9 @@ def _relaxed(problem, d, st, descent, *, tol, max_iter):
     ``st`` failed: the collocation equations relaxed in pseudo-time from it (:func:`_relax`:
     the overdamped surface under the forces the corrector balances, so it lands where the
     descent's surface would roll), else - a relaxation that drifts past a ghost beyond its
-    step cap - the corrector from the contact edges next to it (:func:`_next_edges`); ``st``
-    itself if neither ends on a converged, stable state."""
+    step cap - the corrector from the contact edges next to it or farther out
+    (:func:`_next_edges`), and last (SEPARATED) the separated state of a pull-off
+    (:func:`_separated`); ``st`` itself if none ends on a converged, stable state."""
     w, active = descent
     wr, ar, n_relax = _relax(problem, d, w, active, tol=tol)
     if wr is not None:
@@ -185,8 +186,8 @@ def _relaxed(problem, d, st, descent, *, tol, max_iter):
 def _separated(problem, d, w, *, tol, max_iter):
     """The separated state at d (m): the corrector from the undeformed surface with no
     node in contact, if it converges on a stable state with no node in contact and of lower
-    total energy than the descent's minimum ``w`` (the surface there sits in a basin of the energy that the
-    collocation equations do not have, and rolls on downhill); else None.
+    total energy than the descent's minimum ``w`` (the surface there sits in a basin of the
+    energy that the collocation equations do not have, and rolls on downhill); else None.
 
     Why: at a displacement-controlled pull-off the contact branch ends and the surface jumps
     clear of the floor. Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.95 (372
@@ -207,7 +208,9 @@ def _separated(problem, d, w, *, tol, max_iter):
 def _next_edges(problem, d, w, active, *, tol, max_iter):
     """The stable equilibrium of least total energy that the corrector reaches from the
     descent's minimum w with its disk-shaped contact set moved by one or two nodes at its
-    edge (EDGE_SHIFTS), or None (no such state, or a contact set that is not a disk).
+    edge (EDGE_SHIFTS); where none converges on a stable state, the nearest edges farther out
+    (up to EDGE_SCAN nodes, both ways) that give one; None (no such state, or a contact set
+    that is not a disk).
 
     The energy descent and the corrector solve two forms of one discretisation (the
     symmetric energy and the collocation equations, :func:`_relax`); at an edge node
