@@ -1552,6 +1552,25 @@ DEFECTS = [
       "their stiffening dropped", "femadh/contact/stability.py",
       (("    if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):",
         "    aD = np.minimum(aD, 0.0)\n    if not np.all(np.isfinite(aD)):"),)),
+    # -- the landing's scan of farther contact edges (pull03, issue 21 goal 1)
+    D("scan_one_way", "landing scan: farther edges tried only towards a smaller contact",
+      "femadh/contact/landing.py",
+      (("            best = least((k, -k))", "            best = least((-k,))"),)),
+    D("scan_skips_nearest", "landing scan: starts one node beyond the nearest farther edge",
+      "femadh/contact/landing.py",
+      (("range(max(abs(x) for x in EDGE_SHIFTS) + 1, EDGE_SCAN + 1)",
+        "range(max(abs(x) for x in EDGE_SHIFTS) + 2, EDGE_SCAN + 1)"),)),
+    D("scan_goes_on", "landing scan: does not stop at the first distance with a landing",
+      "femadh/contact/landing.py",
+      (("            if best is not None:\n                break\n",
+        "            if best is not None:\n                pass\n"),)),
+    D("scan_without_shifts", "landing scan: runs with the neighbouring edges turned off",
+      "femadh/contact/landing.py",
+      (("    if best is None and EDGE_SHIFTS:", "    if best is None:"),)),
+    D("sep_climbs", "pull-off landing: the separated state taken even above the descent's "
+      "energy", "femadh/contact/landing.py",
+      (("            problem.energy(st.w, d) < problem.energy(w, d):",
+        "            problem.energy(st.w, d) < problem.energy(w, d) + 1.0:"),)),
 ]
 
 
