@@ -1512,6 +1512,66 @@ DEFECTS = [
     D("snap_decision_cut_always", "stepping: every unconverged decision probe taken as the "
       "decision", "femadh/contact/stepping.py",
       (("    if _cycling(probe[\"history\"]):", "    if True:"),)),
+    # -- branch fixrev1: the reviewer's defects (validation/results/seeded_defects_fixrev1.md)
+    D("rev1_window_best_sample", "kink_peak: a window that missed returns the best sample, "
+      "not refined", "femadh/runner/peak.py",
+      (("    got = refine(lo, hi)\n    return float(pts[got]), float(got), xatol\n\n\ndef _kink",
+        "    got = max((x for x in pts if pts[x] is not None), key=lambda x: pts[x])\n"
+        "    return float(pts[got]), float(got), xatol\n\n\ndef _kink"),)),
+    D("rev1_window_refine_inside_only", "kink_peak: the final refinement only inside the "
+      "window", "femadh/runner/peak.py",
+      (("    got = refine(lo, hi)\n    return float(pts[got]), float(got), xatol\n\n\ndef _kink",
+        "    got = refine(w_lo, w_hi)\n    return float(pts[got]), float(got), xatol\n\n\n"
+        "def _kink"),)),
+    D("rev1_saddle_any_set", "members: a landed saddle kept on any contact set",
+      "femadh/runner/members.py",
+      (("                not np.array_equal(landed.active, st.active):",
+        "                False:"),)),
+    D("rev1_saddle_set_size_loose", "members: a landed saddle kept on a contact set one node "
+      "larger or smaller", "femadh/runner/members.py",
+      (("                not np.array_equal(landed.active, st.active):",
+        "                abs(int(landed.active.sum()) - int(st.active.sum())) > 1:"),)),
+    D("rev1_cert_squares_copied", "certificate: the cumulated squares built from a squared "
+      "temporary and a copy (3 n^2 at the build's peak)", "femadh/contact/stability.py",
+      (("        q = np.empty_like(rinv, order=\"F\")\n        np.square(rinv, out=q)\n"
+        "        for j in range(1, n):\n            np.add(q[:, j], q[:, j - 1], out=q[:, j])\n"
+        "        self.q = q\n",
+        "        self.q = np.asfortranarray(np.cumsum(rinv * rinv, axis=1))\n"),)),
+    D("rev1_cert_squares_skip_column", "certificate: the cumulated squares miss the first "
+      "column's addition", "femadh/contact/stability.py",
+      (("        for j in range(1, n):\n            np.add(q[:, j], q[:, j - 1]",
+        "        for j in range(2, n):\n            np.add(q[:, j], q[:, j - 1]"),)),
+    D("rev1_green_arrays_old", "resources: 8 dense arrays counted (the run holds 11)",
+      "femadh/scene/resources.py", (("GREEN_ARRAYS = 11", "GREEN_ARRAYS = 8"),)),
+    D("rev1_late_factor_uncounted", "complementarity: a deferred refresh factorised by "
+      "covers() not counted", "femadh/contact/complementarity.py",
+      (("    n_factor += int(late and not pre.deferred)", "    n_factor += 0"),)),
+    D("rev1_late_factor_always_counted", "complementarity: a deferred refresh counted whether "
+      "or not covers() factorised it", "femadh/contact/complementarity.py",
+      (("    n_factor += int(late and not pre.deferred)", "    n_factor += int(late)"),)),
+    D("rev1_refute_stiffening", "stability: refutation where some free nodes stiffen, "
+      "their stiffening dropped", "femadh/contact/stability.py",
+      (("    if not (np.all(np.isfinite(aD)) and np.all(aD <= 0)):",
+        "    aD = np.minimum(aD, 0.0)\n    if not np.all(np.isfinite(aD)):"),)),
+    # -- the landing's scan of farther contact edges (pull03, issue 21 goal 1)
+    D("scan_one_way", "landing scan: farther edges tried only towards a smaller contact",
+      "femadh/contact/landing.py",
+      (("            best = least((k, -k))", "            best = least((-k,))"),)),
+    D("scan_skips_nearest", "landing scan: starts one node beyond the nearest farther edge",
+      "femadh/contact/landing.py",
+      (("range(max(abs(x) for x in EDGE_SHIFTS) + 1, EDGE_SCAN + 1)",
+        "range(max(abs(x) for x in EDGE_SHIFTS) + 2, EDGE_SCAN + 1)"),)),
+    D("scan_goes_on", "landing scan: does not stop at the first distance with a landing",
+      "femadh/contact/landing.py",
+      (("            if best is not None:\n                break\n",
+        "            if best is not None:\n                pass\n"),)),
+    D("scan_without_shifts", "landing scan: runs with the neighbouring edges turned off",
+      "femadh/contact/landing.py",
+      (("    if best is None and EDGE_SHIFTS:", "    if best is None:"),)),
+    D("sep_climbs", "pull-off landing: the separated state taken even above the descent's "
+      "energy", "femadh/contact/landing.py",
+      (("            problem.energy(st.w, d) < problem.energy(w, d):",
+        "            problem.energy(st.w, d) < problem.energy(w, d) + 1.0:"),)),
     # -- the same, after review (branch fixrev2, test_snap_cost.py)
     D("snap_hold_none", "stepping: a next-node landing kept without the branch going on from "
       "it (a metastable state one node in beside the pull-off)", "femadh/contact/stepping.py",

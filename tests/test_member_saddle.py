@@ -99,3 +99,40 @@ def test_the_member_state_is_its_whole_traces(case, monkeypatch):
     m2 = members._Member(member, fine, member, build_problem(member))
     with pytest.raises(members._NotReduced):
         m2.state("approach", snaps, len(snaps) - 1)
+
+
+def test_a_landing_on_another_contact_set_is_refused(case, monkeypatch):
+    """The descent's minimum must keep the saddle's contact set: the node of two minima
+    moved to sigma changes its gap 10 % (0.5435 -> 0.489 nm), within off_branch's quarter of
+    every gap, so a stable state with that node (and the nodes it pulls) in contact passes
+    the branch test: Newton from the carried state with the saddle's first two free nodes
+    held converges to a stable state on 209 contact nodes (the saddle's and the basin's
+    minimum's: 208), off_branch False, F_ex 2.17e-3 from the right state (measured). With
+    the landing replaced by that state the member must not be reduced (traced whole), not
+    given it. (The genuine landing keeps the 208: test_the_member_state_is_its_whole_traces.)"""
+    from femadh.contact import landing
+    from femadh.contact.forces import state_forces
+    from femadh.runner.peak import off_branch
+
+    sc, fine, sink, member = case
+    snaps = sink.committed["approach"]
+    snap = snaps[-1]
+    p = build_problem(member)
+    w0, a0 = interpolate_state(fine, p, snap.d, snap.w)
+    saddle = solve_state(p, snap.d, w0, tol=sc.tolerance, max_iter=sc.max_iter, active0=a0)
+    assert saddle.converged and not saddle.stable
+    held = saddle.active.copy()
+    held[np.flatnonzero(~saddle.active)[:2]] = True
+    other = solve_state(p, snap.d, w0, tol=sc.tolerance, max_iter=sc.max_iter, active0=held)
+    # the case: another stable equilibrium, on a larger contact set, that off_branch passes
+    assert other.converged and other.stable
+    assert int(saddle.active.sum()) == 208 and int(other.active.sum()) == 209
+    assert not off_branch(p, snap.d, other.w, w0)
+    f_other = state_forces(p, other)[2]
+    m = members._Member(member, fine, member, build_problem(member))
+    f_right = state_forces(m.problem, m.state("approach", snaps, len(snaps) - 1))[2]
+    assert abs(f_other / f_right - 1) > 1e-3         # measured 2.17e-3
+    monkeypatch.setattr(landing, "land", lambda *a, **k: other)
+    m2 = members._Member(member, fine, member, build_problem(member))
+    with pytest.raises(members._NotReduced):
+        m2.state("approach", snaps, len(snaps) - 1)

@@ -194,6 +194,7 @@ def test_a_trapped_member_triggers_refinement_not_a_refusal(monkeypatch):
     from femadh.contact import landing
     monkeypatch.setattr(landing, "RELAX_STEPS", 0)
     monkeypatch.setattr(landing, "EDGE_SHIFTS", ())
+    monkeypatch.setattr(landing, "SEPARATED", False)    # (the jump-out's separated state)
     sc = femadh.load_scene("validation/scenes/paper1_fig3.toml")
     import copy
     from femadh.scene import scene_from_dict

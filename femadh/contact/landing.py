@@ -24,6 +24,19 @@ RELAX_STEPS = 400
 #: first pseudo-time damping mu (relative to the diagonal of S) and its bounds; mu follows
 #: the residual (switched evolution relaxation: mu_k+1 = mu_k r_k / r_k-1)
 RELAX_MU0, RELAX_MU_MIN, RELAX_MU_MAX = 1.0, 1e-14, 1e6
+#: where none of the neighbouring edges (EDGE_SHIFTS, below) polishes a landing, the edges
+#: farther out, EDGE_SHIFTS' largest + 1 up to this many nodes (both ways, nearest first;
+#: the first distance that gives a stable state is kept). Measured on the 2-mm slider at
+#: sigma = 0.3 nm, p/psat = 0.05 (512 nodes, 1.71-nm follow band, the retract's micro-fold
+#: at d = 1.76836 nm, 157 contact nodes before it, validation/results/sigma03_pulloff.md):
+#: the descent settled on 156 nodes and Newton cycled at a residual of 2.3e-16 m from every
+#: disk of 153-159 nodes (the landing failed and ended the run); from 151 nodes (the
+#: descent's - 5) it converged in 6 iterations on a stable state of 155 nodes, from 149 and
+#: 150 on others farther off. An empty EDGE_SHIFTS turns this scan off with the neighbouring
+#: edges
+EDGE_SCAN = 8
+#: and where none of those polishes either, the separated state (:func:`_separated`)
+SEPARATED = True
 #: contact edges next to the descent's (nodes added or released at the edge of a disk-shaped
 #: contact set, in this order) from which the corrector polishes a landing that neither the
 #: descent's own set nor the relaxation polished. Measured on the sigma = 0.3 nm slider (507
@@ -165,8 +178,9 @@ def _relaxed(problem, d, st, descent, *, tol, max_iter):
     ``st`` failed: the collocation equations relaxed in pseudo-time from it (:func:`_relax`:
     the overdamped surface under the forces the corrector balances, so it lands where the
     descent's surface would roll), else - a relaxation that drifts past a ghost beyond its
-    step cap - the corrector from the contact edges next to it (:func:`_next_edges`); ``st``
-    itself if neither ends on a converged, stable state."""
+    step cap - the corrector from the contact edges next to it or farther out
+    (:func:`_next_edges`), and last (SEPARATED) the separated state of a pull-off
+    (:func:`_separated`); ``st`` itself if none ends on a converged, stable state."""
     w, active = descent
     wr, ar, n_relax = _relax(problem, d, w, active, tol=tol)
     if wr is not None:
@@ -175,16 +189,42 @@ def _relaxed(problem, d, st, descent, *, tol, max_iter):
         if out.converged and out.stable:
             return out
     near = _next_edges(problem, d, w, active, tol=tol, max_iter=max_iter)
+    if near is None and SEPARATED:
+        near = _separated(problem, d, w, tol=tol, max_iter=max_iter)
     if near is not None:
         near.n_iter += st.n_iter + n_relax
         return near
     return st
 
 
+def _separated(problem, d, w, *, tol, max_iter):
+    """The separated state at d (m): the corrector from the undeformed surface with no
+    node in contact, if it converges on a stable state with no node in contact and of lower
+    total energy than the descent's minimum ``w`` (the surface there sits in a basin of the
+    energy that the collocation equations do not have, and rolls on downhill); else None.
+
+    Why: at a displacement-controlled pull-off the contact branch ends and the surface jumps
+    clear of the floor. Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.95 (372
+    nodes, 3.67-nm follow band, the retract's fold at d = 2.24238 nm, 215 contact nodes,
+    validation/results/sigma03_pulloff.md): the descent settled on 215 contact nodes
+    (energy -4.55688e-12 J), the corrector cycled at residuals ~1e-14 m from every disk of
+    203-217 nodes, and from the free surface it converged in 4 iterations on the stable
+    separated state (h0 = 1.536 nm, energy -4.58148e-12 J)."""
+    free = np.zeros(w.size, bool)
+    st = solve_complementarity(problem, d, np.zeros(w.size), tol=tol, max_iter=max_iter,
+                               active0=free)
+    if st.converged and st.stable and not st.active.any() and \
+            problem.energy(st.w, d) < problem.energy(w, d):
+        return st
+    return None
+
+
 def _next_edges(problem, d, w, active, *, tol, max_iter):
     """The stable equilibrium of least total energy that the corrector reaches from the
     descent's minimum w with its disk-shaped contact set moved by one or two nodes at its
-    edge (EDGE_SHIFTS), or None (no such state, or a contact set that is not a disk).
+    edge (EDGE_SHIFTS); where none converges on a stable state, the nearest edges farther out
+    (up to EDGE_SCAN nodes, both ways) that give one; None (no such state, or a contact set
+    that is not a disk).
 
     The energy descent and the corrector solve two forms of one discretisation (the
     symmetric energy and the collocation equations, :func:`_relax`); at an edge node
@@ -198,19 +238,31 @@ def _next_edges(problem, d, w, active, *, tol, max_iter):
     if m is None:
         return None
     b, n = problem.contour(d), w.size
-    best, e_best = None, np.inf
-    for k in EDGE_SHIFTS:
-        if not 0 < m + k < n:
-            continue
-        A = np.zeros(n, bool)
-        A[:m + k] = True
-        w0 = np.array(w, float)
-        w0[A] = b[A] - problem.sigma
-        st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter, active0=A)
-        if st.converged and st.stable:
-            e = problem.energy(st.w, d)
-            if e < e_best:
-                best, e_best = st, e
+
+    def least(shifts):
+        best, e_best = None, np.inf
+        for k in shifts:
+            if not 0 < m + k < n:
+                continue
+            A = np.zeros(n, bool)
+            A[:m + k] = True
+            w0 = np.array(w, float)
+            w0[A] = b[A] - problem.sigma
+            st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter,
+                                       active0=A)
+            if st.converged and st.stable:
+                e = problem.energy(st.w, d)
+                if e < e_best:
+                    best, e_best = st, e
+        return best
+    best = least(EDGE_SHIFTS)
+    if best is None and EDGE_SHIFTS:
+        # the collocation form's equilibria may have vanished on several edges about the
+        # descent's (EDGE_SCAN): the nearest edges farther out on which one exists
+        for k in range(max(abs(x) for x in EDGE_SHIFTS) + 1, EDGE_SCAN + 1):
+            best = least((k, -k))
+            if best is not None:
+                break
     return best
 
 

@@ -170,7 +170,8 @@ class _Member:
         """The stable state an energy descent reaches from the fine run's state carried to
         the member's grid (``w0``), where Newton from it converged to the saddle ``st``:
         the minimum in whose basin the carried state lies, kept where it stays on that
-        branch (within a quarter of every gap of w0); else ``st``.
+        branch (within a quarter of every gap of w0) on the saddle's contact set; else
+        ``st``.
 
         Near the contact edge a free node whose gap sits just above sigma (the member's
         nodes 1.41x further apart than the fine run's, the LJ softening steeper over a
@@ -188,7 +189,13 @@ class _Member:
                       max_iter=self.scene.max_iter)
         self.solves += 1
         if not (landed.converged and landed.stable) or \
-                off_branch(self.problem, st.d, landed.w, w0):
+                off_branch(self.problem, st.d, landed.w, w0) or \
+                not np.array_equal(landed.active, st.active):
+            # and the saddle's contact set: a node of two minima moved to sigma changes its
+            # gap 13 % (0.5628 nm carried -> 0.489), within off_branch's quarter, so a state
+            # with it (and a neighbour) in contact - another branch: 209 contact nodes on the
+            # case of tests/test_member_saddle.py, F_ex 2.2e-3 off - passes that test; the
+            # basin's minimum keeps the saddle's set (208 nodes there)
             return st
         return landed
 
@@ -233,7 +240,7 @@ def _peak(m, sink, snaps, d_fine=None):
     same piece of the branch (between the folds: :func:`femadh.runner.peak.pieces`), then
     the bounded search between the states around it - a fold's landing or last state where
     the piece ends there, as the fine run's bracket."""
-    from .peak import WindowMiss, kink_peak, peak_adhesion, pieces
+    from .peak import peak_adhesion, pieces
 
     branch, _, prev, best, nxt = sink.peak
     states = snaps[branch]
@@ -285,24 +292,37 @@ def _peak(m, sink, snaps, d_fine=None):
         # bracket where the member's optimum ends at the window's edge
         half = PEAK_WINDOW * (abs(piece[j_hi].d - piece[i].d)
                               or abs(piece[i].d - piece[j_lo].d))
-        known = []
-        try:
-            F, d, tol = peak_adhesion(m.problem, *around, m.scene,
-                                      within=(d_fine - half, d_fine + half), reuse=True,
-                                      record=known,
-                                      edge_stop=WINDOW_EDGE_STOP if KINK_PEAK else None)
-            if abs(d - (d_fine - half)) > 2 * tol and abs(d - (d_fine + half)) > 2 * tol:
-                return F, d
-        except WindowMiss:
-            pass
-        if KINK_PEAK:
-            # a miss: the whole bracket by the kink model, from every state the window's
-            # search solved (femadh.runner.peak.kink_peak)
-            F, d, _ = kink_peak(m.problem, *around, m.scene, known=known,
-                                window=(d_fine - half, d_fine + half), reuse=True,
-                                f_of=m.f_ex)
-            return F, d
+        return _window_peak(m.problem, around, m.scene, (d_fine - half, d_fine + half),
+                            f_of=m.f_ex)
     F, d, _ = peak_adhesion(m.problem, *around, m.scene, reuse=True)
+    return F, d
+
+
+def _window_peak(problem, around, scene, window, f_of=None):
+    """(F, d) of a member's largest adhesion searched first on ``window`` = (lo, hi) around
+    the fine run's peak (:func:`~femadh.runner.peak.peak_adhesion` ``within``), kept where
+    its optimum lies inside; where it ends at the window's edge (or stops there, with
+    KINK_PEAK: WINDOW_EDGE_STOP) the whole bracket of ``around`` = (prev, best, nxt) is
+    searched by the kink model from every state the window's search solved (KINK_PEAK), else
+    by the bounded search. Fresh states reuse the nearer grid state's factorisation."""
+    from .peak import WindowMiss, kink_peak, peak_adhesion
+
+    known = []
+    try:
+        F, d, tol = peak_adhesion(problem, *around, scene, within=window, reuse=True,
+                                  record=known,
+                                  edge_stop=WINDOW_EDGE_STOP if KINK_PEAK else None)
+        if abs(d - window[0]) > 2 * tol and abs(d - window[1]) > 2 * tol:
+            return F, d
+    except WindowMiss:
+        pass
+    if KINK_PEAK:
+        # a miss: the whole bracket by the kink model, from every state the window's
+        # search solved (femadh.runner.peak.kink_peak)
+        F, d, _ = kink_peak(problem, *around, scene, known=known, window=window, reuse=True,
+                            f_of=f_of)
+        return F, d
+    F, d, _ = peak_adhesion(problem, *around, scene, reuse=True)
     return F, d
 
 

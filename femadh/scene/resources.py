@@ -5,9 +5,14 @@ import os
 
 from ..errors import DependencyError, SceneError
 
-#: dense N x N float64 arrays a Green contact problem holds at once (compliance, stiffness,
-#: S and its symmetric part, a factorisation and its Hessian copies)
-GREEN_ARRAYS = 8
+#: dense N x N float64 arrays a Green contact run holds at once (compliance, stiffness, the
+#: symmetric S, the stability certificate's R^-1 and its cumulated squares, the corrector's
+#: Jacobian and factorisations, the carried state's factor, a landing's Hessian copies).
+#: Measured (tracemalloc, peak traced memory of a whole Fig 4 run on a fixed grid over
+#: 8 N^2 bytes): 11.0 at N = 2624 (the peak in the corrector's LU step), 13.7 at N = 1312
+#: (in a landing's descent; the states' O(N) arrays weigh more there), with or without the
+#: estimate's members; 8 understated it by 27-42 %
+GREEN_ARRAYS = 11
 #: FE: degrees of freedom per surface node at the default mesh (measured: 22k DOFs at N = 200),
 #: and the dense condensation block (free DOFs x N) that dominates the memory
 FE_DOFS_PER_NODE = 110

@@ -1,0 +1,149 @@
+"""The landing's scan of contact edges farther from the descent's (femadh.contact.landing:
+EDGE_SCAN in :func:`_next_edges`, issue 21 goal 1).
+
+Measured at full size (validation/results/sigma03_pulloff.md): on the stiction map's
+sigma = 0.3 nm, p/psat = 0.05 point the retract's flat branch before the pull-off releases a
+contact node per micro-fold; at d = 1.76836 nm (512 nodes, 1.71-nm follow band, 157 contact
+nodes) the descent settled on 156 nodes and the corrector cycled at a residual of 2.3e-16 m
+from every disk of 153-159 nodes: the landing failed and ended the run. From 151 nodes
+(the descent's - 5) it converged in 6 iterations on a stable state of 155 nodes. That case
+costs minutes; here the same situation is made on the small landing of
+tests/test_landing_relax.py (the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05, 253 nodes,
+26 nm band spacing, its approach's second fold) by letting the corrector fail from every
+disk within EDGE_SHIFTS of the descent's, as it did there."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import femadh
+from femadh.contact import landing, linalg, stepping, trace
+from femadh.contact.linalg import disk_size
+from femadh.discretisation import plan_grid
+from femadh.elastic import GreenOperator
+from femadh.scene import build_problem
+
+from test_landing_relax import D_VALUES, SPACING, _check_landing
+
+SCENE = Path(__file__).resolve().parents[1] / "validation" / "scenes" / \
+    "paper1_slider_meniscus.toml"
+
+
+@pytest.fixture(scope="module")
+def case():
+    """(scene, problem, d, descent (w, contact set), the state before the fold) of the
+    approach's second landing, the one whose polish from the descent fails
+    (test_landing_relax's case, same path)."""
+    scene = femadh.load_scene(SCENE).replace({"effects.asperity_gap.sigma": "0.3 nm",
+                                              "effects.capillary.relative_pressure": 0.05,
+                                              "sweep.start": "4 nm"})
+    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
+                     scene.d_values, scene.target_accuracy)
+    p = build_problem(scene, operator=GreenOperator(plan.family.member(SPACING),
+                                                    scene.e_star))
+    found = []
+    real = landing._relaxed
+
+    def spy(problem, d, st, descent, **kw):
+        found.append((d, descent))
+        return real(problem, d, st, descent, **kw)
+    dtype = linalg.PRECONDITIONER_DTYPE
+    try:
+        landing._relaxed = spy
+        linalg.PRECONDITIONER_DTYPE = np.float64     # the path to that landing (see there)
+        sweep = trace(p, D_VALUES, branch="approach", tol=scene.tolerance,
+                      max_iter=scene.max_iter)
+    finally:
+        landing._relaxed = real
+        linalg.PRECONDITIONER_DTYPE = dtype
+    assert found, "the case's landing no longer needs a fallback"
+    d, descent = found[0]
+    before = [j.before for j in sweep.jumps if j.d_land == d]
+    assert len(before) == 1
+    return scene, p, d, descent, before[0]
+
+
+def _near_fail(monkeypatch, m, reach):
+    """The corrector, as landing calls it, fails from every disk within ``reach`` nodes of
+    the descent's m (as on the full-size case, where no equilibrium exists near those
+    edges); records the start disks tried."""
+    real = landing.solve_complementarity
+    tried = []
+
+    def solve(problem, d, w0, *, active0=None, **kw):
+        k = disk_size(active0) if active0 is not None and active0.any() else None
+        tried.append(k)
+        st = real(problem, d, w0, active0=active0, **kw)
+        if k is not None and abs(k - m) <= reach:
+            st.converged = False
+        return st
+    monkeypatch.setattr(landing, "solve_complementarity", solve)
+    return tried
+
+
+def test_the_scan_lands_from_the_nearest_farther_edge(case, monkeypatch):
+    """With no equilibrium reachable from the edges within EDGE_SHIFTS the scan tries the
+    next farther edges both ways (+3 and -3 first) and returns a stable equilibrium of the
+    collocation equations (checked independently: residual, gap bound, contact pressure,
+    energy Hessian) whose energy lies below the departing surface's; no edge beyond the
+    first distance that gave one is tried."""
+    scene, p, d, (w, active), before = case
+    m = disk_size(active)
+    reach = max(abs(k) for k in landing.EDGE_SHIFTS)
+    tried = _near_fail(monkeypatch, m, reach)
+    st = landing._next_edges(p, d, w, active, tol=scene.tolerance, max_iter=scene.max_iter)
+    assert st is not None
+    _check_landing(p, st, scene.tolerance)
+    scanned = [k - m for k in tried if k is not None and abs(k - m) > reach]
+    assert scanned[:2] == [reach + 1, -(reach + 1)]
+    assert max(abs(k) for k in scanned) == reach + 1      # (measured: +3 converged)
+    # a landing: its energy below the departing surface's at the landing's separation
+    assert p.energy(st.w, d) < p.energy(before.w, d)
+
+
+def test_without_the_scan_the_landing_has_no_edge(case, monkeypatch):
+    """The same failing corrector with EDGE_SCAN at EDGE_SHIFTS' reach (no scan) or with
+    the neighbouring edges off (EDGE_SHIFTS empty: the scan goes with them): no landing."""
+    scene, p, d, (w, active), before = case
+    m = disk_size(active)
+    reach = max(abs(k) for k in landing.EDGE_SHIFTS)
+    _near_fail(monkeypatch, m, reach)
+    monkeypatch.setattr(landing, "EDGE_SCAN", reach)
+    assert landing._next_edges(p, d, w, active, tol=scene.tolerance,
+                               max_iter=scene.max_iter) is None
+    monkeypatch.setattr(landing, "EDGE_SCAN", 8)
+    monkeypatch.setattr(landing, "EDGE_SHIFTS", ())
+    assert landing._next_edges(p, d, w, active, tol=scene.tolerance,
+                               max_iter=scene.max_iter) is None
+
+
+def test_a_pull_off_lands_on_the_separated_state(case):
+    """_separated: on the slider's member at d = 1.3 nm (between the approach's jump-in at
+    1.11 nm and the retract's pull-off) the surface at the approach's deepest contact state
+    carried there, a surface in contact with more energy than the separated state (the
+    descent's minimum of a pull-off, measured at full size: -4.5569e-12 J in contact,
+    -4.5815e-12 J separated), lands on the separated state: a stable equilibrium with no
+    node in contact (checked independently); from a surface of lower energy than that
+    state it is refused (a landing never climbs)."""
+    from femadh.contact.complementarity import solve_complementarity
+
+    scene, p, d_fold, _, before = case
+    d = 1.3e-9
+    free = landing._separated(p, d, np.zeros(p.grid.n), tol=scene.tolerance,
+                              max_iter=scene.max_iter)
+    # the undeformed surface itself lies above the separated state's energy (the laws pull
+    # the surface down by a little): a landing from it
+    assert free is not None and not free.active.any()
+    _check_landing(p, free, scene.tolerance)
+    e_free = p.energy(free.w, d)
+    # a surface of lower energy: the contact state at that separation (the retract's
+    # branch, reached by Newton from the fold's departing surface): no landing from it
+    b = p.contour(d)
+    A = before.active.copy()
+    w0 = np.where(A, b - p.sigma, before.w)
+    held = solve_complementarity(p, d, w0, tol=scene.tolerance, max_iter=scene.max_iter,
+                                 active0=A)
+    assert held.converged and held.stable and held.active.any()
+    assert p.energy(held.w, d) < e_free
+    assert landing._separated(p, d, held.w, tol=scene.tolerance,
+                              max_iter=scene.max_iter) is None
