@@ -1474,7 +1474,8 @@ DEFECTS = [
         "if near is not None:"),)),
     D("snap_next_shift_sign", "stepping: the next-node landing's disk moved against the edge "
       "(grown on a retract)", "femadh/contact/stepping.py",
-      (("-1 if grid_step > 0 else 1, tol=tol)", "1 if grid_step > 0 else -1, tol=tol)"),)),
+      (("-1 if grid_step > 0 else 1, tol=tol, stats=sweep.work,",
+        "1 if grid_step > 0 else -1, tol=tol, stats=sweep.work,"),)),
     D("snap_next_unstable", "landing: a next-node candidate taken without its stability",
       "femadh/contact/landing.py",
       (("if not (st.stable and m_new is not None", "if not (m_new is not None"),)),
@@ -1571,6 +1572,25 @@ DEFECTS = [
       "energy", "femadh/contact/landing.py",
       (("            problem.energy(st.w, d) < problem.energy(w, d):",
         "            problem.energy(st.w, d) < problem.energy(w, d) + 1.0:"),)),
+    # -- the same, after review (branch fixrev2, test_snap_cost.py)
+    D("snap_hold_none", "stepping: a next-node landing kept without the branch going on from "
+      "it (a metastable state one node in beside the pull-off)", "femadh/contact/stepping.py",
+      (("NEXT_NODE_HOLD_STEPS = 2", "NEXT_NODE_HOLD_STEPS = 0"),)),
+    D("snap_hold_no_acceptance", "stepping: the hold's steps taken whatever the corrector "
+      "gave", "femadh/contact/stepping.py",
+      (("        if not _accept(new, w_pred, d, problem, act):\n            return False\n"
+        "        g_new = total_force(problem, new)\n        if crossed_fold(",
+        "        g_new = total_force(problem, new)\n        if False and crossed_fold("),)),
+    D("snap_hold_backwards", "stepping: the hold probed back toward the last state, not on",
+      "femadh/contact/stepping.py",
+      (("        d = d_land + direction * k * min_step\n",
+        "        d = d_land - direction * k * min_step\n"),)),
+    D("snap_aim_repeated", "stepping: the rhythm's aim kept after its trial was turned down "
+      "as too far for the predictor", "femadh/contact/stepping.py",
+      (("            rhythm.forget_aim()\n", "            pass\n"),)),
+    D("snap_path_end_only", "landing: the downhill test samples the path's end only",
+      "femadh/contact/landing.py",
+      (("PATH_SAMPLES = 16", "PATH_SAMPLES = 1"),)),
 ]
 
 

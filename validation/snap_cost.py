@@ -84,8 +84,8 @@ class Compare:
     def __enter__(self):
         orig = self._orig
 
-        def compared(problem, d, state, sign, *, tol):
-            st = orig(problem, d, state, sign, tol=tol)
+        def compared(problem, d, state, sign, *, tol, **k):
+            st = orig(problem, d, state, sign, tol=tol, **k)
             if st is not None:
                 ref = landing.land(problem, d, state.w, tol=tol, max_iter=40)
                 self.rows.append((d, int(st.active.sum()), int(ref.active.sum()),

@@ -266,7 +266,7 @@ def _next_edges(problem, d, w, active, *, tol, max_iter):
     return best
 
 
-def land_next_node(problem, d, state, sign, *, tol):
+def land_next_node(problem, d, state, sign, *, tol, stats=None, stall_iter=STALL_ITER):
     """The landing of a single node's snap at separation d (m) found by the corrector alone,
     or None (then the energy descent, :func:`land`, decides).
 
@@ -281,7 +281,10 @@ def land_next_node(problem, d, state, sign, *, tol):
     the descent never climbs), and that energy falling monotonically along the straight path
     from the start to it at PATH_SAMPLES points (no barrier between them that would send the
     descent into another basin). The caller still classifies it as a lattice snap (the energy
-    it released, :func:`femadh.contact.stepping.lattice_snap`) before it is used."""
+    it released, :func:`femadh.contact.stepping.lattice_snap`) before it is used, and keeps it
+    only where the branch goes on from it (``stepping._next_node_holds``). ``stats``: the
+    corrector's work counters (as :func:`solve_complementarity`'s), added to;
+    ``stall_iter``: its stagnation exit (the stepping's own, None: none)."""
     from .linalg import disk_size
 
     if problem.sigma is None or not np.any(state.active):
@@ -301,7 +304,7 @@ def land_next_node(problem, d, state, sign, *, tol):
         w0 = np.array(state.w, float)
         w0[A] = b[A] - problem.sigma
         st = solve_complementarity(problem, d, w0, tol=tol, max_iter=NEXT_NODE_ITER,
-                                   active0=A, stall_iter=STALL_ITER)
+                                   active0=A, stall_iter=stall_iter, stats=stats)
         if not st.converged:
             continue
         m_new = disk_size(st.active)

@@ -41,10 +41,15 @@ contact's snap (jump-in, pull-off) releases ~150x it and is a jump. A trial step
 gives up when it stagnates (the smallest step's, which decides a fold, has its whole budget).
 
 A contact unzipping node by node near a pull-off (issue 21) makes a micro-fold of every node
-it releases. Three things keep that cheap without moving a fold or a state
-(validation/results/snap_cost.md): a single node's snap is landed first by the corrector
-from the disk a node or two further (:func:`femadh.contact.landing.land_next_node`, taken
-only where it is plainly the descent's landing and a lattice snap); after a lattice snap a
+it releases. Three things keep that cheap; measured on the Fig 4 disk at 50, 60, ..., 400
+nodes and on the 532-node slider (validation/results/snap_cost.md) they move no fold off
+its lattice point and no state's contact set, and the surfaces agree with the old path's to
+1e-18 m (the polishes stop at different iterates within the tolerance): a single node's
+snap is landed first by the corrector from the disk a node or two further
+(:func:`femadh.contact.landing.land_next_node`, taken only where it is plainly the
+descent's landing, a lattice snap, and the branch goes on from it for
+NEXT_NODE_HOLD_STEPS resolution steps: beside a pull-off the corrector can find a
+metastable state one node in where the descent leaves the contact); after a lattice snap a
 fold's decision that goes round a cycle of contact sets (m <-> m - 1) is turned down after
 CYCLE_PROBE_ITER iterations, not the whole budget (:func:`_decide`); and after three snaps
 in a rhythm the next is expected one spacing past the last (:class:`_SnapRhythm`).
@@ -398,14 +403,21 @@ class _SnapRhythm:
     """Where the next lattice snap of a contact unzipping node by node is expected.
 
     Records the last three lattice-snap folds (the last stable separations before them, m);
-    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm:
-    on the Fig 4 disk at 100 nodes three snaps 2-3x apart in spacing are none, and aiming at
-    them cost 9 more fold solves), the last distance s predicts the next fold at F + s past
+    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm;
+    measured on the Fig 4 disk at 90 nodes: snaps 261, 88, 59 and 31 steps apart, the
+    first pair 3x apart is none, the later ones are; at 100 nodes 58 and 36 steps apart,
+    a rhythm that aims at a fourth snap which does not come: the pull-off), the last
+    distance s predicts the next fold at F + s past
     the last one F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
     SNAP_MARGIN steps short of it, then one resolution step at a time up to SNAP_CREEP steps
     past it (the fold is then located by a decision solve one step past its last stable
     lattice point - the same point the doubling and bisection find on a connected branch
-    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback."""
+    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback; its aim
+    is dropped when the aimed trial is too far for the predictor (:meth:`forget_aim`). Not
+    kept beyond one trace (a checkpoint stores no rhythm): a resume, a regrid or a widening
+    starts without it, which moves only where trials go - the retract resumed from each
+    grid state reaches the same folds and states (tests/test_snap_cost.py), though not
+    always to the last bit (another path of trials)."""
 
     def __init__(self):
         self.clear()
@@ -424,6 +436,11 @@ class _SnapRhythm:
         if 1 <= s <= SNAP_RHYTHM_MAX and 0.5 * s0 <= s <= 2 * s0:
             self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step
             self.creep_to = d_fold + direction * (s + SNAP_CREEP) * min_step
+
+    def forget_aim(self):
+        """The aimed trial was turned down as too far for the predictor: no aim until the
+        next snap (the halving takes over; the snaps seen are kept)."""
+        self.target = self.creep_to = None
 
     def aim(self, d, d_try, min_step, direction):
         """The trial separation from the state at ``d`` instead of ``d_try`` (m): the
@@ -451,9 +468,11 @@ class _SnapRhythm:
 #: second iteration to its 40th (the edge node tensile on m, below sigma on m - 1), the
 #: residual of each set repeating to 6e-6 relative or closer from the third iteration on (to
 #: the last bit in some); the whole budget run beside every decision cut short converged at none
-#: (snap_cost.md). Only after a lattice snap since the last jump (a contact unzipping):
-#: elsewhere a turned-down decision (a jump-in, a pull-off) runs its whole budget without
-#: a cycle and the probe's iterations would be spent again. 0: no probe
+#: (snap_cost.md). Only after a lattice snap since the last jump or fallback (a contact
+#: unzipping): a turned-down decision elsewhere (a jump-in, a pull-off with no snap before
+#: it) runs its whole budget without a cycle and the probe's iterations would be spent
+#: again. The pull-off that ends an unzipping is probed too, and pays them again (its
+#: decision does not cycle). 0: no probe
 CYCLE_PROBE_ITER = 8
 #: ... the cycle's length in iterations (a node in and out of the contact)
 CYCLE_PERIOD = 2
@@ -461,6 +480,41 @@ CYCLE_PERIOD = 2
 #: it (relative; measured 6e-6 at most on the cycles above, 4e-9 to 1e-7 on most, while a
 #: corrector on its way to converge cuts its residual by orders of magnitude per iteration)
 CYCLE_RTOL = 1e-3
+
+
+#: a single node's snap landed by the corrector (:func:`land_next_node`) is kept only where the
+#: branch goes on from it for this many resolution steps (each a stable state accepted as a
+#: healthy smallest step); else the energy descent lands it. The descent can leave the
+#: contact from the same start (a pull-off) where the corrector found a stable state one
+#: node in, downhill of the start and a lattice snap by its energy - a metastable state
+#: beside its own fold. Measured on the Fig 4 disk (tests/test_snap_cost.py): at 110, 200
+#: and 270 nodes the candidate's branch ended at the very next resolution step (the fold
+#: moved by one step, F_ex before it by up to 5.4 %); on 50..400 nodes every candidate
+#: that held for 2 steps was the descent's landing
+NEXT_NODE_HOLD_STEPS = 2
+
+
+def _next_node_holds(problem, landed, d_land, min_step, direction, tol, max_iter, work):
+    """True if the branch continues from the next-node landing ``landed`` (at ``d_land``, m)
+    for NEXT_NODE_HOLD_STEPS resolution steps ``min_step`` (m) in ``direction``: each a
+    converged stable state close to its prediction that releases no more than the lattice
+    bound (the test of a healthy smallest step). Its solves are added to ``work``; none of
+    their states is kept (the sweep goes on from ``landed`` as before)."""
+    st, g = landed, total_force(problem, landed)
+    t = _tangent(problem, st)
+    for k in range(1, NEXT_NODE_HOLD_STEPS + 1):
+        d = d_land + direction * k * min_step
+        w_pred, act = _predict(problem, st, d, t)
+        new = solve_complementarity(problem, d, w_pred, tol=tol, max_iter=max_iter,
+                                    active0=act, factor=st.lu, stall_iter=STALL_ITER,
+                                    stats=work)
+        if not _accept(new, w_pred, d, problem, act):
+            return False
+        g_new = total_force(problem, new)
+        if crossed_fold(problem, st, new, g, g_new, FOLD_ENERGY_SHARE_MIN_STEP):
+            return False
+        st, g, t = new, g_new, _tangent(problem, new)
+    return True
 
 
 def _decide(problem, d, w_pred, tol, budget, act, factor, work):
@@ -688,10 +742,13 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 exc.sweep = sweep
                 raise exc
             solves_here += 1
+            aimed = False       # the trial is the rhythm's (:meth:`_SnapRhythm.aim`)
             if fold.far is None or halving:
                 d_try = state.d + step
                 if SNAP_RHYTHM and not halving:
+                    plain = d_try
                     d_try = rhythm.aim(state.d, d_try, min_step, math.copysign(1.0, grid_step))
+                    aimed = d_try != plain
                 if (d_next - d_try) * math.copysign(1.0, grid_step) < 0 or \
                         abs(d_next - d_try) < 0.5 * min_step:
                     d_try = d_next
@@ -791,6 +848,10 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                     continue
             else:
                 k = int(round(abs(d_try - state.d) / min_step))
+                if why == "rejected_predictor" and aimed:
+                    # the rhythm's trial was too far for the predictor: the halving below
+                    # must take over (the aim would repeat the same trial to the stall)
+                    rhythm.forget_aim()
                 if (why == "rejected_predictor" or edge) and k > 1:
                     # half the distance, in whole resolution steps (the trials' lattice)
                     step = math.copysign(max(1, k // 2) * min_step, grid_step)
@@ -805,15 +866,25 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             if NEXT_NODE_LANDING and not halving:
                 # a node snapping across the lattice: the corrector from the disk a node or
                 # two further (the way the edge goes: it recedes on a retract), used only if
-                # it is plainly the descent's landing and a lattice snap
+                # it is plainly the descent's landing, a lattice snap, and the branch goes
+                # on from it (:func:`_next_node_holds`: else it may be a metastable state
+                # one node in where the descent pulls off)
+                n0 = sweep.work.get("solves", 0)
                 near = land_next_node(problem, d_try, state,
-                                      -1 if grid_step > 0 else 1, tol=tol)
-                sweep.n_solves += 1
+                                      -1 if grid_step > 0 else 1, tol=tol, stats=sweep.work,
+                                      stall_iter=STALL_ITER)
                 if near is not None and lattice_snap(problem, state, near, g_state,
                                                      total_force(problem, near)):
-                    landed = near
-                    sweep.work["next_node_landings"] = \
-                        sweep.work.get("next_node_landings", 0) + 1
+                    if _next_node_holds(problem, near, d_try, min_step,
+                                        math.copysign(1.0, grid_step), tol, max_iter,
+                                        sweep.work):
+                        landed = near
+                        sweep.work["next_node_landings"] = \
+                            sweep.work.get("next_node_landings", 0) + 1
+                    else:
+                        sweep.work["next_node_refused_short"] = \
+                            sweep.work.get("next_node_refused_short", 0) + 1
+                sweep.n_solves += sweep.work.get("solves", 0) - n0
             if landed is None:
                 landed = land(problem, d_try, state.w, tol=tol, max_iter=max_iter)
                 sweep.n_solves += 1
