@@ -8,6 +8,8 @@ grid step from the fine run's peak, beyond the window; each member's F_ex(d) the
 smooth pieces meeting at a kink (slopes +1e4 and -2.7e4 N/m)."""
 import warnings
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -118,12 +120,9 @@ def test_kink_search_agrees_with_the_bounded_search_at_fewer_states(slider_peaks
     assert rel <= 1e-2          # measured 6.8e-4
 
 
-def _analytic(monkeypatch, f):
-    """kink_peak on the curve F = f(d) (d in nm): the fresh states stand-ins that carry
-    their separation, F_ex from f. Returns a function (lo, best, hi) -> (F, d, xatol,
-    evaluations)."""
-    from types import SimpleNamespace
-
+def _stub_states(monkeypatch, force):
+    """Fresh states as stand-ins that carry their separation, F_ex = force(d); returns the
+    list the separations of the fresh states are appended to."""
     import femadh.contact.forces as forces
 
     calls = []
@@ -133,7 +132,15 @@ def _analytic(monkeypatch, f):
         return SimpleNamespace(d=d, w=np.zeros(1), lu=None)
 
     monkeypatch.setattr(peak, "state_between", between)
-    monkeypatch.setattr(forces, "state_forces", lambda p, st: (0.0, 0.0, f(st.d)))
+    monkeypatch.setattr(forces, "state_forces", lambda p, st: (0.0, 0.0, force(st.d)))
+    return calls
+
+
+def _analytic(monkeypatch, f):
+    """kink_peak on the curve F = f(d) (d in nm): the fresh states stand-ins that carry
+    their separation, F_ex from f. Returns a function (lo, best, hi) -> (F, d, xatol,
+    evaluations)."""
+    calls = _stub_states(monkeypatch, f)
 
     def search(lo, best, hi, **kw):
         calls.clear()
@@ -173,18 +180,7 @@ def _windowed(monkeypatch, f):
     bounded search with its edge stop, then the kink model where it missed) on the curve
     F = f(d) as :func:`_analytic`. Returns a function (lo, best, hi, window) -> (F, d,
     evaluations)."""
-    from types import SimpleNamespace
-
-    import femadh.contact.forces as forces
-
-    calls = []
-
-    def between(problem, a, b, d, scene, reuse=False, start=None):
-        calls.append(d)
-        return SimpleNamespace(d=d, w=np.zeros(1), lu=None)
-
-    monkeypatch.setattr(peak, "state_between", between)
-    monkeypatch.setattr(forces, "state_forces", lambda p, st: (0.0, 0.0, f[0](st.d)))
+    calls = _stub_states(monkeypatch, lambda d: f[0](d))
 
     def search(lo, best, hi, window):
         calls.clear()
