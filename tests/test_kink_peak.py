@@ -222,3 +222,28 @@ def test_a_window_stopped_near_its_edge_is_refined_inside(monkeypatch, shape):
             assert F <= curve(dk)                      # the curve's own value somewhere
             worst = max(worst, (curve(dk) - F) / xatol)
     assert worst <= (1e-6 if shape == "smooth" else 1.0), worst
+
+
+@pytest.mark.parametrize("shape", ["kink", "smooth"])
+def test_a_window_that_holds_the_peak_is_the_bounded_search(monkeypatch, shape):
+    """A maximum well inside the window (within 30 % of its half-width of the centre, 13
+    positions): the window's bounded search closes its bracket there and is kept - the same
+    F, d and fresh states as peak_adhesion on the window without an edge stop; the kink
+    model is not consulted (it costs the window's ends and the bracket outside)."""
+    lo, best, hi, half = 0.8, 1.0, 1.2, 0.025
+    window = (best - half, best + half)
+    for dk in best + half * np.linspace(-0.3, 0.3, 13):
+        if shape == "smooth":
+            def curve(d, dk=dk):
+                return -(d - dk) ** 2
+        else:
+            def curve(d, dk=dk):
+                x = d - dk
+                return min(1.0 * x - 2.5 * x * x, -2.7 * x - 6.7 * x * x)
+        grid = [SimpleNamespace(d=x, w=np.zeros(1), f_ex=curve(x)) for x in (lo, best, hi)]
+        calls = _stub_states(monkeypatch, curve)
+        F, d = members._window_peak(None, grid, None, window)
+        n = len(calls)
+        calls = _stub_states(monkeypatch, curve)
+        Fb, db, _ = peak.peak_adhesion(None, *grid, None, within=window, reuse=True)
+        assert (F, d, n) == (Fb, db, len(calls))
