@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import femadh
-from femadh.contact import landing, linalg, stepping, trace
+from femadh.contact import landing, linalg, trace
 from femadh.contact.linalg import disk_size
 from femadh.discretisation import plan_grid
 from femadh.elastic import GreenOperator

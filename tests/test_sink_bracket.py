@@ -4,7 +4,6 @@ re-solve (Sink._fold_fields): synthetic sequences of committed records.
 
 The bracket [prev, best, next] is interpolated node by node (femadh.runner.peak.state_between):
 its states must be on one grid (the peak's problem's) and hold displacements."""
-from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
