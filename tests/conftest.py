@@ -151,10 +151,10 @@ def adaptive_scene(path="validation/scenes/paper1_fig3.toml", **solver):
     return scene_from_dict(raw, sc.path, bare_numbers=False)
 
 
-def fig4_banded(start, stop):
+def fig4_banded(start, stop, step="0.2 nm", directions=None):
     """The Fig 4 slider (sigma = 0.5 nm) on an explicit banded grid (30 nm in a 5.9-um band,
-    a = 12.6 um), swept from ``start`` to ``stop`` (strings with units) in 0.2 nm steps and
-    back."""
+    a = 12.6 um), swept from ``start`` to ``stop`` (strings with units) in ``step`` and back
+    (``directions``: the sweep's, where given)."""
     import copy
 
     import femadh
@@ -166,5 +166,7 @@ def fig4_banded(start, stop):
     raw["solver"]["analysis_radius"] = "12.6e-6 m"
     raw["solver"]["grid"] = {"spacing": "30e-9 m", "band": "5.9e-6 m",
                              "grading": "0.295e-6 m"}
-    raw["sweep"].update(start=start, stop=stop, step="0.2 nm")
+    raw["sweep"].update(start=start, stop=stop, step=step)
+    if directions is not None:
+        raw["sweep"]["directions"] = directions
     return scene_from_dict(raw, base.path, bare_numbers=False)

@@ -9,7 +9,6 @@ N) and the next grid state, at 0.7 nm, is past the contact piece's largest F_ex 
 the no-contact state at 1.2 nm, every fresh state between them was turned down as another
 branch, and the search kept the grid value: 1.0650e-4 N, 2.5e-2 below the curve's maximum.
 """
-import copy
 import signal
 import warnings
 
@@ -19,13 +18,13 @@ import pytest
 import femadh
 from femadh.runner import estimates
 from femadh.runner.result import ContactResult
-from femadh.scene import scene_from_dict
 from femadh.contact import solve_state
 from femadh.contact.forces import state_forces
 from femadh.runner.contact import solve_sweeps
 from femadh.runner.peak import pieces
 from femadh.runner.sink import Committed, Sink
 
+from conftest import fig4_banded
 from validation.fault_matrix import cli, phase, summary
 
 #: the dense scan's points between the landing and the next grid state (0.41 nm: 2.7 pm apart)
@@ -218,15 +217,7 @@ def test_the_sink_keeps_a_fold_s_states_with_their_own_forces(scene_path):
 def _banded():
     """The case on the banded grid of tests/test_estimate_members.py (30 nm in a 5.9-um
     band, a = 12.6 um): its estimate's members are solved on the fine run's states."""
-    base = femadh.load_scene("validation/scenes/paper1_fig4.toml")
-    raw = copy.deepcopy(base.raw)
-    raw["solver"].pop("accuracy", None)
-    raw["solver"]["analysis_radius"] = "12.6e-6 m"
-    raw["solver"]["grid"] = {"spacing": "30e-9 m", "band": "5.9e-6 m",
-                             "grading": "0.295e-6 m"}
-    raw["sweep"].update(start="1.7 nm", stop="0.2 nm", step="0.5 nm",
-                        directions=["approach"])
-    return scene_from_dict(raw, base.path, bare_numbers=False)
+    return fig4_banded("1.7 nm", "0.2 nm", step="0.5 nm", directions=["approach"])
 
 
 @pytest.mark.slow
