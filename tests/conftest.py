@@ -170,3 +170,15 @@ def fig4_banded(start, stop, step="0.2 nm", directions=None):
     if directions is not None:
         raw["sweep"]["directions"] = directions
     return scene_from_dict(raw, base.path, bare_numbers=False)
+
+
+def fields_by_state(out):
+    """{state: (r, h) arrays in m} read from a run folder's fields.csv (the grid each state
+    was written on)."""
+    import csv
+
+    rows = {}
+    with open(Path(out) / "fields.csv", newline="") as f:
+        for row in csv.DictReader(f):
+            rows.setdefault(row["state"], []).append((float(row["r_m"]), float(row["h_m"])))
+    return {k: tuple(np.array(v).T) for k, v in rows.items()}

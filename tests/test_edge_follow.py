@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import femadh
+from conftest import fields_by_state
 from femadh.discretisation import GridFamily
 from femadh.discretisation import moving, plan
 from femadh.discretisation.moving import EdgeBand, zone_gap
@@ -185,13 +186,8 @@ def test_the_fine_band_stays_on_the_edge_through_the_jump_in(small_sweep):
     assert res.grid["regrids"] >= 3
     H = grid["spacing"]
     zone = zone_gap(sc.effects, SIGMA)
-    states = {}
-    with open(out / "fields.csv", newline="") as f:
-        for row in csv.DictReader(f):
-            states.setdefault(row["state"], []).append((float(row["r_m"]), float(row["h_m"])))
     in_contact, sizes = 0, set()
-    for rows in states.values():
-        r, h = np.array(rows).T
+    for r, h in fields_by_state(out).values():
         sizes.add(r.size)
         touching = np.flatnonzero(h <= SIGMA * (1 + 1e-9))
         if not touching.size:

@@ -2,7 +2,6 @@
 the band's exchange rule, the state carried to a new grid, the sweep through its folds with
 every committed state on a grid whose band holds its edge, and the adaptive run's answer to
 a lattice-trapped estimate member."""
-import csv
 import math
 
 import numpy as np
@@ -18,7 +17,7 @@ from femadh.runner.run import run
 from femadh.runner.estimates import variant
 from femadh.scene import build_problem
 
-from conftest import check_curve_against_fields
+from conftest import check_curve_against_fields, fields_by_state
 
 FIG4 = "validation/scenes/paper1_fig4.toml"
 #: the Fig 4 scene (sigma = 0.5 nm, 2-mm slider) through its jump-in and jump-out, coarse
@@ -120,14 +119,10 @@ def test_the_fine_band_follows_the_edge_through_the_folds(followed):
     assert res.grid["regrids"] >= 3
     assert {j["branch"] for j in res.jumps} == {"approach", "retract"}
     sigma = res.scene.gap.sigma
-    states = {}
-    with open(out / "fields.csv", newline="") as f:
-        for row in csv.DictReader(f):
-            states.setdefault(row["state"], []).append((float(row["r_m"]), float(row["h_m"])))
+    states = fields_by_state(out)
     in_contact = 0
     sizes = set()
-    for rows in states.values():
-        r, h = np.array(rows).T
+    for r, h in states.values():
         sizes.add(r.size)
         touching = np.flatnonzero(h <= sigma * (1 + 1e-9))
         if not touching.size:
