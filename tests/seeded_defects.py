@@ -1591,6 +1591,23 @@ DEFECTS = [
     D("snap_path_end_only", "landing: the downhill test samples the path's end only",
       "femadh/contact/landing.py",
       (("PATH_SAMPLES = 16", "PATH_SAMPLES = 1"),)),
+    # -- session 9 (estcost): a small member's states factorise their own Jacobian
+    D("estcost_factor_inverted", "members: the nearby factorisation reused below the node "
+      "threshold and not above it", "femadh/runner/peak.py",
+      (("    return problem.grid.n >= MEMBER_FACTOR_MIN_NODES",
+        "    return problem.grid.n < MEMBER_FACTOR_MIN_NODES"),)),
+    D("estcost_factor_fine_too", "peak search: the fine run's own fresh states drop their "
+      "chord factorisation too (its headline moves)", "femadh/runner/peak.py",
+      (("            not (reuse and not reuse_factor(problem)):",
+        "            reuse_factor(problem):"),)),
+    D("estcost_factor_grid_states_inherit", "members: the states at the fine run's grid "
+      "separations still inherit the nearest member state's factorisation",
+      "femadh/runner/members.py",
+      (("        if near and reuse_factor(self.problem):", "        if near:"),)),
+    D("estcost_factor_fresh_inherit", "peak search: a small member's fresh states still "
+      "inherit the nearby factorisation", "femadh/runner/peak.py",
+      (("            not (reuse and not reuse_factor(problem)):",
+        "            True:"),)),
 ]
 
 

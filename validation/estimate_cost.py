@@ -3,7 +3,10 @@ validation/accuracy.py, each run with the estimate's reductions off ("before": e
 solves the deepest state and four states around each zero-force crossing, and its fold
 decisions run to max_iter), on as session 7 left them ("after") and with session 8's
 ("kink": a member's windowed peak search that misses stops at the window's edge and the kink
-model searches the rest of the bracket; a member state Newton ends on a saddle is landed),
+model searches the rest of the bracket; a member state Newton ends on a saddle is landed)
+and with session 9's ("factor": a member's states on a grid of fewer than
+femadh.runner.peak.MEMBER_FACTOR_MIN_NODES nodes factorise their own Jacobian instead of
+inheriting a nearby state's factorisation),
 counting the members' work by part - states, corrector solves, Newton iterations,
 factorisations, folds, landings, peak searches (windowed and over the whole bracket) and the
 fresh states they solve - and timing the estimate against the sweep it judges (median of
@@ -25,7 +28,7 @@ import os
 from pathlib import Path
 import statistics
 
-from femadh.runner import estimates, members
+from femadh.runner import estimates, members, peak
 
 from .accuracy import CASES, SCENES, _adaptive, _timed
 
@@ -39,7 +42,15 @@ SETTINGS = {"before": {"ZERO_FORCE_PAIR_FIRST": False, "LOCKED_DEEPEST_ONLY": Fa
             # session 8: a window that misses stops at its edge and the kink model searches
             # the rest of the bracket; a member state on a saddle is landed
             "kink": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True,
-                     "FOLD_DECISION_STALL": True, "KINK_PEAK": True, "LAND_SADDLE": True}}
+                     "FOLD_DECISION_STALL": True, "KINK_PEAK": True, "LAND_SADDLE": True,
+                     "MEMBER_FACTOR_MIN_NODES": 0},
+            # session 9: a small member's states factorise their own Jacobian instead of
+            # inheriting a factorisation from a state a fraction of a grid step away
+            "factor": {"ZERO_FORCE_PAIR_FIRST": True, "LOCKED_DEEPEST_ONLY": True,
+                       "FOLD_DECISION_STALL": True, "KINK_PEAK": True, "LAND_SADDLE": True,
+                       "MEMBER_FACTOR_MIN_NODES": peak.MEMBER_FACTOR_MIN_NODES}}
+for _s in ("before", "after"):
+    SETTINGS[_s]["MEMBER_FACTOR_MIN_NODES"] = 0
 PARTS = ("deepest", "peak grid states", "peak search", "folds", "zero force", "edge-placed")
 
 
@@ -63,7 +74,7 @@ def _setting(flags):
         saved[(estimates, "reduced_member")] = orig
         estimates.reduced_member = reduced
     for k, v in flags.items():
-        mod = members if hasattr(members, k) else estimates
+        mod = members if hasattr(members, k) else peak if hasattr(peak, k) else estimates
         saved[(mod, k)] = getattr(mod, k)
         setattr(mod, k, v)
     try:

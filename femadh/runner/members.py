@@ -45,7 +45,7 @@ import numpy as np
 
 from ..contact.stepping import MIN_STEP_FRACTION
 from ..estimate.guards import TRAPPING_LIMIT
-from .peak import off_branch
+from .peak import off_branch, reuse_factor
 
 #: grid states the member may walk past the fine run's peak looking for its own grid maximum
 PEAK_WALK = 3
@@ -150,9 +150,11 @@ class _Member:
         w0, active0 = interpolate_state(self.fine, self.problem, c.d, c.w)
         kw = {} if active0 is None else {"active0": active0}
         # the factorisation of the member's nearest state on the branch serves the chord
-        # steps (as a sweep's previous step does)
+        # steps (as a sweep's previous step does) on a grid where that is cheaper than the
+        # chord steps it makes (femadh.runner.peak.reuse_factor: a grid step away, a small
+        # member's own factorisation converges in fewer evaluations of the laws)
         near = [j for b, j in self.cache if b == branch]
-        if near:
+        if near and reuse_factor(self.problem):
             kw["factor"] = self.cache[(branch, min(near, key=lambda j: abs(j - k)))].lu
         st = solve_state(self.problem, c.d, w0, tol=self.scene.tolerance,
                          max_iter=self.scene.max_iter, **kw)

@@ -17,8 +17,10 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
     """A fresh equilibrium at separation d between two states a and b of one branch, solved
     from the displacements interpolated between them, or None unless it converged, is stable
     and stayed on that branch (every gap within a quarter of the interpolation's). With
-    ``reuse``, the nearer state's factorisation (if it has one) serves the corrector's chord
-    steps, as in a sweep's step (an estimate's member: a third of the fresh factorisations).
+    ``reuse`` (an estimate's member), the nearer state's factorisation (if it has one) serves the
+    corrector's chord steps, as in a sweep's step, on a grid of at least
+    MEMBER_FACTOR_MIN_NODES nodes (:func:`reuse_factor`; on fewer the corrector factorises
+    its own).
 
     ``start`` = (state, slope): Newton starts from a fresh state of the same branch nearer
     to d instead, w = state.w + slope (d - state.d) (slope: dw/dd, m/m), with its contact
@@ -35,7 +37,8 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
         w_start = near.w + slope * (d - near.d)
         if problem.sigma is not None:
             w_start = np.minimum(w_start, problem.contour(d) - problem.sigma)
-    if (reuse or start is not None) and getattr(near, "lu", None) is not None:
+    if (reuse or start is not None) and getattr(near, "lu", None) is not None and \
+            not (reuse and not reuse_factor(problem)):
         kw["factor"] = near.lu
     if problem.contact_model == "hertz-closure":
         kw["r_c0"] = near.r_c or None
@@ -45,6 +48,26 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
     if not (st.converged and st.stable) or off_branch(problem, d, st.w, w0):
         return None
     return st
+
+
+#: an estimate member's fresh state (``reuse``) starts its corrector with the factorisation
+#: of a state nearby only on a grid of at least this many nodes; on fewer, its corrector
+#: factorises its own Jacobian. A factorisation inherited from a state a fraction of a grid
+#: step away (the grid state, or a fresh state that solved with it: the chord steps keep it
+#: while the residual falls by the chord rate) makes the corrector's steps chord steps, each
+#: a full evaluation of the laws (the slider meniscus scene's sub-grid meniscus quadrature),
+#: where a factorisation of a member's few dozen nodes costs less than one of them:
+#: measured on the accuracy table's adaptive rows (estimate_cost.md, session 9) - the
+#: members' Newton iterations fell 22-28 % on the 29-114-node members (Fig 3 at 1e-2, the
+#: slider at 1e-2 and 1e-3) and stayed the same on Fig 4's 142-420-node members. (The fine
+#: run's own peak search keeps its chord steps: its headline is not moved.)
+MEMBER_FACTOR_MIN_NODES = 150
+
+
+def reuse_factor(problem):
+    """Whether an estimate member's state on ``problem`` starts its corrector with a nearby
+    state's factorisation (its grid has at least MEMBER_FACTOR_MIN_NODES nodes)."""
+    return problem.grid.n >= MEMBER_FACTOR_MIN_NODES
 
 
 def off_branch(problem, d, w, w0):
