@@ -57,10 +57,12 @@ def state_between(problem, a, b, d, scene, reuse=False, start=None):
 #: while the residual falls by the chord rate) makes the corrector's steps chord steps, each
 #: a full evaluation of the laws (the slider meniscus scene's sub-grid meniscus quadrature),
 #: where a factorisation of a member's few dozen nodes costs less than one of them:
-#: measured on the accuracy table's adaptive rows (estimate_cost.md, session 9) - the
-#: members' Newton iterations fell 22-28 % on the 29-114-node members (Fig 3 at 1e-2, the
-#: slider at 1e-2 and 1e-3) and stayed the same on Fig 4's 142-420-node members. (The fine
-#: run's own peak search keeps its chord steps: its headline is not moved.)
+#: measured on the accuracy table's adaptive rows (estimate_cost.md, session 9), the
+#: members' Newton iterations fell 26-33 % on the 29-128-node members (Fig 3 at 1e-2, 3e-3
+#: and 1e-3, the slider at 1e-2 and 1e-3); with own factorisations on Fig 4's 201-420-node
+#: members too, not one iteration fewer (267 and 482 over the whole run at 3e-3 and 1e-3,
+#: as with this threshold), where a factorisation costs more. (The fine run's own peak
+#: search keeps its chord steps: its headline is not moved.)
 MEMBER_FACTOR_MIN_NODES = 150
 
 
