@@ -1490,28 +1490,28 @@ DEFECTS = [
       "femadh/contact/landing.py",
       (("if not np.isfinite(e) or e > e_prev + noise:",
         "if not np.isfinite(e) or e > e_prev + abs(e_prev) + noise:"),)),
-    D("snap_rhythm_past", "stepping: the rhythm's first trial aimed past the expected fold",
-      "femadh/contact/stepping.py",
+    D("snap_rhythm_past", "snap: the rhythm's first trial aimed past the expected fold",
+      "femadh/contact/snap.py",
       (("self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step",
         "self.target = d_fold + direction * (s + SNAP_MARGIN) * min_step"),)),
-    D("snap_rhythm_any_spacing", "stepping: any three snaps taken for a rhythm",
-      "femadh/contact/stepping.py",
+    D("snap_rhythm_any_spacing", "snap: any three snaps taken for a rhythm",
+      "femadh/contact/snap.py",
       (("if 1 <= s <= SNAP_RHYTHM_MAX and 0.5 * s0 <= s <= 2 * s0:",
         "if 1 <= s <= SNAP_RHYTHM_MAX:"),)),
-    D("snap_rhythm_creep_two", "stepping: the rhythm creeps two resolution steps at a time "
-      "(a fold located to two steps)", "femadh/contact/stepping.py",
+    D("snap_rhythm_creep_two", "snap: the rhythm creeps two resolution steps at a time "
+      "(a fold located to two steps)", "femadh/contact/snap.py",
       (("            return d + direction * min_step\n",
         "            return d + direction * 2 * min_step\n"),)),
-    D("snap_cycle_any_residual", "stepping: a decision whose residual falls by orders of "
-      "magnitude taken for a cycle", "femadh/contact/stepping.py",
+    D("snap_cycle_any_residual", "snap: a decision whose residual falls by orders of "
+      "magnitude taken for a cycle", "femadh/contact/snap.py",
       (("CYCLE_RTOL = 1e-3", "CYCLE_RTOL = 1.0"),)),
-    D("snap_cycle_nodes_ignored", "stepping: the cycle told by the residuals alone",
-      "femadh/contact/stepping.py",
+    D("snap_cycle_nodes_ignored", "snap: the cycle told by the residuals alone",
+      "femadh/contact/snap.py",
       (("    return all(last[i][1] == last[i + CYCLE_PERIOD][1]\n               and abs(",
         "    return all(True\n               and abs("),)),
-    D("snap_decision_cut_always", "stepping: every unconverged decision probe taken as the "
-      "decision", "femadh/contact/stepping.py",
-      (("    if _cycling(probe[\"history\"]):", "    if True:"),)),
+    D("snap_decision_cut_always", "snap: every unconverged decision probe taken as the "
+      "decision", "femadh/contact/snap.py",
+      (("    if cycling(probe[\"history\"]):", "    if True:"),)),
     # -- branch fixrev1: the reviewer's defects (validation/results/seeded_defects_fixrev1.md)
     D("rev1_window_best_sample", "kink_peak: a window that missed returns the best sample, "
       "not refined", "femadh/runner/peak.py",
@@ -1573,18 +1573,18 @@ DEFECTS = [
       (("            problem.energy(st.w, d) < problem.energy(w, d):",
         "            problem.energy(st.w, d) < problem.energy(w, d) + 1.0:"),)),
     # -- the same, after review (branch fixrev2, test_snap_cost.py)
-    D("snap_hold_none", "stepping: a next-node landing kept without the branch going on from "
-      "it (a metastable state one node in beside the pull-off)", "femadh/contact/stepping.py",
+    D("snap_hold_none", "snap: a next-node landing kept without the branch going on from "
+      "it (a metastable state one node in beside the pull-off)", "femadh/contact/snap.py",
       (("NEXT_NODE_HOLD_STEPS = 2", "NEXT_NODE_HOLD_STEPS = 0"),)),
     D("snap_hold_no_acceptance", "stepping: the hold's steps taken whatever the corrector "
       "gave", "femadh/contact/stepping.py",
-      (("        if not _accept(new, w_pred, d, problem, act):\n            return False\n"
+      (("        if not _accept(new, w_pred, d, problem, act):\n            return None\n"
         "        g_new = total_force(problem, new)\n        if crossed_fold(",
         "        g_new = total_force(problem, new)\n        if False and crossed_fold("),)),
-    D("snap_hold_backwards", "stepping: the hold probed back toward the last state, not on",
-      "femadh/contact/stepping.py",
-      (("        d = d_land + direction * k * min_step\n",
-        "        d = d_land - direction * k * min_step\n"),)),
+    D("snap_hold_backwards", "snap: the hold probed back toward the last state, not on",
+      "femadh/contact/snap.py",
+      (("        at = step(at, d_land + direction * k * min_step)\n",
+        "        at = step(at, d_land - direction * k * min_step)\n"),)),
     D("snap_aim_repeated", "stepping: the rhythm's aim kept after its trial was turned down "
       "as too far for the predictor", "femadh/contact/stepping.py",
       (("            rhythm.forget_aim()\n", "            pass\n"),)),
