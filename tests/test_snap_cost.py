@@ -253,8 +253,9 @@ def test_an_aimed_trial_too_far_for_the_predictor_gives_way_to_the_halving(monke
 
 
 def test_a_resume_with_no_rhythm_reaches_the_same_states():
-    """The rhythm lives in one trace (a resume, a regrid or a widening starts without it):
-    the retract resumed from each of its grid states (the checkpoint's state, its edge
+    """A trace without the rhythm (a regrid, a widening, a resume re-solved without its
+    checkpoint start without it; tests/test_snaphome_resume.py: a checkpoint keeps it):
+    the retract resumed from each of its grid states, its rhythm dropped (its edge
     predictor's point kept) reaches the same folds and grid states as the uninterrupted one
     - the rhythm moves only where trials go, never a fold (the 36 sizes above: rhythm on and
     off the same)."""
@@ -276,7 +277,8 @@ def test_a_resume_with_no_rhythm_reaches_the_same_states():
     from femadh.contact import trace
     d_values = list(FIG4_D_VALUES[::-1])
     for k in range(1, len(re.states) - 1):
-        part = trace(p, d_values[k:], branch="retract", tol=TOL, start=re.states[k])
+        part = trace(p, d_values[k:], branch="retract", tol=TOL,
+                     start=dataclasses.replace(re.states[k], snap_rhythm=None))
         tail = dataclasses.replace(re, states=re.states[k:],
                                    jumps=[j for j in re.jumps if j.d_fold >= re.states[k].d])
         _same_path(p, (part,), (tail,))

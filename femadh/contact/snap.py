@@ -31,6 +31,10 @@ measured to move no fold off its lattice point and no state's contact set:
   branch goes on from it (:func:`next_node_holds`): beside a pull-off the corrector can find
   a metastable state one node in where the energy descent leaves the contact.
 
+The rhythm is the stepping's only memory across grid steps besides the state itself; it is
+kept on each committed grid state (:meth:`SnapRhythm.snapshot`) so that a run resumed from
+its checkpoint mid-unzipping is the uninterrupted run to the bit.
+
 References
 ----------
 Paper 1 (/work/shared/papers/adhesion-aspects-in-mems-nems.txt): eqs 6 and 10 (the
@@ -75,17 +79,36 @@ class SnapRhythm:
     piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback; its aim
     is dropped when the aimed trial is too far for the predictor (:meth:`forget_aim`).
 
-    Not
-    kept beyond one trace (a checkpoint stores no rhythm): a resume, a regrid or a widening
-    starts without it, which moves only where trials go - the retract resumed from each
-    grid state reaches the same folds and states (tests/test_snap_cost.py), though not
-    always to the last bit (another path of trials)."""
+    Kept across one branch's trace, and on every grid state the trace commits as that state
+    leaves it (:meth:`snapshot`, ``State.snap_rhythm``): a trace of the same branch started
+    from such a state - a checkpoint's, resumed (:mod:`femadh.runner.checkpoint`) - goes on
+    with it (:meth:`restored`), so a resume mid-unzipping takes the uninterrupted run's very
+    trials and reaches its states to the bit. The next branch, a regrid or a widening
+    (a state carried to another grid) start without it, which moves only where trials go -
+    the retract traced again from each grid state without the rhythm reaches the same folds
+    and states (tests/test_snap_cost.py), though not always to the last bit (another path of
+    trials)."""
 
     def __init__(self):
         self.clear()
 
     def clear(self):
         self.folds, self.target, self.creep_to = [], None, None
+
+    def snapshot(self, branch):
+        """The rhythm as plain numbers (a checkpoint keeps them): (branch, folds (m, the
+        last three at most), target (m or None), creep_to (m or None))."""
+        return (branch, tuple(self.folds), self.target, self.creep_to)
+
+    @classmethod
+    def restored(cls, snapshot, branch):
+        """The rhythm of a :meth:`snapshot` taken on ``branch``; a fresh one for None or a
+        snapshot of another branch (an approach's rhythm says nothing of the retract)."""
+        out = cls()
+        if snapshot is not None and snapshot[0] == branch:
+            _, folds, out.target, out.creep_to = snapshot
+            out.folds = list(folds)
+        return out
 
     def snapped(self, d_fold, min_step, direction):
         """A lattice snap whose departing branch was last stable at ``d_fold`` (m)."""

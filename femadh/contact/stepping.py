@@ -544,7 +544,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
     t_state = _tangent(problem, state)
-    rhythm = snap.SnapRhythm()
+    # the rhythm of the trace this one resumes (a checkpoint's state of this branch), else
+    # fresh; the start itself is left as it came
+    rhythm = snap.SnapRhythm.restored(state.snap_rhythm, branch)
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -778,6 +780,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             state, g_state = landed, g_landed
             t_state = _tangent(problem, state)
             fold.restart(state, t_state, problem)
+        # the rhythm as this grid state leaves it: a trace resumed from it goes on with it
+        state.snap_rhythm = rhythm.snapshot(branch)
         sweep.states.append(state)
         if on_state:
             on_state(state)
