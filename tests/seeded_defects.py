@@ -1507,7 +1507,7 @@ DEFECTS = [
       (("CYCLE_RTOL = 1e-3", "CYCLE_RTOL = 1.0"),)),
     D("snap_cycle_nodes_ignored", "snap: the cycle told by the residuals alone",
       "femadh/contact/snap.py",
-      (("    return all(last[i][1] == last[i + CYCLE_PERIOD][1]\n               and abs(",
+      (("    return all(last[i][3] == last[i + CYCLE_PERIOD][3]\n               and abs(",
         "    return all(True\n               and abs("),)),
     D("snap_decision_cut_always", "snap: every unconverged decision probe taken as the "
       "decision", "femadh/contact/snap.py",
@@ -1591,6 +1591,39 @@ DEFECTS = [
     D("snap_path_end_only", "landing: the downhill test samples the path's end only",
       "femadh/contact/landing.py",
       (("PATH_SAMPLES = 16", "PATH_SAMPLES = 1"),)),
+    # -- the snap rhythm in the checkpoint, cycles told by their sets (branch snaphome,
+    #    test_snaphome_resume.py, test_snaphome_cycling.py)
+    D("snaphome_rhythm_not_saved", "checkpoint: the snap rhythm not written (a resume "
+      "mid-unzipping with a fresh one)", "femadh/runner/checkpoint.py",
+      (("    data.update(_rhythm_data(st.snap_rhythm))\n", ""),)),
+    D("snaphome_rhythm_not_restored", "stepping: a trace started from a state of its branch "
+      "ignores the state's rhythm", "femadh/contact/stepping.py",
+      (("    rhythm = snap.SnapRhythm.restored(state.snap_rhythm, branch)",
+        "    rhythm = snap.SnapRhythm()"),)),
+    D("snaphome_rhythm_any_branch", "snap: a rhythm restored on any branch (the approach's on "
+      "the retract)", "femadh/contact/snap.py",
+      (("        if snapshot is not None and snapshot[0] == branch:",
+        "        if snapshot is not None:"),)),
+    D("snaphome_rhythm_fresh_snapshot", "stepping: each grid state keeps a fresh rhythm, not "
+      "the trace's", "femadh/contact/stepping.py",
+      (("        state.snap_rhythm = rhythm.snapshot(branch)",
+        "        state.snap_rhythm = snap.SnapRhythm().snapshot(branch)"),)),
+    D("snaphome_rhythm_aim_lost", "checkpoint: the rhythm's aim read back as none",
+      "femadh/runner/checkpoint.py",
+      (("    target, creep_to = (None if math.isnan(x) else float(x) for x in z[\"snap_aim\"])",
+        "    target, creep_to = None, None"),)),
+    D("snaphome_rhythm_float32", "checkpoint: the rhythm's separations kept in float32",
+      "femadh/runner/checkpoint.py",
+      (("\"snap_folds\": np.array(folds, dtype=float)",
+        "\"snap_folds\": np.array(folds, dtype=np.float32)"),)),
+    D("snaphome_cycle_sizes", "snap: a cycle told by the sizes of the contact sets, not the "
+      "sets", "femadh/contact/snap.py",
+      (("    return all(last[i][3] == last[i + CYCLE_PERIOD][3]\n",
+        "    return all(last[i][1] == last[i + CYCLE_PERIOD][1]\n"),)),
+    D("snaphome_history_next_set", "complementarity: the history records the next "
+      "iteration's contact set, not the one iterated on", "femadh/contact/complementarity.py",
+      (("                                     A.tobytes()))",
+        "                                     new_A.tobytes()))"),)),
 ]
 
 

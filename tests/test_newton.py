@@ -67,7 +67,7 @@ def test_newton_converges_quadratically_once_the_contact_set_settles(fig4):
                                 stats=stats)
     assert new.converged and new.n_iter <= 6
     settled = []
-    for res, _, same in stats["history"]:
+    for res, _, same, _ in stats["history"]:
         settled = settled + [res] if same else []
     # residuals far above round-off (~1e-24 m here): the quadratic phase
     r = [x for x in settled if x > 1e-22]

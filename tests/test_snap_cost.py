@@ -342,12 +342,18 @@ def test_every_next_node_landing_taken_is_a_lattice_snap(monkeypatch):
 
 #: a decision's corrector history on the sigma = 0.489 nm slider's retract (532 nodes, the
 #: micro-fold at 1.2884 nm; validation/results/snap_cost.md): (residual (m), contact nodes,
-#: set unchanged) per iteration - the disk of 73 and 72 nodes in turn from the second
-#: iteration on, each residual repeating to 6e-6 relative from the third
-CYCLE = [(2.6511e-21, 73, False), (1.3992e-15, 72, False), (1.5452737311835257e-15, 73, False),
-         (1.3988823954798885e-15, 72, False), (1.5452641917231115e-15, 73, False),
-         (1.3988824008565625e-15, 72, False), (1.5452641915163163e-15, 73, False),
-         (1.3988823985818158e-15, 72, False)]
+#: set unchanged, the set) per iteration - the disk of 73 and 72 nodes in turn from the
+#: second iteration on, each residual repeating to 6e-6 relative from the third
+def _disk(m, n=532):
+    """The contact disk of m nodes as the corrector's history holds it (bytes)."""
+    return (np.arange(n) < m).tobytes()
+
+
+CYCLE = [(r, m, False, _disk(m)) for r, m in (
+    (2.6511e-21, 73), (1.3992e-15, 72), (1.5452737311835257e-15, 73),
+    (1.3988823954798885e-15, 72), (1.5452641917231115e-15, 73),
+    (1.3988824008565625e-15, 72), (1.5452641915163163e-15, 73),
+    (1.3988823985818158e-15, 72))]
 
 
 def test_a_corrector_going_round_a_cycle_of_contact_sets_is_told():
@@ -356,10 +362,11 @@ def test_a_corrector_going_round_a_cycle_of_contact_sets_is_told():
     whose set stood still at an iteration, nor one alternating between other node counts
     at the same residuals, nor fewer than three rounds."""
     assert snap.cycling(CYCLE)
-    falling = [(10.0 ** -(10 + 2 * k), 72 + k % 2, False) for k in range(8)]
+    falling = [(10.0 ** -(10 + 2 * k), 72 + k % 2, False, _disk(72 + k % 2))
+               for k in range(8)]
     assert not snap.cycling(falling)
-    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 72, True)])
-    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 71, False)])
+    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 72, True, _disk(72))])
+    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 71, False, _disk(71))])
     assert not snap.cycling(CYCLE[3:])
 
 

@@ -188,19 +188,22 @@ def decide(problem, d, w_pred, tol, budget, act, factor, work):
 
 def cycling(history):
     """True if the corrector's last 3 CYCLE_PERIOD iterations go round one cycle three
-    times: each with the contact nodes and, to CYCLE_RTOL, the residual of the iteration
-    CYCLE_PERIOD before it, the contact set changing at every one of them - a node let go
-    and taken back, its residual not falling (the first two iterations, from the
-    prediction, are not on the cycle: CYCLE_PROBE_ITER = 8 sees it three times).
-    ``history``: (residual (m), contact nodes, set unchanged) per iteration
-    (:func:`solve_complementarity`'s stats)."""
+    times: each with the contact set (the same nodes, not only as many) and, to CYCLE_RTOL,
+    the residual of the iteration CYCLE_PERIOD before it, the contact set changing at every
+    one of them - a node let go and taken back, its residual not falling (the first two
+    iterations, from the prediction, are not on the cycle: CYCLE_PROBE_ITER = 8 sees it three
+    times). A corrector that moves on through other sets of the same sizes (a node let go
+    at one place and another taken at the next) is not on a cycle. ``history``: (residual
+    (m), contact nodes, set unchanged, the set as bytes) per iteration
+    (:func:`solve_complementarity`'s stats); the sets are compared as those bytes, a
+    comparison of n bytes per iteration."""
     n = 2 * CYCLE_PERIOD
     if len(history) < n + CYCLE_PERIOD:
         return False
     last = history[-n - CYCLE_PERIOD:]
-    if any(same for _, _, same in last):
+    if any(same for _, _, same, _ in last):
         return False
-    return all(last[i][1] == last[i + CYCLE_PERIOD][1]
+    return all(last[i][3] == last[i + CYCLE_PERIOD][3]
                and abs(last[i][0] - last[i + CYCLE_PERIOD][0]) <= CYCLE_RTOL * last[i][0]
                for i in range(n))
 
