@@ -51,7 +51,7 @@ def test_wrong_derivative_fails_cleanly_in_stepping_continuation(monkeypatch):
     bounded number of Newton iterations, not in a crawl. Measured: 92 complementarity solves,
     3077 Newton iterations in all (2 s quiet) before the landing after the jump-in fails; the
     bound is 3x that. It counts work, not seconds: a wall-clock bound failed at load 15."""
-    from femadh.contact import landing, stepping
+    from femadh.contact import landing, snap, stepping
 
     work = {"solves": 0, "iterations": 0}
 
@@ -65,6 +65,7 @@ def test_wrong_derivative_fails_cleanly_in_stepping_continuation(monkeypatch):
     monkeypatch.setattr(stepping, "solve_complementarity",
                         counted(stepping.solve_complementarity))
     monkeypatch.setattr(landing, "solve_complementarity", counted(landing.solve_complementarity))
+    monkeypatch.setattr(snap, "solve_complementarity", counted(snap.solve_complementarity))
     p = _fig4(SteepDerivative(HAMAKER, Z0), check=False)
     ds = np.round(np.arange(2.0, -2.0001, -0.2), 10) * 1e-9
     with pytest.raises(ConvergenceError, match=r"d = .* nm") as e:

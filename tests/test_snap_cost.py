@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import FIG4_TOL, fig4_problem, fig4_sweeps
-from femadh.contact import landing, stepping
+from femadh.contact import landing, snap, stepping
 from femadh.contact.stepping import lattice_snap, total_force
 
 TOL = FIG4_TOL
@@ -118,25 +118,25 @@ def test_the_snap_rhythm_aims_at_the_next_fold():
     unzipping, snap_cost.md) put the first trial SNAP_MARGIN steps short of the fold 26
     steps past the last, then creep one step at a time to SNAP_CREEP past it; snaps 3x apart
     in spacing are no rhythm; a jump forgets it."""
-    r = stepping._SnapRhythm()
+    r = snap.SnapRhythm()
     for k in (0, 28, 54):
         r.snapped(k * H, H, 1.0)
     land = 55 * H
-    assert round(r.aim(land, land + H, H, 1.0) / H) == 54 + 26 - stepping.SNAP_MARGIN
-    d = (54 + 26 - stepping.SNAP_MARGIN) * H
+    assert round(r.aim(land, land + H, H, 1.0) / H) == 54 + 26 - snap.SNAP_MARGIN
+    d = (54 + 26 - snap.SNAP_MARGIN) * H
     assert round((r.aim(d, d + 64 * H, H, 1.0) - d) / H) == 1
-    d = (54 + 26 + stepping.SNAP_CREEP) * H
+    d = (54 + 26 + snap.SNAP_CREEP) * H
     assert r.aim(d, d + 64 * H, H, 1.0) == d + 64 * H
     assert r.target is None
-    q = stepping._SnapRhythm()
+    q = snap.SnapRhythm()
     for k in (0, 10, 40):
         q.snapped(k * H, H, 1.0)
     assert q.target is None
     # on a decreasing d (an approach) the same, mirrored
-    m = stepping._SnapRhythm()
+    m = snap.SnapRhythm()
     for k in (0, -28, -54):
         m.snapped(k * H, H, -1.0)
-    assert round(m.aim(-55 * H, -56 * H, H, -1.0) / H) == -(54 + 26 - stepping.SNAP_MARGIN)
+    assert round(m.aim(-55 * H, -56 * H, H, -1.0) / H) == -(54 + 26 - snap.SNAP_MARGIN)
     m.clear()
     assert m.aim(-55 * H, -56 * H, H, -1.0) == -56 * H
 
@@ -147,9 +147,9 @@ def test_the_unzipping_folds_and_states_are_those_of_the_old_path(unzip, monkeyp
     at the same lattice points (to the round-off of d, 1e-6 of a resolution step), the same
     grid states to the tolerance."""
     p, ap, re, _ = unzip
-    monkeypatch.setattr(stepping, "SNAP_RHYTHM", False)
-    monkeypatch.setattr(stepping, "NEXT_NODE_LANDING", False)
-    monkeypatch.setattr(stepping, "CYCLE_PROBE_ITER", 0)
+    monkeypatch.setattr(snap, "SNAP_RHYTHM", False)
+    monkeypatch.setattr(snap, "NEXT_NODE_LANDING", False)
+    monkeypatch.setattr(snap, "CYCLE_PROBE_ITER", 0)
     ap0, re0 = fig4_sweeps(p)
     for new, old in ((ap, ap0), (re, re0)):
         assert [round(j.d_fold / H, 6) for j in new.jumps] == \
@@ -182,30 +182,30 @@ def test_a_next_node_landing_beside_a_pull_off_is_left_to_the_descent(n, monkeyp
     node in (8 -> 7, 13 -> 12 nodes) that is stable, downhill of the descent's start and a
     lattice snap - while the descent from the same start leaves the contact (the pull-off,
     one resolution step earlier; F_ex before it 5.4 % apart at 110 nodes). The candidate's
-    branch ends at the next resolution step (:func:`stepping._next_node_holds`), so the
+    branch ends at the next resolution step (:func:`snap.next_node_holds`), so the
     descent lands it: the folds, grid states and landings are the old path's (all three
     switches off), and so with each switch on alone (measured on 50, 60, ..., 400 nodes: all
     36 the same)."""
     p = fig4_problem(n)
     refused = []
-    orig = stepping._next_node_holds
+    orig = snap.next_node_holds
 
-    def holds(problem, landed, *a):
-        ok = orig(problem, landed, *a)
+    def holds(start, *a):
+        ok = orig(start, *a)
         if not ok:
-            refused.append(landed)
+            refused.append(start[0])
         return ok
-    monkeypatch.setattr(stepping, "_next_node_holds", holds)
+    monkeypatch.setattr(snap, "next_node_holds", holds)
     on = fig4_sweeps(p)
     assert len(refused) == 1 and on[1].jumps[-1].after.active.sum() == 0
     assert refused[0].active.sum() == on[1].jumps[-1].before.active.sum() - 1
     switches = {"SNAP_RHYTHM": False, "NEXT_NODE_LANDING": False, "CYCLE_PROBE_ITER": 0}
     for name, value in switches.items():
-        monkeypatch.setattr(stepping, name, value)
+        monkeypatch.setattr(snap, name, value)
     _same_path(p, on, fig4_sweeps(p))
     for name in switches:
         with monkeypatch.context() as m:
-            m.setattr(stepping, name, {"SNAP_RHYTHM": True, "NEXT_NODE_LANDING": True,
+            m.setattr(snap, name, {"SNAP_RHYTHM": True, "NEXT_NODE_LANDING": True,
                                        "CYCLE_PROBE_ITER": 8}[name])
             _same_path(p, on, fig4_sweeps(p))
 
@@ -219,7 +219,7 @@ def test_an_aimed_trial_too_far_for_the_predictor_gives_way_to_the_halving(monke
     p = fig4_problem(100)
     ref = fig4_sweeps(p)
     aimed, turned = set(), []
-    aim, accept, crossed, solve = (stepping._SnapRhythm.aim, stepping._accept,
+    aim, accept, crossed, solve = (snap.SnapRhythm.aim, stepping._accept,
                                    stepping.crossed_fold, stepping.solve_complementarity)
 
     def aim_seen(self, d, d_try, min_step, direction):
@@ -243,7 +243,8 @@ def test_an_aimed_trial_too_far_for_the_predictor_gives_way_to_the_halving(monke
             st = dataclasses.replace(st, converged=True, stable=True)
         return st
     monkeypatch.setattr(stepping, "solve_complementarity", solve_aimed_stable)
-    monkeypatch.setattr(stepping._SnapRhythm, "aim", aim_seen)
+    monkeypatch.setattr(snap, "solve_complementarity", solve_aimed_stable)
+    monkeypatch.setattr(snap.SnapRhythm, "aim", aim_seen)
     monkeypatch.setattr(stepping, "_accept", accept_not_aimed)
     monkeypatch.setattr(stepping, "crossed_fold", crossed_not_aimed)
     got = fig4_sweeps(p)
@@ -252,30 +253,32 @@ def test_an_aimed_trial_too_far_for_the_predictor_gives_way_to_the_halving(monke
 
 
 def test_a_resume_with_no_rhythm_reaches_the_same_states():
-    """The rhythm lives in one trace (a resume, a regrid or a widening starts without it):
-    the retract resumed from each of its grid states (the checkpoint's state, its edge
+    """A trace without the rhythm (a regrid, a widening, a resume re-solved without its
+    checkpoint start without it; tests/test_snaphome_resume.py: a checkpoint keeps it):
+    the retract resumed from each of its grid states, its rhythm dropped (its edge
     predictor's point kept) reaches the same folds and grid states as the uninterrupted one
     - the rhythm moves only where trials go, never a fold (the 36 sizes above: rhythm on and
     off the same)."""
     p = fig4_problem(100)
     aimed = []
-    aim = stepping._SnapRhythm.aim
+    aim = snap.SnapRhythm.aim
 
     def aim_seen(self, d, d_try, min_step, direction):
         out = aim(self, d, d_try, min_step, direction)
         aimed.extend([out] if out != d_try else [])
         return out
-    stepping._SnapRhythm.aim = aim_seen
+    snap.SnapRhythm.aim = aim_seen
     try:
         ap, re = fig4_sweeps(p)
     finally:
-        stepping._SnapRhythm.aim = aim
+        snap.SnapRhythm.aim = aim
     assert re.work["lattice_snaps"] == 3 and aimed     # the rhythm aimed on this retract
     from conftest import FIG4_D_VALUES
     from femadh.contact import trace
     d_values = list(FIG4_D_VALUES[::-1])
     for k in range(1, len(re.states) - 1):
-        part = trace(p, d_values[k:], branch="retract", tol=TOL, start=re.states[k])
+        part = trace(p, d_values[k:], branch="retract", tol=TOL,
+                     start=dataclasses.replace(re.states[k], snap_rhythm=None))
         tail = dataclasses.replace(re, states=re.states[k:],
                                    jumps=[j for j in re.jumps if j.d_fold >= re.states[k].d])
         _same_path(p, (part,), (tail,))
@@ -339,12 +342,18 @@ def test_every_next_node_landing_taken_is_a_lattice_snap(monkeypatch):
 
 #: a decision's corrector history on the sigma = 0.489 nm slider's retract (532 nodes, the
 #: micro-fold at 1.2884 nm; validation/results/snap_cost.md): (residual (m), contact nodes,
-#: set unchanged) per iteration - the disk of 73 and 72 nodes in turn from the second
-#: iteration on, each residual repeating to 6e-6 relative from the third
-CYCLE = [(2.6511e-21, 73, False), (1.3992e-15, 72, False), (1.5452737311835257e-15, 73, False),
-         (1.3988823954798885e-15, 72, False), (1.5452641917231115e-15, 73, False),
-         (1.3988824008565625e-15, 72, False), (1.5452641915163163e-15, 73, False),
-         (1.3988823985818158e-15, 72, False)]
+#: set unchanged, the set) per iteration - the disk of 73 and 72 nodes in turn from the
+#: second iteration on, each residual repeating to 6e-6 relative from the third
+def _disk(m, n=532):
+    """The contact disk of m nodes as the corrector's history holds it (bytes)."""
+    return (np.arange(n) < m).tobytes()
+
+
+CYCLE = [(r, m, False, _disk(m)) for r, m in (
+    (2.6511e-21, 73), (1.3992e-15, 72), (1.5452737311835257e-15, 73),
+    (1.3988823954798885e-15, 72), (1.5452641917231115e-15, 73),
+    (1.3988824008565625e-15, 72), (1.5452641915163163e-15, 73),
+    (1.3988823985818158e-15, 72))]
 
 
 def test_a_corrector_going_round_a_cycle_of_contact_sets_is_told():
@@ -352,12 +361,13 @@ def test_a_corrector_going_round_a_cycle_of_contact_sets_is_told():
     while its set still changes is not (a Newton converging as the edge settles), nor one
     whose set stood still at an iteration, nor one alternating between other node counts
     at the same residuals, nor fewer than three rounds."""
-    assert stepping._cycling(CYCLE)
-    falling = [(10.0 ** -(10 + 2 * k), 72 + k % 2, False) for k in range(8)]
-    assert not stepping._cycling(falling)
-    assert not stepping._cycling(CYCLE[:-1] + [(CYCLE[-1][0], 72, True)])
-    assert not stepping._cycling(CYCLE[:-1] + [(CYCLE[-1][0], 71, False)])
-    assert not stepping._cycling(CYCLE[3:])
+    assert snap.cycling(CYCLE)
+    falling = [(10.0 ** -(10 + 2 * k), 72 + k % 2, False, _disk(72 + k % 2))
+               for k in range(8)]
+    assert not snap.cycling(falling)
+    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 72, True, _disk(72))])
+    assert not snap.cycling(CYCLE[:-1] + [(CYCLE[-1][0], 71, False, _disk(71))])
+    assert not snap.cycling(CYCLE[3:])
 
 
 def test_a_decision_not_cut_short_is_the_whole_budgets_solve():
@@ -374,12 +384,12 @@ def test_a_decision_not_cut_short_is_the_whole_budgets_solve():
         full = stepping.solve_complementarity(p, d, w, tol=TOL, max_iter=40, active0=act,
                                               factor=before.lu)
         work = {}
-        got = stepping._decide(p, d, w, TOL, 40, act, before.lu, work)
+        got = snap.decide(p, d, w, TOL, 40, act, before.lu, work)
         assert got.converged == full.converged and got.n_iter == full.n_iter
         assert np.array_equal(got.w, full.w) and np.array_equal(got.active, full.active)
-        probe = min(stepping.CYCLE_PROBE_ITER, full.n_iter)
+        probe = min(snap.CYCLE_PROBE_ITER, full.n_iter)
         assert work["iterations"] == full.n_iter + (0 if full.converged else probe)
         assert "decisions_cycling" not in work
         seen.append((full.converged, full.n_iter))
     assert seen[0] == (False, 40)
-    assert seen[1][0] and seen[1][1] <= stepping.CYCLE_PROBE_ITER
+    assert seen[1][0] and seen[1][1] <= snap.CYCLE_PROBE_ITER

@@ -16,7 +16,7 @@ import os
 import time
 
 import femadh
-from femadh.contact import complementarity, landing, stepping
+from femadh.contact import complementarity, landing, snap, stepping
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "scenes", "paper1_slider_meniscus.toml")
@@ -29,10 +29,10 @@ class Counter:
         self.work = {}
         self.landings, self.land_time = 0, 0.0
         self._orig = (stepping.solve_complementarity, landing.solve_complementarity,
-                      stepping.land)
+                      stepping.land, snap.solve_complementarity)
 
     def __enter__(self):
-        solve, _, land = self._orig
+        solve, _, land, _ = self._orig
 
         def counted_solve(*a, **k):
             stats = k.pop("stats", None)
@@ -57,12 +57,13 @@ class Counter:
 
         stepping.solve_complementarity = counted_solve
         landing.solve_complementarity = counted_solve
+        snap.solve_complementarity = counted_solve
         stepping.land = counted_land
         return self
 
     def __exit__(self, *exc):
-        stepping.solve_complementarity, landing.solve_complementarity, stepping.land = \
-            self._orig
+        (stepping.solve_complementarity, landing.solve_complementarity, stepping.land,
+         snap.solve_complementarity) = self._orig
 
     def row(self):
         w = self.work
@@ -75,7 +76,7 @@ class Compare:
     disk a node or two further (:func:`landing.land_next_node`) and records how far apart
     they are: (d, contact nodes of each, max |w_next - w_descent| (m), energies (J)); and
     the whole-budget corrector next to every fold decision cut short in a cycle
-    (:func:`stepping._decide`): (d, converged, iterations)."""
+    (:func:`snap.decide`): (d, converged, iterations)."""
 
     def __init__(self):
         self.rows = []
@@ -94,7 +95,7 @@ class Compare:
             return st
 
         stepping.land_next_node = compared
-        decide = self._decide = stepping._decide
+        decide = self._decide = snap.decide
 
         def checked(problem, d, w_pred, tol, budget, act, factor, work):
             n0 = work.get("decisions_cycling", 0)
@@ -108,12 +109,12 @@ class Compare:
             return new
 
         self.cycles = []
-        stepping._decide = checked
+        snap.decide = checked
         return self
 
     def __exit__(self, *exc):
         stepping.land_next_node = self._orig
-        stepping._decide = self._decide
+        snap.decide = self._decide
 
 
 def first_trial_problem(sigma="0.488888888889 nm", rel=0.15, start="4 nm"):
@@ -167,8 +168,8 @@ def main():
                     help="run the descent landing next to every next-node landing")
     args = ap.parse_args()
     if args.off:
-        stepping.SNAP_RHYTHM = stepping.NEXT_NODE_LANDING = False
-        stepping.CYCLE_PROBE_ITER = 0
+        snap.SNAP_RHYTHM = snap.NEXT_NODE_LANDING = False
+        snap.CYCLE_PROBE_ITER = 0
     print("load:", os.getloadavg())
     scene, problem = first_trial_problem(args.sigma, args.rel)
     print(f"nodes {problem.grid.n}")

@@ -124,7 +124,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     residual); converged states carry no diagnostics. ``stats`` (dict, optional) accumulates
     the work done: "solves", "iterations", "factorisations" and "stagnated" (solves that
     gave up); with a "history" list in it, each iteration appends (residual (m), active
-    nodes, active set unchanged).
+    nodes, active set unchanged, the active set itself as ``A.tobytes()`` - two sets of one
+    size told apart, :func:`femadh.contact.snap.cycling`).
     """
     K, b = problem.K, problem.contour(d)
     sigma = problem.sigma
@@ -200,7 +201,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             new_A = A
         res = _residual(problem, w, P - pc)
         if stats is not None and "history" in stats:
-            stats["history"].append((res, int(A.sum()), bool(np.array_equal(new_A, A))))
+            stats["history"].append((res, int(A.sum()), bool(np.array_equal(new_A, A)),
+                                     A.tobytes()))
         if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
             factor = (pre if fresh == "krylov" else lu if isinstance(lu, TrailingLU)
                       else (lu, lu_I))

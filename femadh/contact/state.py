@@ -49,6 +49,10 @@ class State:
     #: (:func:`femadh.contact.stepping.edge_set`)
     edge_from: tuple = None
     diagnostics: dict = field(default_factory=dict)
+    #: the stepping's expectation of the next lattice snap as this grid state left it
+    #: (:meth:`femadh.contact.snap.SnapRhythm.snapshot`; None: none recorded): a trace of
+    #: the same branch started from this state goes on with it (a checkpoint keeps it)
+    snap_rhythm: tuple = None
 
     @property
     def h0(self):

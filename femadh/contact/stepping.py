@@ -41,18 +41,13 @@ contact's snap (jump-in, pull-off) releases ~150x it and is a jump. A trial step
 gives up when it stagnates (the smallest step's, which decides a fold, has its whole budget).
 
 A contact unzipping node by node near a pull-off (issue 21) makes a micro-fold of every node
-it releases. Three things keep that cheap; measured on the Fig 4 disk at 50, 60, ..., 400
-nodes and on the 532-node slider (validation/results/snap_cost.md) they move no fold off
-its lattice point and no state's contact set, and the surfaces agree with the old path's to
-1e-18 m (the polishes stop at different iterates within the tolerance): a single node's
-snap is landed first by the corrector from the disk a node or two further
-(:func:`femadh.contact.landing.land_next_node`, taken only where it is plainly the
-descent's landing, a lattice snap, and the branch goes on from it for
-NEXT_NODE_HOLD_STEPS resolution steps: beside a pull-off the corrector can find a
-metastable state one node in where the descent leaves the contact); after a lattice snap a
-fold's decision that goes round a cycle of contact sets (m <-> m - 1) is turned down after
-CYCLE_PROBE_ITER iterations, not the whole budget (:func:`_decide`); and after three snaps
-in a rhythm the next is expected one spacing past the last (:class:`_SnapRhythm`).
+it releases; what keeps that cheap - the next snap expected from the rhythm of the last, a
+fold's decision cut short where the corrector cycles between contact sets, a single node's
+snap landed by the corrector - lives in :mod:`femadh.contact.snap`. Measured on the Fig 4
+disk at 50, 60, ..., 400 nodes and on the 532-node slider (validation/results/snap_cost.md)
+they move no fold off its lattice point and no state's contact set, and the surfaces agree
+with the old path's to 1e-18 m (the polishes stop at different iterates within the
+tolerance).
 """
 from dataclasses import dataclass, field
 import math
@@ -64,6 +59,7 @@ from ..errors import ConvergenceError
 from .complementarity import STALL_ITER, solve_complementarity, tangent
 from .linalg import disk_size
 from .landing import land, land_next_node
+from . import snap
 
 #: smallest continuation step, as a fraction of the grid step (fold located to this resolution)
 MIN_STEP_FRACTION = 2.0**-10
@@ -379,180 +375,25 @@ class _Bracket:
         return a + self.dir * (n // 2) * h
 
 
-#: a contact unzipping node by node (issue 21): after three lattice snaps in a rhythm the next
-#: one is expected as far past the last as the last was past the one before
-#: (:class:`_SnapRhythm`);
-#: the first trial aims SNAP_MARGIN resolution steps short of it, then the branch is crept
-#: one resolution step at a time (each the decision of a fold, whole budget: 1-2 iterations
-#: while the branch continues) until SNAP_CREEP steps past it, where the doubling resumes.
-#: Measured on the sigma = 0.489 nm, p/psat 0.15 slider's retract (532 nodes, the grid step
-#: 1.2 -> 1.4 nm, validation/results/snap_cost.md): 85 nodes released at folds 28, 28, 26, 25,
-#: 23, ... 3, 2, 1 resolution steps apart, each found by doubling and bisection in ~10 solves
-SNAP_RHYTHM = True
-SNAP_MARGIN, SNAP_CREEP = 2, 4
-#: ... only while the snaps are at most this many resolution steps apart (a rhythm, not two
-#: snaps far apart on the branch)
-SNAP_RHYTHM_MAX = 128
-#: a single node's snap landed first by the corrector from the disk moved by a node or two
-#: (:func:`femadh.contact.landing.land_next_node`), the energy descent only where that fails
-#: or is not plainly the descent's landing
-NEXT_NODE_LANDING = True
-
-
-class _SnapRhythm:
-    """Where the next lattice snap of a contact unzipping node by node is expected.
-
-    Records the last three lattice-snap folds (the last stable separations before them, m);
-    where their two distances (in resolution steps) agree within a factor of 2 (a rhythm;
-    measured on the Fig 4 disk at 90 nodes: snaps 261, 88, 59 and 31 steps apart, the
-    first pair 3x apart is none, the later ones are; at 100 nodes 58 and 36 steps apart,
-    a rhythm that aims at a fourth snap which does not come: the pull-off), the last
-    distance s predicts the next fold at F + s past
-    the last one F. :meth:`aim` bends a trial outside a fold's bracket to that prediction: first to
-    SNAP_MARGIN steps short of it, then one resolution step at a time up to SNAP_CREEP steps
-    past it (the fold is then located by a decision solve one step past its last stable
-    lattice point - the same point the doubling and bisection find on a connected branch
-    piece, in fewer and cheaper solves). Cleared by a jump or the halving fallback; its aim
-    is dropped when the aimed trial is too far for the predictor (:meth:`forget_aim`). Not
-    kept beyond one trace (a checkpoint stores no rhythm): a resume, a regrid or a widening
-    starts without it, which moves only where trials go - the retract resumed from each
-    grid state reaches the same folds and states (tests/test_snap_cost.py), though not
-    always to the last bit (another path of trials)."""
-
-    def __init__(self):
-        self.clear()
-
-    def clear(self):
-        self.folds, self.target, self.creep_to = [], None, None
-
-    def snapped(self, d_fold, min_step, direction):
-        """A lattice snap whose departing branch was last stable at ``d_fold`` (m)."""
-        self.folds = (self.folds + [d_fold])[-3:]
-        self.target = self.creep_to = None
-        if len(self.folds) < 3:
-            return
-        s0, s = (int(round((b - a) * direction / min_step))
-                 for a, b in zip(self.folds, self.folds[1:]))
-        if 1 <= s <= SNAP_RHYTHM_MAX and 0.5 * s0 <= s <= 2 * s0:
-            self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step
-            self.creep_to = d_fold + direction * (s + SNAP_CREEP) * min_step
-
-    def forget_aim(self):
-        """The aimed trial was turned down as too far for the predictor: no aim until the
-        next snap (the halving takes over; the snaps seen are kept)."""
-        self.target = self.creep_to = None
-
-    def aim(self, d, d_try, min_step, direction):
-        """The trial separation from the state at ``d`` instead of ``d_try`` (m): the
-        expected fold's lattice point short of it, the next resolution step while creeping
-        past it, else ``d_try`` (the rhythm is then forgotten)."""
-        if self.target is None:
-            return d_try
-        ahead = int(round((self.target - d) * direction / min_step))
-        if ahead >= 1:
-            # straight to the lattice point short of the expected fold (the step after a
-            # landing would be the smallest, doubled from there)
-            return d + direction * ahead * min_step
-        if (self.creep_to - d) * direction > 0.5 * min_step:
-            return d + direction * min_step
-        self.target = self.creep_to = None
-        return d_try
-
-
-#: a fold's decision solve (the smallest step, whole budget) is first run for this many
-#: corrector iterations; one that has not converged by then and whose last iterations go
-#: round a cycle of contact sets (:func:`_cycling`) is decided there as turned down (else the
-#: whole budget from the start: the same solve as without the probe). Measured on the
-#: sigma = 0.489 nm slider's retract (validation/results/snap_cost.md): every decision that
-#: turned a micro-fold down alternated between the disk of m and of m - 1 nodes from its
-#: second iteration to its 40th (the edge node tensile on m, below sigma on m - 1), the
-#: residual of each set repeating to 6e-6 relative or closer from the third iteration on (to
-#: the last bit in some); the whole budget run beside every decision cut short converged at none
-#: (snap_cost.md). Only after a lattice snap since the last jump or fallback (a contact
-#: unzipping): a turned-down decision elsewhere (a jump-in, a pull-off with no snap before
-#: it) runs its whole budget without a cycle and the probe's iterations would be spent
-#: again. The pull-off that ends an unzipping is probed too, and pays them again (its
-#: decision does not cycle). 0: no probe
-CYCLE_PROBE_ITER = 8
-#: ... the cycle's length in iterations (a node in and out of the contact)
-CYCLE_PERIOD = 2
-#: ... and how closely the residual of an iteration must repeat the one CYCLE_PERIOD before
-#: it (relative; measured 6e-6 at most on the cycles above, 4e-9 to 1e-7 on most, while a
-#: corrector on its way to converge cuts its residual by orders of magnitude per iteration)
-CYCLE_RTOL = 1e-3
-
-
-#: a single node's snap landed by the corrector (:func:`land_next_node`) is kept only where the
-#: branch goes on from it for this many resolution steps (each a stable state accepted as a
-#: healthy smallest step); else the energy descent lands it. The descent can leave the
-#: contact from the same start (a pull-off) where the corrector found a stable state one
-#: node in, downhill of the start and a lattice snap by its energy - a metastable state
-#: beside its own fold. Measured on the Fig 4 disk (tests/test_snap_cost.py): at 110, 200
-#: and 270 nodes the candidate's branch ended at the very next resolution step (the fold
-#: moved by one step, F_ex before it by up to 5.4 %); on 50..400 nodes every candidate
-#: that held for 2 steps was the descent's landing
-NEXT_NODE_HOLD_STEPS = 2
-
-
-def _next_node_holds(problem, landed, d_land, min_step, direction, tol, max_iter, work):
-    """True if the branch continues from the next-node landing ``landed`` (at ``d_land``, m)
-    for NEXT_NODE_HOLD_STEPS resolution steps ``min_step`` (m) in ``direction``: each a
-    converged stable state close to its prediction that releases no more than the lattice
-    bound (the test of a healthy smallest step). Its solves are added to ``work``; none of
-    their states is kept (the sweep goes on from ``landed`` as before)."""
-    st, g = landed, total_force(problem, landed)
-    t = _tangent(problem, st)
-    for k in range(1, NEXT_NODE_HOLD_STEPS + 1):
-        d = d_land + direction * k * min_step
+def _smallest_step(problem, tol, max_iter, work):
+    """The healthy smallest step that :func:`femadh.contact.snap.next_node_holds` takes from
+    a next-node landing: a callable ((state, G (N), tangent), d (m)) -> the same at d, or
+    None unless the corrector converged to a stable state close to its prediction that
+    releases no more than the lattice bound (:func:`_accept`, :func:`crossed_fold` with
+    FOLD_ENERGY_SHARE_MIN_STEP). Its solves are added to ``work``."""
+    def step(at, d):
+        st, g, t = at
         w_pred, act = _predict(problem, st, d, t)
         new = solve_complementarity(problem, d, w_pred, tol=tol, max_iter=max_iter,
                                     active0=act, factor=st.lu, stall_iter=STALL_ITER,
                                     stats=work)
         if not _accept(new, w_pred, d, problem, act):
-            return False
+            return None
         g_new = total_force(problem, new)
         if crossed_fold(problem, st, new, g, g_new, FOLD_ENERGY_SHARE_MIN_STEP):
-            return False
-        st, g, t = new, g_new, _tangent(problem, new)
-    return True
-
-
-def _decide(problem, d, w_pred, tol, budget, act, factor, work):
-    """The decision solve at the smallest step: the corrector with the whole ``budget``,
-    cut short after CYCLE_PROBE_ITER iterations where it cycles (:func:`_cycling`); the
-    work of both attempts is added to ``work``."""
-    probe = {"history": []}
-    new = solve_complementarity(problem, d, w_pred, tol=tol,
-                                max_iter=min(budget, CYCLE_PROBE_ITER), active0=act,
-                                factor=factor, stall_iter=None, stats=probe)
-    for key in ("solves", "iterations", "factorisations", "stagnated"):
-        work[key] = work.get(key, 0) + probe.get(key, 0)
-    if new.converged or budget <= CYCLE_PROBE_ITER:
-        return new      # the very solve the whole budget runs (nothing else depends on it)
-    if _cycling(probe["history"]):
-        work["decisions_cycling"] = work.get("decisions_cycling", 0) + 1
-        return new
-    return solve_complementarity(problem, d, w_pred, tol=tol, max_iter=budget, active0=act,
-                                 factor=factor, stall_iter=None, stats=work)
-
-
-def _cycling(history):
-    """True if the corrector's last 3 CYCLE_PERIOD iterations go round one cycle three
-    times: each with the contact nodes and, to CYCLE_RTOL, the residual of the iteration
-    CYCLE_PERIOD before it, the contact set changing at every one of them - a node let go
-    and taken back, its residual not falling (the first two iterations, from the
-    prediction, are not on the cycle: CYCLE_PROBE_ITER = 8 sees it three times).
-    ``history``: (residual (m), contact nodes, set unchanged) per iteration
-    (:func:`solve_complementarity`'s stats)."""
-    n = 2 * CYCLE_PERIOD
-    if len(history) < n + CYCLE_PERIOD:
-        return False
-    last = history[-n - CYCLE_PERIOD:]
-    if any(same for _, _, same in last):
-        return False
-    return all(last[i][1] == last[i + CYCLE_PERIOD][1]
-               and abs(last[i][0] - last[i + CYCLE_PERIOD][0]) <= CYCLE_RTOL * last[i][0]
-               for i in range(n))
+            return None
+        return new, g_new, _tangent(problem, new)
+    return step
 
 
 def _tangent(problem, state):
@@ -703,7 +544,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
     # snap on their own and the states depend on the path (no stagnation exit there)
     trapped = problem.surface_force_stiffness()[0] >= 1.0
     t_state = _tangent(problem, state)
-    rhythm = _SnapRhythm()
+    # the rhythm of the trace this one resumes (a checkpoint's state of this branch), else
+    # fresh; the start itself is left as it came
+    rhythm = snap.SnapRhythm.restored(state.snap_rhythm, branch)
     for k, d_next in enumerate(d_values[1:], start=1):
         grid_step = d_next - state.d
         step = grid_step
@@ -742,10 +585,10 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 exc.sweep = sweep
                 raise exc
             solves_here += 1
-            aimed = False       # the trial is the rhythm's (:meth:`_SnapRhythm.aim`)
+            aimed = False       # the trial is the rhythm's (:meth:`snap.SnapRhythm.aim`)
             if fold.far is None or halving:
                 d_try = state.d + step
-                if SNAP_RHYTHM and not halving:
+                if snap.SNAP_RHYTHM and not halving:
                     plain = d_try
                     d_try = rhythm.aim(state.d, d_try, min_step, math.copysign(1.0, grid_step))
                     aimed = d_try != plain
@@ -781,9 +624,9 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 stall = None if smallest or trapped else STALL_ITER
                 budget = max_iter if smallest or trapped or TRIAL_MAX_ITER is None \
                     else min(max_iter, TRIAL_MAX_ITER)
-                if smallest and not trapped and CYCLE_PROBE_ITER and rhythm.folds:
-                    new = _decide(problem, d_try, w_pred, tol, budget, act, state.lu,
-                                  sweep.work)
+                if smallest and not trapped and snap.CYCLE_PROBE_ITER and rhythm.folds:
+                    new = snap.decide(problem, d_try, w_pred, tol, budget, act, state.lu,
+                                      sweep.work)
                 else:
                     new = solve_complementarity(problem, d_try, w_pred, tol=tol,
                                                 max_iter=budget, active0=act,
@@ -863,11 +706,11 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                 d_try = fold.far
             # Fold: no stable state continues the branch beyond state.d.
             landed = None
-            if NEXT_NODE_LANDING and not halving:
+            if snap.NEXT_NODE_LANDING and not halving:
                 # a node snapping across the lattice: the corrector from the disk a node or
                 # two further (the way the edge goes: it recedes on a retract), used only if
                 # it is plainly the descent's landing, a lattice snap, and the branch goes
-                # on from it (:func:`_next_node_holds`: else it may be a metastable state
+                # on from it (:func:`snap.next_node_holds`: else it may be a metastable state
                 # one node in where the descent pulls off)
                 n0 = sweep.work.get("solves", 0)
                 near = land_next_node(problem, d_try, state,
@@ -875,9 +718,10 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
                                       stall_iter=STALL_ITER)
                 if near is not None and lattice_snap(problem, state, near, g_state,
                                                      total_force(problem, near)):
-                    if _next_node_holds(problem, near, d_try, min_step,
-                                        math.copysign(1.0, grid_step), tol, max_iter,
-                                        sweep.work):
+                    if snap.next_node_holds(
+                            (near, total_force(problem, near), _tangent(problem, near)),
+                            d_try, min_step, math.copysign(1.0, grid_step),
+                            _smallest_step(problem, tol, max_iter, sweep.work)):
                         landed = near
                         sweep.work["next_node_landings"] = \
                             sweep.work.get("next_node_landings", 0) + 1
@@ -936,6 +780,8 @@ def _trace(sweep, problem, d_values, *, branch, tol, start, max_iter, on_state, 
             state, g_state = landed, g_landed
             t_state = _tangent(problem, state)
             fold.restart(state, t_state, problem)
+        # the rhythm as this grid state leaves it: a trace resumed from it goes on with it
+        state.snap_rhythm = rhythm.snapshot(branch)
         sweep.states.append(state)
         if on_state:
             on_state(state)

@@ -1,5 +1,7 @@
 """Resuming a contact run: where its committed rows end (every file checked first) and the
 checkpoint that lets a stopped sweep continue bit for bit."""
+import math
+
 import numpy as np
 
 from ..contact import State
@@ -55,6 +57,7 @@ def save_checkpoint(folder, sink):
             "effects": np.array(list(st.p_effects))}
     if st.edge_from is not None:        # the edge predictor's second point (stepping)
         data["edge_from"] = np.array(st.edge_from, dtype=float)
+    data.update(_rhythm_data(st.snap_rhythm))
     data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
     data.update(_fold_data(sink))
     lu = st.lu
@@ -113,9 +116,32 @@ def load_checkpoint(folder, k, d):
             if "edge_from" in z.files:
                 d_p, m_p = (float(x) for x in z["edge_from"])
                 st.edge_from = (d_p, int(m_p))
+            st.snap_rhythm = _rhythm_read(z)
             return st
     except (OSError, ValueError, KeyError):
         return None
+
+
+def _rhythm_data(snapshot):
+    """The stepping's snap rhythm as the state left it
+    (:meth:`~femadh.contact.snap.SnapRhythm.snapshot`: branch, the last lattice-snap folds
+    (m), the aimed target and creep end (m, NaN for none)) as arrays; none for None."""
+    if snapshot is None:
+        return {}
+    branch, folds, target, creep_to = snapshot
+    return {"snap_branch": np.array(branch), "snap_folds": np.array(folds, dtype=float),
+            "snap_aim": np.array([math.nan if x is None else x for x in (target, creep_to)],
+                                 dtype=float)}
+
+
+def _rhythm_read(z):
+    """The snapshot :func:`_rhythm_data` wrote, or None (a checkpoint of an older femadh:
+    the resumed trace starts with a fresh rhythm, as it did then)."""
+    if "snap_folds" not in z.files:
+        return None
+    target, creep_to = (None if math.isnan(x) else float(x) for x in z["snap_aim"])
+    return (str(z["snap_branch"]), tuple(float(x) for x in z["snap_folds"]), target,
+            creep_to)
 
 
 def _fold_data(sink):
