@@ -48,11 +48,19 @@ POINTS = [
     (0.489, 0.15, 5.25, 1.567073e-4, "1772-node trial, converged: +- 1.36e-7 N (8.7e-4)"),
 ]
 #: family members h0 / sqrt2^j, j = 0..LEVELS-1
-LEVELS = 7
-#: half-width and grading of the edge grids in units of h0 (fixed across a family)
-HALF, GRADING = 24, 8
-#: the analysis radius covers the runner's down to this fraction of the fold's edge radius
-LOW = 0.9
+LEVELS = 5
+#: half-width and grading of the edge grids in units of h0 (fixed across a family). The
+#: grading sets the spacing at the meniscus edge, microns out in the graded far field: at
+#: 8 h0 its lattice (the edge crossing the scaled grid's coarse nodes as c moves) made the
+#: members' differences erratic (sigma = 0.3 nm, p/psat 0.55: successive difference ratios
+#: 1.76, 1.17, 2.13; 0.85: -189, -0.22, -0.61, on 155-618 nodes), at 32 h0 they are 2.00,
+#: 2.00, 2.00 and 2.01, 2.00, 2.00 (386-1542 nodes; the values agree to 3e-5 and 1e-6)
+HALF, GRADING = 24, 32
+#: the analysis radius covers the runner's down to this fraction of the pilot's fold edge
+#: radius (the family's fold may lie lower: with the far field graded at 8 h0 the meniscus
+#: edge's lattice puts wiggles of ~30 % into dd/dc, and the fold's c moves by up to ~15 %
+#: between grids where d(c) is flat - measured at sigma = 0.489 nm, p/psat 0.65)
+LOW = 0.5
 
 
 def scene_at(sigma_nm, rel):
@@ -62,7 +70,7 @@ def scene_at(sigma_nm, rel):
 
 
 def branch_on(scene, c_ref, h, h0, a0):
-    g, k = edge_grid(a0, c_ref, h, HALF * h0, GRADING * h0)
+    g, k = edge_grid(a0, c_ref, h, HALF * h0, GRADING * h0, max_nodes=20000)
     op = GreenOperator(g, scene.body.e_star)
     return SigmaEdgeBranch(op, k, scene.sphere, scene.effects, scene.gap, scene.tolerance)
 
@@ -82,11 +90,21 @@ def trace(scene, c_ref, h, h0, a0, a_run, c_fold_hint, c_high):
     return br, res, time.perf_counter() - t0
 
 
+#: observed orders accepted for the extrapolation (the branch converges at 2: measured 2.00
+#: on every clean family); outside, the finest member is kept and its error bounded by
+#: GUARD times the last difference
+ORDER_RANGE, GUARD = (1.5, 2.5), 2.0
+
+
 def richardson(h, F):
-    """Observed order and extrapolation from the last three of F(h) (ratio sqrt2)."""
+    """(observed order, extrapolation, error estimate of the finest member) from the last
+    three of F(h) (ratio sqrt2); an order outside ORDER_RANGE: the finest member itself and
+    GUARD x its difference from the next coarser."""
     f1, f2, f3 = F[-3:]
     r = h[-2] / h[-1]
-    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r)
+    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r) if f2 != f3 else math.inf
+    if not ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
+        return p, f3, GUARD * abs(f3 - f2)
     ext = f3 + (f3 - f2) / (r ** p - 1)
     return p, ext, abs(f3 - ext)
 
@@ -197,6 +215,16 @@ def point(sigma_nm, rel, h0_nm, runner_value, runner_note, out):
     ratios = [(Fs[i] - Fs[i + 1]) / (Fs[i + 1] - Fs[i + 2]) for i in range(LEVELS - 2)]
     out.append("Successive difference ratios (sqrt2^p; 1.41 = first order, 2 = second): "
                + ", ".join(f"{x:.3f}" for x in ratios) + ".")
+    # the estimate of a coarser triple against its finest member's actual error (the
+    # finest triple's extrapolation as the truth): the effectivity a loop stopping there has
+    eff = []
+    for j in range(LEVELS - 3):
+        _, e_j, err_j = richardson(hs[:j + 3], Fs[:j + 3])
+        actual = abs(Fs[j + 2] - ext)
+        eff.append(f"h = {hs[j + 2] * 1e9:.3g} nm: estimated {err_j / ext:.1e}, actual "
+                   f"{actual / ext:.1e} (effectivity {err_j / actual:.2f})")
+    out.append("Richardson of the coarser triples (estimate of their finest member against "
+               "its error from the finest extrapolation): " + "; ".join(eff) + ".")
     if runner_value is not None:
         out.append(f"The runner: {runner_value:.6e} N ({runner_note}): "
                    f"{(runner_value - ext) / ext:+.2e} relative to the extrapolation.")
@@ -236,6 +264,123 @@ def point(sigma_nm, rel, h0_nm, runner_value, runner_note, out):
             "F": Fs, "h": hs, "fold": extf}
 
 
+#: the map's axes (validation/stiction_map.py's MAP)
+MAP_SIGMA = np.linspace(0.3, 2.0, 10)
+MAP_REL = np.linspace(0.05, 0.95, 10)
+#: the map scan's family: pilot spacing at c = 1 um, members h0 / sqrt2^j, j < MAP_LEVELS
+MAP_H0, MAP_LEVELS = 4e-9, 3
+
+
+def runner_map(path=RESULTS / "stiction_map.md"):
+    """The runner's max adhesion / 4 pi R gamma from stiction_map.md's table, by (sigma nm
+    rounded to 2 decimals, p/psat rounded to 2), nan where it failed."""
+    out, sig = {}, None
+    for line in path.read_text().splitlines():
+        if line.startswith("| p/psat"):
+            sig = [float(x) for x in line.split("|")[2:-1]]
+        elif sig and line.startswith("| 0."):
+            cells = line.split("|")[1:-1]
+            rel = float(cells[0])
+            for s_, v in zip(sig, cells[1:]):
+                out[round(s_, 2), round(rel, 2)] = float(v)
+    return out
+
+
+def map_point(sigma_nm, rel):
+    """One map point by the edge branch: a pilot at c = 1 um (h MAP_H0, analysis radius
+    20 a_run: the runner's disk down to c = 0.05 um), then MAP_LEVELS members at c*.
+    Returns a dict (or the reason it could not)."""
+    scene = scene_at(sigma_nm, rel)
+    a_run = scene.discretisation.analysis_radius
+    t0 = time.perf_counter()
+    try:
+        _, pil, _ = trace(scene, 1e-6, MAP_H0, MAP_H0, 20 * a_run, a_run, 0.05e-6 / LOW,
+                          8e-6)
+        c_star, c_fold = pil.best.c, pil.fold.c
+        a0 = a_run * c_star / (LOW * c_fold)
+        hs, Fs, nodes, worst = [], [], [], [math.inf, math.inf]
+        for j in range(MAP_LEVELS):
+            h = MAP_H0 / math.sqrt(2) ** j
+            br, r, _ = trace(scene, c_star, h, MAP_H0, a0, a_run, c_fold, 3 * c_star)
+            hs.append(h)
+            Fs.append(r.max_adhesion)
+            nodes.append(br.n)
+            worst = [min(worst[0], r.worst_complementarity[0]),
+                     min(worst[1], r.worst_complementarity[1])]
+        p, ext, err = richardson(hs, Fs)
+    except Exception as exc:          # the point's reason, kept for the table
+        text = str(exc)
+        kind = "no fold" if "no fold of d(c)" in text else "failed"
+        if kind == "no fold":
+            text = (f"no fold at c >= {float(text.split('above c = ')[1].split(' m')[0]) * 1e6:.3f}"
+                    " um (the contact shrinks without a jump)")
+        return {"reason": f"{type(exc).__name__}: {text}"[:160] if kind == "failed" else text,
+                "kind": kind, "time": time.perf_counter() - t0}
+    return {"F": ext, "err": err / ext, "order": p, "c_star": c_star, "c_fold": c_fold,
+            "d_star": r.best.d, "at_fold": r.at_fold, "nodes": nodes, "worst": worst,
+            "time": time.perf_counter() - t0}
+
+
+def map_scan(out):
+    """The whole stiction map by the edge branch, against the runner's map."""
+    ref = runner_map()
+    t0 = time.perf_counter()
+    rows = []
+    for s_ in MAP_SIGMA:
+        for rel in MAP_REL:
+            r = map_point(round(float(s_), 4), round(float(rel), 2))
+            rows.append((float(s_), float(rel), r))
+            print(f"  map sigma {s_:.3f} rel {rel:.2f}: "
+                  + (f"{r['F']:.6e} ({r['err']:.1e}, {r['time']:.1f} s)" if "F" in r
+                     else r["reason"]), file=sys.stderr)
+    wall = time.perf_counter() - t0
+    scene = scene_at(0.3, 0.95)
+    norm = 4 * math.pi * scene.sphere.radius * scene.effects["capillary"].surface_tension
+    ok = [r for *_, r in rows if "F" in r]
+    out.append("\n## The whole stiction map by the edge branch\n")
+    out.append(f"Each point: a pilot at c = 1 um (h = {MAP_H0 * 1e9:g} nm), then "
+               f"{MAP_LEVELS} members h = {MAP_H0 * 1e9:g} nm / sqrt2^j at c* and Richardson "
+               f"from the three finest (as above). One process: **{wall:.0f} s for "
+               f"{len(rows)} points** ({len(ok)} traced; the runner's map: 639.9 s on 2 "
+               f"processes, 10 refused or failed). Columns: the branch's max adhesion / "
+               f"4 pi R gamma (Richardson), its estimated relative error, the runner's map "
+               f"value (3 digits, stiction_map.md) and their relative difference, the "
+               f"observed order, c* and the fold's c, whether the largest force is the fold's, "
+               f"the worst multiplier / max and free gap - sigma (sigma) on the branch, "
+               f"nodes, seconds.\n")
+    nofold = [r for *_, r in rows if r.get("kind") == "no fold"]
+    failed = [r for *_, r in rows if r.get("kind") == "failed"]
+    diffs = [abs(ref.get((round(s_, 2), round(rel, 2)), math.nan) * norm - r["F"]) / r["F"]
+             for s_, rel, r in rows if "F" in r]
+    diffs = [x for x in diffs if math.isfinite(x)]
+    out.append(f"Traced: {len(ok)} points, largest estimated relative error "
+               f"{max(r['err'] / r['F'] for r in ok):.1e} (median "
+               f"{float(np.median([r['err'] / r['F'] for r in ok])):.1e}), "
+               f"{sum(r['time'] for r in ok):.0f} s in all; against the runner's 3-digit "
+               f"values where it has one ({len(diffs)} points): largest difference "
+               f"{max(diffs):.1e} relative (the table's rounding: up to 5e-4 / value). "
+               f"No fold of d(c) above the pilot's smallest edge radius: {len(nofold)} points "
+               f"(the contact shrinks to nothing without a jump, DMT's side; the largest "
+               f"force is then where the contact vanishes or on the separated branch, which "
+               f"this continuation does not trace). Other failures: {len(failed)}.\n")
+    out.append("| sigma (nm) | p/psat | branch | est. rel. error | runner | diff | order | "
+               "c* (um) | c_fold (um) | max at fold | worst p / max | worst gap | nodes | s |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for s_, rel, r in rows:
+        rv = ref.get((round(s_, 2), round(rel, 2)), math.nan)
+        if "F" not in r:
+            out.append(f"| {s_:.3f} | {rel:.2f} | {r['reason']} | | {rv:.3f} | | | | | | | | "
+                       f"| {r['time']:.1f} |")
+            continue
+        f = r["F"] / norm
+        out.append(f"| {s_:.3f} | {rel:.2f} | {f:.4f} | {r['err']:.1e} | {rv:.3f} | "
+                   f"{(rv - f) / f:+.1e} | {r['order']:.2f} | {r['c_star'] * 1e6:.3f} | "
+                   f"{r['c_fold'] * 1e6:.3f} | {r['at_fold']} | {r['worst'][0]:.3f} | "
+                   f"{r['worst'][1]:.2g} | {r['nodes'][0]}-{r['nodes'][-1]} | "
+                   f"{r['time']:.1f} |")
+    return rows
+
+
 def main():
     import os
 
@@ -259,6 +404,8 @@ def main():
         out.append(f"| {r['sigma']} | {r['rel']} | {r['ext']:.6e} | {r['err'] / r['ext']:.1e} "
                    f"| {r['total']:.1f} | {r['nodes'][0]}-{r['nodes'][-1]} | "
                    f"{now[r['rel']]} |")
+    if "--points-only" not in sys.argv:
+        map_scan(out)
     RESULTS.mkdir(exist_ok=True)
     text = "\n".join(out) + "\n"
     (RESULTS / "sigma_edge.md").write_text(text)
