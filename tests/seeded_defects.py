@@ -1625,6 +1625,10 @@ DEFECTS = [
     D("sedge_held_gap", "sigma-edge branch: the held nodes' displacement without sigma",
       "femadh/contact/sigma_edge.py",
       (("        w[:k + 1] = d + shape[:k + 1] - sigma\n", "        w[:k + 1] = d + shape[:k + 1]\n"),)),
+    D("sedge_homotopy_guard", "sigma-edge start: the homotopy's states taken without "
+      "complementarity", "femadh/contact/sigma_edge.py",
+      (("            if trial is None or not branch.complementary(trial):",
+        "            if trial is None:"),)),
     D("sedge_hertz_guess", "sigma-edge: Hertz's start with the contact's interference doubled",
       "femadh/contact/sigma_edge.py",
       (("    delta = c * c / R\n    d = branch.sigma - delta\n",
