@@ -388,8 +388,8 @@ def map_point(sigma_nm, rel):
         text = str(exc)
         kind = "no fold" if "no fold of d(c)" in text else "failed"
         if kind == "no fold":
-            text = (f"no fold at c >= {float(text.split('above c = ')[1].split(' m')[0]) * 1e6:.3f}"
-                    " um (the contact shrinks without a jump)")
+            c_min = float(text.split("above c = ")[1].split(" m")[0])
+            text = f"no fold at c >= {c_min * 1e6:.3f} um (the contact shrinks without a jump)"
         return {"reason": f"{type(exc).__name__}: {text}"[:160] if kind == "failed" else text,
                 "kind": kind, "time": time.perf_counter() - t0}
     return {"F": ext, "err": err / ext, "order": p, "c_star": c_star, "c_fold": c_fold,

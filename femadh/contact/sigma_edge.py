@@ -28,13 +28,14 @@ need a tensile p_c < 0, one < 0 a gap below sigma just outside), p_c ~ (c - r)^1
 state with h_k = sigma and p_c,k = 0 solves the collocation problem with node k held *and*
 with node k free (its free-node equation is row k; its gap is at the bound): it is the state
 where the fixed-grid branch releases node k, the junction of two of its pieces, so every
-state of this branch is a solution of the runner's equations on its scaled grid (checked:
-:meth:`SigmaEdgeBranch.check`), with complementarity holding as long as p_c,i >= 0 for
-i < k and h_i > sigma for i > k; (iii) it leaves a square, regular system (the Jacobian
-below is the free block of K + diag(P') bordered by the d column: the system of the edge
-branch with the edge node's gap pinned at sigma). Pinning another quantity (a gap of the
-first free node, a multiplier p_c,k > 0) gives states that are not the fixed grid's junctions
-and carry a lattice offset of their own.
+state of this branch is a solution of the runner's equations on its scaled grid (checked by
+tests/test_sigma_edge.py and validation/sigma_edge.py: residual, the runner's Newton and
+stability test), with complementarity holding as long as p_c,i >= 0 for i < k and
+h_i > sigma for i > k (:meth:`SigmaEdgeBranch.complementarity`); (iii) it leaves a square,
+regular system (the Jacobian below is the free block of K + diag(P') bordered by the d
+column: the system of the edge branch with the edge node's gap pinned at sigma). Pinning
+another quantity (a gap of the first free node, a multiplier p_c,k > 0) gives states that
+are not the fixed grid's junctions and carry a lattice offset of their own.
 
 The force is F_ex = sum_i area_i (P_i - p_c,i) (attractive positive, as the runner's F_ex;
 areas lambda^2 area^0). A law integrated sub-grid (:mod:`femadh.contact.subgrid`, the
@@ -43,9 +44,11 @@ invariant under the scaling (both scale like lambda^2): the reference problem's 
 pressure and law Jacobian serve every scaled grid.
 
 On the retract the contact radius decreases monotonically from deep contact to the
-displacement-controlled pull-off, the fold of d(c) (dd/dc = 0): the branch is traced by
-plain Newton in c with :class:`~femadh.contact.edge_branch.BranchTrace` (its march, its
-fold as the root of dd/dc, its parabolic search of the largest force).
+displacement-controlled pull-off, the fold of d(c) (dd/dc = 0; measured at every point of
+the stiction map where d(c) has a fold, validation/results/sigma_edge.md: no turning point
+of c, complementarity with margin on every state): the branch is traced by plain Newton in
+c with :class:`~femadh.contact.edge_branch.BranchTrace` (its march, its fold as the root of
+dd/dc, its parabolic search of the largest force).
 """
 from dataclasses import dataclass
 import math
@@ -170,7 +173,7 @@ class SigmaEdgeBranch:
         """The state with its edge on node k at c (m) from the guess (w0 on all nodes, d0):
         Newton, steps limited so that no free gap closes by more than GAP_CLOSURE of itself.
         Returns a SigmaEdgeState, or None if Newton did not converge in MAX_ITER."""
-        k, n = self.k, self.n
+        k = self.k
         lam = c / self.r0
         wf, d = np.array(w0[k + 1:], float), float(d0)
         self.n_solves += 1
@@ -300,8 +303,9 @@ def hertz_guess(branch, c):
 def tail_between(effects, sphere, d, a1, a2):
     """Force (N, attractive positive) of the laws on the undeformed paraboloid between radii
     a1 < a2 (m): 2 pi R int_{h1}^{h2} P dh = 2 pi R (U(h2) - U(h1)) with h = d + shape(a)
-    (P = dU/dh, attractive positive), i.e. :func:`femadh.contact.forces.tail_force`'s integral between two
-    analysis radii (what a scaled grid's disk holds beyond the runner's)."""
+    (P = dU/dh, attractive positive), i.e. :func:`femadh.contact.forces.tail_force`'s
+    integral between two analysis radii (what a scaled grid's disk holds beyond the
+    runner's)."""
     R = sphere.radius
     h = np.array([d + sphere.shape(a1), d + sphere.shape(a2)])
     u = sum(np.asarray(e.energy(h), float) for e in effects.values())
