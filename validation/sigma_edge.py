@@ -82,16 +82,19 @@ one per node; the checks above show each is the runner's state on its own grid (
 below the runner's 1e-19 m, the runner's Newton from it converges at once without moving it,
 the runner's stability test passes, complementarity with margin). On a fixed grid the runner's
 states between junctions lie below the branch by the lattice sawtooth (tests: 1.3e-3 - 3e-3 on
-125 nodes at 7.7-nm spacing; here the fixed-grid scans: within 1e-5 - 7e-5 on ~350-400 nodes).
+125 nodes at 7.7-nm spacing; here the fixed-grid scans' largest: 6e-6 - 9e-5 below the branch
+on 514-673 nodes).
 
 ## Is the branch monotone in c?
 
 Yes at every point where it was traced: the retract's edge radius decreases monotonically from
 deep contact to the displacement-controlled pull-off (the fold of d(c), dd/dc = 0, the largest
-d), Newton in c never met a turning point of c (2-4 Newton steps per state at 2-8 % steps,
-15-20 states per branch), and complementarity held with margin on every state (worst
-multiplier >= 2 % of the largest, every free gap above sigma). The largest tension is interior
-on the stable side (c* ~ 2 c_fold) at every traced point: it is the max adhesion the runner
+d), Newton in c never met a turning point of c (15-16 states per branch at 2-8 % steps, 20-22
+solves, 4-5 factorisations a solve), and complementarity held on every state (worst multiplier
+>= 1.9 % of the largest; every free gap above sigma, the first free node's by ~(h/c)^3/2 as
+the continuum's gap (r - c)^3/2 says: down to 3e-7 sigma where c_fold ~ 0.07 um). The largest
+tension is interior on the stable side at every traced point (c* = 2.2-2.4 c_fold at the three
+points, up to 16 c_fold at sigma = 0.68 nm, p/psat 0.85): it is the max adhesion the runner
 reads at d ~ 1-1.5 nm (approach and retract coincide there in the continuum: the same branch;
 the runner's two values at d = 1.4 nm, p/psat 0.95, differ by 6e-5). What the continuation
 does not do: the points where d(c) has no fold above 0.05 um (the contact shrinks to nothing
@@ -430,8 +433,8 @@ def map_scan(out):
              for s_, rel, r in rows if "F" in r]
     diffs = [x for x in diffs if math.isfinite(x)]
     out.append(f"Traced: {len(ok)} points, largest estimated relative error "
-               f"{max(r['err'] / r['F'] for r in ok):.1e} (median "
-               f"{float(np.median([r['err'] / r['F'] for r in ok])):.1e}), "
+               f"{max(r['err'] for r in ok):.1e} (median "
+               f"{float(np.median([r['err'] for r in ok])):.1e}), "
                f"{sum(r['time'] for r in ok):.0f} s in all; against the runner's 3-digit "
                f"values where it has one ({len(diffs)} points): largest difference "
                f"{max(diffs):.1e} relative (the table's rounding: up to 5e-4 / value). "
