@@ -108,6 +108,20 @@ the graded part, and moves across the scaled grid's coarse nodes as c changes; a
 scan) and moved the fold's edge radius by up to 15 % where d(c) is flat (its d by 3e-3 nm), at
 32 h0 the families converge at order 2.00. The family's grading must resolve that edge.
 
+## Against the runner's values
+
+sigma = 0.3 nm, p/psat 0.95: the runner's 8.075837e-4 N (this session, accuracy 3e-3 asked,
+estimate 1.45e-3) lies 4.2e-4 below the branch's limit, d at max 1.4418 nm (the branch's
+1.4439 nm), jump-out 2.24238 nm (the fold 2.24312 nm; the runner's estimate 4e-3 nm): within
+its estimates. p/psat 0.05: 3.3861e-4 N, +5.4e-4 (its trial 1's estimate 8.8e-3; trial 2's
+unfinished), jump-out 1.7707 nm (the fold 1.77069 nm). sigma = 0.489 nm, p/psat 0.15: the
+runner's converged 1.567073e-4 N +- 1.36e-7 (8.7e-4) lies 1.42e-3 above the limit - 1.6 times
+its own estimate (effectivity 0.6). The branch's side of that: its members converge at order
+2.00 with effectivity 1.00 of the coarser triples' estimates, and the runner's own solver on
+the branch's fixed grid agrees with the branch there to 6.4e-6; so the difference is the
+runner's grid error (static band 4.04 nm, 1772 nodes, members lattice-trapped), which its
+estimate under-reads at this point.
+
 ## How it should be wired into the runner (next session; not done here)
 
 - Which scenes: sigma-gap complementarity without eq 20's adhesion, on the Green operator
@@ -469,7 +483,7 @@ def main():
            f"`python -m validation.sigma_edge` (module femadh/contact/sigma_edge.py). Machine: "
            f"2 cores shared with other sessions, load (1/5/15 min) {load[0]:.1f} / "
            f"{load[1]:.1f} / {load[2]:.1f} at the start; one BLAS thread. Times are wall "
-           f"seconds of this process (a quiet machine: about half)."]
+           f"seconds of this process under that load (counts are exact)."]
     rows = []
     for args in POINTS:
         rows.append(point(*args, out))
