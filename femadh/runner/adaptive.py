@@ -321,6 +321,15 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
     out = None
     first = _trial(scene, family, h)
+    if estimate is True:
+        # a grid that would follow the edge: a sigma-gap retract that unzips node by node;
+        # where its pilot finds a fold, the branch in its edge radius instead (edge_route)
+        from .edge_route import route_for, run_edge_route
+
+        pil = route_for(scene, first.follow is not None)
+        if pil is not None:
+            return run_edge_route(scene, out_dir, pil, figures=figures, overwrite=overwrite,
+                                  resume=resume, folder_id=scene_id(scene))
     if first.operator is None:
         failure = _too_many_nodes(first)
     else:

@@ -1,0 +1,426 @@
+"""The edge-branch route of a sigma-gap contact run: its max adhesion from the retract traced
+in its edge radius (:mod:`femadh.contact.sigma_edge`), its error from a grid family of edge
+grids and a guarded Richardson extrapolation (issue 21, goal 1).
+
+Why a route of its own: on a sigma-gap complementarity scene whose cohesive zone is narrow
+(the stiction map's sigma = 0.3 nm column, sigma = 0.489 nm at p/psat 0.15) the runner's
+retract unzips node by node - hundreds of micro-folds, each bracketed, bisected and landed -
+and its coarser members unzip along lattice paths of their own; 400-1500 s a point without
+reaching 1e-3 (validation/results/sigma_edge.md). On a grid scaled with the contact radius
+the same branch is a smooth function of c, every state a release point of the runner's
+collocation problem (paper 1 eqs 6, 8) on its own grid; a family h, h/sqrt2, h/2 of such grids
+converges at order 2.00 (effectivity 1.00 of the coarser triples' estimates, sigma_edge.md).
+
+Which runs take it (:func:`route_for`): a scene that
+
+- is sigma-gap complementarity without eq 20's adhesion on the contact set (the edge
+  condition p_c,k = 0 needs a contact set that holds no tension);
+- is on the Green operator of the homogeneous half-space (C = lam C^0 holds for it only: no
+  FE body, no coating);
+- is traced by stepping without an instrument (the route reads the displacement-controlled
+  branch);
+- is adaptive (femadh chooses the grid: an explicit ``nodes`` or ``[solver.grid]`` is a
+  request for that grid and is honoured);
+- and whose adaptive grid would follow the contact edge, i.e. whose static band at the
+  trapping-safe spacing exceeds :data:`~femadh.runner.adaptive.FOLLOW_NODES` (the scenes
+  whose retract unzips node by node; every bundled scene has a static band and keeps its
+  path, numbers bit for bit);
+
+and then a pilot trace (< 1 s) decides: a fold of d(c) at a finite edge radius takes the
+route, no fold (the contact shrinks to nothing without a jump, DMT's side: the largest force
+is not on this branch) the present path.
+
+What the route gives (:func:`run_edge_route`): the max adhesion (the finest member's largest
+F_ex on the runner's analysis disk, where on the branch it is, its edge radius) and the
+displacement-controlled pull-off (the fold's d, ``jump_out_d_m``), each with its estimated
+error (Richardson of the family, the force beyond the analysis radius, the solver's
+tolerance, as the runner's estimate has them); the finest member's branch states as the
+curve "retract_edge_branch" (each state on its own scaled grid; d decreasing from deep
+contact to the fold). Not given (yet): the approach, the jump-in, the jump-out's landing and
+the separated retract beyond it, the surface fields - the headline numbers read from those
+(jump_in_d_m, hysteresis_J, the deepest forces) are absent, and the summary says so.
+"""
+from dataclasses import dataclass, field
+import math
+import time
+
+import numpy as np
+
+from ..contact.edge_branch import edge_grid
+from ..contact.sigma_edge import SigmaEdgeBranch, tail_between, trace_retract
+from ..errors import ConvergenceError
+
+#: half-width and grading of the edge grids in units of the pilot's spacing h0 (fixed
+#: across a family: one mesh density). The grading sets the spacing at the meniscus edge,
+#: microns out in the graded far field: at 8 h0 the members' differences were erratic, at
+#: 32 h0 they converge at order 2.00 (validation/results/sigma_edge.md)
+HALF, GRADING = 24, 32
+#: the family's analysis radius covers the runner's down to this fraction of the pilot's
+#: fold edge radius (the family's fold may lie lower; sigma_edge.md)
+LOW = 0.5
+#: the pilot: edge node at c_ref = PILOT_FRACTION x the JKR contact radius at zero load
+#: (Johnson 1985 eq 5.20 with P = 0: a^3 = 9 pi W R^2 / (2 E*), W the scene's work of
+#: adhesion), spacing h0 = c_ref / PILOT_NODES, traced down to c_ref / PILOT_SPAN and up to
+#: PILOT_SPAN_UP c_ref. (On the stiction map's slider c_ref ~ 1 um and h0 ~ 4 nm: the map
+#: scan of validation/sigma_edge.py, 36 points traced, largest estimate 7.7e-4 on 3 members)
+PILOT_FRACTION, PILOT_NODES, PILOT_SPAN, PILOT_SPAN_UP = 0.25, 250, 20, 8
+#: the family traces up to this multiple of the pilot's c* (the largest force's edge radius)
+C_HIGH = 3
+#: members: at least MIN_LEVELS (Richardson needs three), at most MAX_LEVELS, the spacing
+#: divided by sqrt 2 from one to the next
+MIN_LEVELS, MAX_LEVELS = 3, 6
+#: observed orders accepted for the extrapolation (the branch converges at 2: measured 2.00
+#: on every clean family); outside, the finest member is kept and its error bounded by GUARD
+#: times its difference from the next coarser
+ORDER_RANGE, GUARD = (1.5, 2.5), 2.0
+
+
+def richardson(h, F):
+    """(observed order, extrapolation, error estimate of the finest member) from the last
+    three of F(h) (spacings in ratio sqrt 2); an order outside ORDER_RANGE (or two equal
+    members): the finest member itself and GUARD x its difference from the next coarser."""
+    f1, f2, f3 = F[-3:]
+    r = h[-2] / h[-1]
+    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r) if f2 != f3 and f1 != f2 \
+        else math.inf
+    if not ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
+        return p, f3, GUARD * abs(f3 - f2)
+    ext = f3 + (f3 - f2) / (r ** p - 1)
+    return p, ext, abs(f3 - ext)
+
+
+def branch_on(scene, c_ref, h, h0, a0):
+    """The :class:`SigmaEdgeBranch` of ``scene`` on the edge grid with node k at c_ref (m),
+    spacing h there, half-width HALF h0 and grading GRADING h0, analysis radius a0."""
+    from ..discretisation.family import MAX_NODES
+    from ..elastic import GreenOperator
+
+    g, k = edge_grid(a0, c_ref, h, HALF * h0, GRADING * h0, max_nodes=MAX_NODES)
+    op = GreenOperator(g, scene.e_star)
+    return SigmaEdgeBranch(op, k, scene.sphere, scene.effects, scene.gap, scene.tolerance)
+
+
+def runner_force(br, a_run):
+    """F_ex (N) of a branch state on the runner's analysis disk of radius a_run: the scaled
+    grid's minus the laws between a_run and the scaled analysis radius (on the undeformed
+    paraboloid, :func:`~femadh.contact.sigma_edge.tail_between`)."""
+    def value(st):
+        return br.force(st) - tail_between(br.effects, br.sphere, st.d, a_run, br.radius(st))
+    return value
+
+
+def trace(scene, c_ref, h, h0, a0, a_run, c_low, c_high):
+    """(branch, :class:`~femadh.contact.sigma_edge.Retract`, seconds): the retract of
+    ``scene`` on the edge grid at c_ref, down to the fold (or c_low), up past the largest
+    force (or c_high), the force read on the runner's disk a_run."""
+    t0 = time.perf_counter()
+    br = branch_on(scene, c_ref, h, h0, a0)
+    res = trace_retract(br, c_ref, c_low, c_high, value=runner_force(br, a_run))
+    return br, res, time.perf_counter() - t0
+
+
+def work_of_adhesion(scene):
+    """The scene's work of adhesion (J/m^2): minus the laws' energy at the gap sigma."""
+    h = np.array([scene.gap.sigma])
+    return float(-sum(np.asarray(e.energy(h))[0] for e in scene.effects.values()))
+
+
+def pilot_radius(scene):
+    """c_ref (m), the pilot's edge radius: PILOT_FRACTION x JKR's contact radius at zero
+    load, a^3 = 9 pi W R^2 / (2 E*) (Johnson 1985 eq 5.20)."""
+    W, R = work_of_adhesion(scene), scene.sphere.radius
+    if not W > 0:
+        raise ValueError("edge route: the scene's work of adhesion is not positive")
+    return PILOT_FRACTION * (9 * math.pi * W * R * R / (2 * scene.e_star)) ** (1 / 3)
+
+
+@dataclass
+class Pilot:
+    """The pilot trace: its edge grid's reference radius and spacing (m), the fold's and
+    the largest force's edge radii (m), the retract, its seconds."""
+
+    c_ref: float
+    h0: float
+    c_fold: float
+    c_star: float
+    retract: object
+    seconds: float
+
+
+def pilot(scene):
+    """The pilot trace of ``scene``'s retract on the coarse edge grid (c_ref, h0 = c_ref /
+    PILOT_NODES): a :class:`Pilot`, or None where d(c) has no fold down to c_ref /
+    PILOT_SPAN (the contact shrinks to nothing without a jump). Any other failure is
+    raised."""
+    a_run = scene.analysis_radius
+    c_ref = pilot_radius(scene)
+    h0 = c_ref / PILOT_NODES
+    t0 = time.perf_counter()
+    try:
+        _, r, _ = trace(scene, c_ref, h0, h0, a_run * PILOT_SPAN, a_run, c_ref / PILOT_SPAN,
+                        PILOT_SPAN_UP * c_ref)
+    except ConvergenceError as exc:
+        if "no fold of d(c)" in str(exc):
+            return None
+        raise
+    return Pilot(c_ref, h0, r.fold.c, r.best.c, r, time.perf_counter() - t0)
+
+
+def static_reasons(scene):
+    """Why ``scene`` cannot take the edge route (a list of reasons; empty: it can, if its
+    grid would follow the edge and its pilot finds a fold)."""
+    out = []
+    gap = scene.gap
+    if gap is None or gap.contact_model != "complementarity" or gap.adhesion:
+        out.append("not the sigma-gap with the complementarity model and no eq 20 adhesion")
+    if scene.method != "green" or getattr(scene, "layers", ()):
+        out.append("not the Green operator of the homogeneous half-space")
+    if scene.continuation == "arclength" or getattr(scene, "instrument", None) is not None:
+        out.append("not a displacement-controlled stepping sweep")
+    if not getattr(scene, "adaptive", False):
+        out.append("its grid is set by the scene ([solver] nodes or [solver.grid])")
+    if "retract" not in scene.directions:
+        out.append("no retract")
+    if getattr(scene, "topography", None) is not None:
+        out.append("a topography")
+    return out
+
+
+def route_for(scene, follows):
+    """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
+    path). ``follows``: whether the scene's adaptive grid would follow the contact edge
+    (:func:`femadh.runner.adaptive._follow_trial` chose a follow band)."""
+    if not follows or static_reasons(scene):
+        return None
+    return pilot(scene)
+
+
+@dataclass
+class EdgeFamily:
+    """The family of edge grids at the pilot's c*: spacings (m), nodes, the members'
+    retracts, and Richardson's order, extrapolation and error of the finest member for the
+    max adhesion and the fold's d; ``met`` whether the max adhesion's relative error (grid
+    part) is within the target; ``stop`` why the family stopped growing."""
+
+    h: list = field(default_factory=list)
+    nodes: list = field(default_factory=list)
+    runs: list = field(default_factory=list)
+    seconds: list = field(default_factory=list)
+    order: float = math.nan
+    value: float = math.nan
+    extrapolation: float = math.nan
+    error: float = math.inf
+    fold_order: float = math.nan
+    fold_extrapolation: float = math.nan
+    fold_error: float = math.inf
+    met: bool = False
+    stop: str = ""
+
+    @property
+    def finest(self):
+        """(branch, retract) of the finest member."""
+        return self.runs[-1]
+
+
+def family(scene, pil, target, max_levels=MAX_LEVELS, max_nodes=None, on_member=None):
+    """Grow the family h0 / sqrt2^j (node k at the pilot's c*, analysis radius a_run c* /
+    (LOW c_fold)) until Richardson's relative error of the max adhesion is at most
+    ``target``: MIN_LEVELS members at least, ``max_levels`` at most, no member above
+    ``max_nodes`` (default the family's node limit). ``on_member(j, branch, retract)`` after
+    each member. Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
+    where the budget ended first)."""
+    from ..discretisation.family import MAX_NODES
+
+    max_nodes = MAX_NODES if max_nodes is None else max_nodes
+    a_run = scene.analysis_radius
+    c_star, c_fold, h0 = pil.c_star, pil.c_fold, pil.h0
+    a0 = a_run * c_star / (LOW * c_fold)
+    fam = EdgeFamily()
+    for j in range(max_levels):
+        h = h0 / math.sqrt(2) ** j
+        if j and _nodes_of(a0, c_star, h, h0) > max_nodes:
+            fam.stop = f"the next member would exceed {max_nodes} nodes"
+            break
+        br, r, sec = trace(scene, c_star, h, h0, a0, a_run, LOW * c_fold, C_HIGH * c_star)
+        fam.h.append(h)
+        fam.nodes.append(br.n)
+        fam.runs.append((br, r))
+        fam.seconds.append(sec)
+        if on_member is not None:
+            on_member(j, br, r)
+        if len(fam.h) >= MIN_LEVELS:
+            F = [x.max_adhesion for _, x in fam.runs]
+            fam.order, fam.extrapolation, fam.error = richardson(fam.h, F)
+            fam.value = F[-1]
+            fam.fold_order, fam.fold_extrapolation, fam.fold_error = richardson(
+                fam.h, [x.fold.d for _, x in fam.runs])
+            if fam.error <= target * abs(fam.value):
+                fam.met = True
+                fam.stop = "met"
+                break
+    else:
+        fam.stop = f"{max_levels} members (the family's budget)"
+    return fam
+
+
+def _nodes_of(a0, c, h, h0):
+    """Node count of the edge grid (without building its operator)."""
+    from ..discretisation.family import MAX_NODES
+
+    g, _ = edge_grid(a0, c, h, HALF * h0, GRADING * h0, max_nodes=10 * MAX_NODES)
+    return g.n
+
+
+#: the curve's name for the branch's own states (each on its own scaled grid; not the
+#: sweep's separations)
+CURVE = "retract_edge_branch"
+#: what the route does not give, said in the result's warnings
+MISSING = ("edge route: the curve is the retract's branch traced in its edge radius (its "
+           "own states, each on its own scaled grid, from deep contact to the pull-off "
+           "fold); the approach, the jump-in, the jump-out's landing and the separated "
+           "retract beyond it, and the surface fields are not computed on this route: the "
+           "headline numbers read from them (jump_in_d_m, hysteresis_J, the deepest forces) "
+           "are absent")
+
+
+def _curve(br, r, a_run):
+    """The curve columns (curve.csv's) of the retract's states on the stable part (the
+    fold and deeper), in the order of the retract (c decreasing, d increasing)."""
+    states = [r.fold] + [s for s in r.states if s.c > r.fold.c]
+    if r.best is not r.fold and all(s is not r.best for s in states):
+        states.append(r.best)
+    states.sort(key=lambda s: -s.c)
+    force = runner_force(br, a_run)
+    cols = {"d_m": [], "h0_m": [], "F_ex_N": [], "r_c_m": [], "n_iter": [],
+            "residual_m": [], "converged": [], "stable": []}
+    for s in states:
+        cols["d_m"].append(s.d)
+        cols["h0_m"].append(float(s.h[0]))
+        cols["F_ex_N"].append(force(s))
+        cols["r_c_m"].append(s.c)
+        cols["n_iter"].append(s.n_iter)
+        cols["residual_m"].append(s.residual)
+        cols["converged"].append(True)
+        cols["stable"].append(bool(br.stable(s)))
+    return {k: np.asarray(v, bool if k in ("converged", "stable") else
+                          int if k == "n_iter" else float) for k, v in cols.items()}
+
+
+def _tolerance_part(br, scene):
+    """The solver tolerance's share of a force error (N), as the runner's estimate has it:
+    the analysis disk's area x tolerance x the largest law stiffness at the gap sigma."""
+    P1 = np.abs(br._ref.dpressure(np.full(br.n, scene.gap.sigma)))
+    return float(math.pi * scene.analysis_radius ** 2 * scene.tolerance * P1.max())
+
+
+def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume=False,
+                   folder_id=None):
+    """Run ``scene`` by the edge route (see the module docstring) from its pilot ``pil``:
+    the family to the scene's target accuracy (``scene.target_accuracy``), the headline
+    numbers with their errors, the branch's curve; written to ``out_dir`` (summary.json,
+    curve.csv) where given. Returns a ContactResult: "converged" where the estimate meets
+    the target, else "failed" with one line saying what the family reached (failure kind
+    "accuracy"). A failed trace ends the run "failed" naming the step."""
+    from ..scene import scene_id
+    from .lifecycle import lifecycle
+    from .result import ContactResult, contact_summary
+
+    t0 = time.perf_counter()
+    target = scene.target_accuracy
+    short = None
+    res = ContactResult(scene.name, scene)
+    folder = None
+    if out_dir is not None:
+        from ..io.run_folder import RunFolder
+
+        mode = "overwrite" if (overwrite or resume) else "new"
+        folder = RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode)
+        folder.__enter__()
+        res.out_dir = str(folder.path)
+
+    def write(status=None):
+        if folder is not None:
+            folder.write_summary(contact_summary(res, status))
+    try:
+        from .estimates import GuardError
+
+        with lifecycle(res, write, failures=(ConvergenceError, GuardError, ValueError),
+                       t0=t0):
+            short = _route(scene, res, pil, target)
+            if folder is not None:
+                res.to_csv(folder.path / "curve.csv")
+        if short is not None and res.status == "converged":
+            # the estimate does not support the request: one line, what was reached
+            res.status, res.error, res.failure_kind = "failed", short, "accuracy"
+            write()
+    finally:
+        if folder is not None:
+            folder.__exit__(None, None, None)
+    return res
+
+
+def _route(scene, res, pil, target):
+    """Fill ``res`` (headline, estimates, curve, grid, accuracy) from the family; returns the
+    one-line failure where the estimate does not meet ``target`` (else None)."""
+    from .headline import work_of_adhesion as W_of
+    from ..reference import dmt_pull_off, jkr_pull_off
+
+    a_run = scene.analysis_radius
+    t1 = time.perf_counter()
+    fam = family(scene, pil, target)
+    res.timings["family_s"] = time.perf_counter() - t1
+    res.timings["pilot_s"] = pil.seconds
+    br, r = fam.finest
+    res.nodes = br.nodes0 * r.best.lam
+    res.branches[CURVE] = _curve(br, r, a_run)
+    hl = res.headline
+    best = r.best
+    hl["max_adhesion_N"] = fam.value
+    hl["d_at_max_adhesion_m"] = float(best.d)
+    hl["max_adhesion_branch"] = CURVE
+    hl["r_c_at_max_adhesion_m"] = best.c
+    hl["jump_out_d_m"] = float(r.fold.d)
+    W = W_of(br._ref)
+    R = scene.sphere.radius
+    hl["work_of_adhesion_J_per_m2"] = W
+    hl["dmt_pull_off_N"] = dmt_pull_off(R, W)
+    hl["jkr_pull_off_N"] = jkr_pull_off(R, W)
+    # the errors: the family's Richardson (grid), the force beyond the analysis radius on the
+    # undeformed paraboloid (tail: the runner's F_ex is read on its disk, as here) and the
+    # solver's tolerance - added in magnitude, as the runner's estimate adds its parts
+    h_a = np.array([best.d + scene.sphere.shape(a_run)])
+    tail = float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
+                                        for e in scene.effects.values()))
+    parts = {"max_adhesion_N": {"grid": fam.error, "tail": tail,
+                                "tolerance": _tolerance_part(br, scene)},
+             "jump_out_d_m": {"grid": float(fam.fold_error)}}
+    for k, comp in parts.items():
+        comp["total"] = float(sum(abs(v) for v in comp.values()))
+        hl[f"{k}_error"] = comp["total"]
+    res.estimates = parts
+    rel = hl["max_adhesion_N_error"] / abs(fam.value)
+    res.grid = {"kind": "edge-branch", "route": "edge-branch", "nodes": fam.nodes[-1],
+                "analysis_radius_m": float(br.radius(best)),
+                "runner_analysis_radius_m": a_run, "edge_node": br.k,
+                "family_spacings_m": fam.h, "family_nodes": fam.nodes,
+                "family_seconds": fam.seconds, "observed_order": fam.order,
+                "extrapolation_N": fam.extrapolation, "fold_order": fam.fold_order,
+                "fold_extrapolation_m": fam.fold_extrapolation,
+                "pilot": {"c_ref_m": pil.c_ref, "spacing_m": pil.h0,
+                          "c_fold_m": pil.c_fold, "c_star_m": pil.c_star,
+                          "seconds": pil.seconds},
+                "worst_complementarity": list(r.worst_complementarity)}
+    res.accuracy = {"target": target, "met": bool(rel <= target), "adaptive": True,
+                    "route": "edge-branch", "nodes": fam.nodes[-1], "members": len(fam.h),
+                    "estimated_rel_error": rel, "stop": fam.stop}
+    res.warnings.append(MISSING)
+    # the largest adhesion within the smooth laws' bounds, as every run's (a GuardError)
+    from .estimates import guard_bounds
+
+    guard_bounds(res, br._ref)
+    if rel > target:
+        return (f"accuracy {target:g} not met on the edge route: estimated relative error "
+                f"{rel:.2g} of the max adhesion with {len(fam.h)} members ({fam.nodes[0]}-"
+                f"{fam.nodes[-1]} nodes, {sum(fam.seconds) + pil.seconds:.3g} s); stopped: "
+                f"{fam.stop}")
+    return None
