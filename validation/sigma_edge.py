@@ -31,9 +31,11 @@ import time
 import numpy as np
 
 import femadh
-from femadh.contact.edge_branch import edge_grid
-from femadh.contact.sigma_edge import SigmaEdgeBranch, tail_between, trace_retract
 from femadh.elastic import GreenOperator, RadialGrid
+# the edge grids' half-width and grading (units of h0), the analysis radius's reach, the
+# pilot, the family and the guarded Richardson are the edge route's: one home
+from femadh.runner.edge_route import GRADING, HALF, LOW, family, pilot, richardson
+from femadh.runner.edge_route import trace as _trace
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
@@ -50,20 +52,6 @@ POINTS = [
 ]
 #: family members h0 / sqrt2^j, j = 0..LEVELS-1
 LEVELS = 5
-#: half-width and grading of the edge grids in units of h0 (fixed across a family). The
-#: grading sets the spacing at the meniscus edge, microns out in the graded far field: at
-#: 8 h0 its lattice (the edge crossing the scaled grid's coarse nodes as c moves) made the
-#: members' differences erratic (sigma = 0.3 nm, p/psat 0.55: successive difference ratios
-#: 1.76, 1.17, 2.13; 0.85: -189, -0.22, -0.61, on 155-618 nodes), at 32 h0 they are 2.00,
-#: 2.00, 2.00 and 2.01, 2.00, 2.00 (386-1542 nodes; the values agree to 3e-5 and 1e-6)
-HALF, GRADING = 24, 32
-#: the analysis radius covers the runner's down to this fraction of the pilot's fold edge
-#: radius (the family's fold may lie lower: with the far field graded at 8 h0 the meniscus
-#: edge's lattice puts wiggles of ~30 % into dd/dc, and the fold's c moves by up to ~15 %
-#: between grids where d(c) is flat - measured at sigma = 0.489 nm, p/psat 0.65)
-LOW = 0.5
-
-
 #: what the results say beyond their numbers (appended to the report as it stands)
 NOTES = """
 ## What the method is, and why the edge condition is p_c,k = 0
@@ -162,44 +150,10 @@ def scene_at(sigma_nm, rel):
         "effects.capillary.relative_pressure": rel})
 
 
-def branch_on(scene, c_ref, h, h0, a0):
-    g, k = edge_grid(a0, c_ref, h, HALF * h0, GRADING * h0, max_nodes=20000)
-    op = GreenOperator(g, scene.body.e_star)
-    return SigmaEdgeBranch(op, k, scene.sphere, scene.effects, scene.gap, scene.tolerance)
-
-
-def runner_force(br, a_run):
-    """F_ex (N) on the runner's analysis disk: the scaled grid's minus the laws between a_run
-    and the scaled analysis radius."""
-    def value(st):
-        return br.force(st) - tail_between(br.effects, br.sphere, st.d, a_run, br.radius(st))
-    return value
-
-
 def trace(scene, c_ref, h, h0, a0, a_run, c_fold_hint, c_high):
-    t0 = time.perf_counter()
-    br = branch_on(scene, c_ref, h, h0, a0)
-    res = trace_retract(br, c_ref, LOW * c_fold_hint, c_high, value=runner_force(br, a_run))
-    return br, res, time.perf_counter() - t0
-
-
-#: observed orders accepted for the extrapolation (the branch converges at 2: measured 2.00
-#: on every clean family); outside, the finest member is kept and its error bounded by
-#: GUARD times the last difference
-ORDER_RANGE, GUARD = (1.5, 2.5), 2.0
-
-
-def richardson(h, F):
-    """(observed order, extrapolation, error estimate of the finest member) from the last
-    three of F(h) (ratio sqrt2); an order outside ORDER_RANGE: the finest member itself and
-    GUARD x its difference from the next coarser."""
-    f1, f2, f3 = F[-3:]
-    r = h[-2] / h[-1]
-    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r) if f2 != f3 else math.inf
-    if not ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
-        return p, f3, GUARD * abs(f3 - f2)
-    ext = f3 + (f3 - f2) / (r ** p - 1)
-    return p, ext, abs(f3 - ext)
+    """The edge route's trace (:func:`femadh.runner.edge_route.trace`) down to LOW x the
+    fold's edge radius ``c_fold_hint``."""
+    return _trace(scene, c_ref, h, h0, a0, a_run, LOW * c_fold_hint, c_high)
 
 
 def check_runner_equations(scene, br, st):
@@ -360,8 +314,8 @@ def point(sigma_nm, rel, h0_nm, runner_value, runner_note, out):
 #: the map's axes (validation/stiction_map.py's MAP)
 MAP_SIGMA = np.linspace(0.3, 2.0, 10)
 MAP_REL = np.linspace(0.05, 0.95, 10)
-#: the map scan's family: pilot spacing at c = 1 um, members h0 / sqrt2^j, j < MAP_LEVELS
-MAP_H0, MAP_LEVELS = 4e-9, 3
+#: the map scan's family: members h0 / sqrt2^j, j < MAP_LEVELS (h0 the route's pilot's)
+MAP_LEVELS = 3
 
 
 def runner_map(path=RESULTS / "stiction_map.md"):
@@ -380,38 +334,37 @@ def runner_map(path=RESULTS / "stiction_map.md"):
 
 
 def map_point(sigma_nm, rel):
-    """One map point by the edge branch: a pilot at c = 1 um (h MAP_H0, analysis radius
-    20 a_run: the runner's disk down to c = 0.05 um), then MAP_LEVELS members at c*.
-    Returns a dict (or the reason it could not)."""
+    """One map point as a run of the scene takes the edge route: the route's pilot
+    (:func:`femadh.runner.edge_route.pilot`, c_ref from JKR's radius, spacing c_ref / 250:
+    ~1 um and ~4 nm here), then MAP_LEVELS members at c* (:func:`~femadh.runner.edge_route.
+    family`, no target: all of them) and Richardson from the three finest. Returns a dict
+    (or the reason it could not)."""
     scene = scene_at(sigma_nm, rel)
-    a_run = scene.discretisation.analysis_radius
     t0 = time.perf_counter()
     try:
-        _, pil, _ = trace(scene, 1e-6, MAP_H0, MAP_H0, 20 * a_run, a_run, 0.05e-6 / LOW,
-                          8e-6)
-        c_star, c_fold = pil.best.c, pil.fold.c
-        a0 = a_run * c_star / (LOW * c_fold)
-        hs, Fs, nodes, worst = [], [], [], [math.inf, math.inf]
-        for j in range(MAP_LEVELS):
-            h = MAP_H0 / math.sqrt(2) ** j
-            br, r, _ = trace(scene, c_star, h, MAP_H0, a0, a_run, c_fold, 3 * c_star)
-            hs.append(h)
-            Fs.append(r.max_adhesion)
-            nodes.append(br.n)
-            worst = [min(worst[0], r.worst_complementarity[0]),
-                     min(worst[1], r.worst_complementarity[1])]
-        p, ext, err = richardson(hs, Fs)
+        pil = pilot(scene)
+        if pil is None:
+            text = (f"no fold at c >= {pilot_low(scene) * 1e6:.3f} um (the contact shrinks "
+                    "without a jump)")
+            return {"reason": text, "kind": "no fold", "time": time.perf_counter() - t0}
+        fam = family(scene, pil, 0.0, max_levels=MAP_LEVELS)
+        worst = [min(r.worst_complementarity[0] for _, r in fam.runs),
+                 min(r.worst_complementarity[1] for _, r in fam.runs)]
+        r = fam.finest[1]
     except Exception as exc:          # the point's reason, kept for the table
-        text = str(exc)
-        kind = "no fold" if "no fold of d(c)" in text else "failed"
-        if kind == "no fold":
-            c_min = float(text.split("above c = ")[1].split(" m")[0])
-            text = f"no fold at c >= {c_min * 1e6:.3f} um (the contact shrinks without a jump)"
-        return {"reason": f"{type(exc).__name__}: {text}"[:160] if kind == "failed" else text,
-                "kind": kind, "time": time.perf_counter() - t0}
-    return {"F": ext, "err": err / ext, "order": p, "c_star": c_star, "c_fold": c_fold,
-            "d_star": r.best.d, "at_fold": r.at_fold, "nodes": nodes, "worst": worst,
+        return {"reason": f"{type(exc).__name__}: {exc}"[:160], "kind": "failed",
+                "time": time.perf_counter() - t0}
+    return {"F": fam.extrapolation, "err": fam.error / fam.extrapolation, "order": fam.order,
+            "c_star": pil.c_star, "c_fold": pil.c_fold, "d_star": r.best.d,
+            "at_fold": r.at_fold, "nodes": fam.nodes, "worst": worst,
             "time": time.perf_counter() - t0}
+
+
+def pilot_low(scene):
+    """The pilot's smallest edge radius (m)."""
+    from femadh.runner.edge_route import PILOT_SPAN, pilot_radius
+
+    return pilot_radius(scene) / PILOT_SPAN
 
 
 def map_scan(out):
@@ -431,8 +384,9 @@ def map_scan(out):
     norm = 4 * math.pi * scene.sphere.radius * scene.effects["capillary"].surface_tension
     ok = [r for *_, r in rows if "F" in r]
     out.append("\n## The whole stiction map by the edge branch\n")
-    out.append(f"Each point: a pilot at c = 1 um (h = {MAP_H0 * 1e9:g} nm), then "
-               f"{MAP_LEVELS} members h = {MAP_H0 * 1e9:g} nm / sqrt2^j at c* and Richardson "
+    out.append(f"Each point: the edge route's pilot (c_ref = JKR's radius / 4, ~1 um; h = "
+               f"c_ref / 250, ~4 nm), then "
+               f"{MAP_LEVELS} members h / sqrt2^j at c* and Richardson "
                f"from the three finest (as above). One process: **{wall:.0f} s for "
                f"{len(rows)} points** ({len(ok)} traced; the runner's map: 639.9 s on 2 "
                f"processes, 10 refused or failed). Columns: the branch's max adhesion / "
