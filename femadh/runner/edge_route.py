@@ -186,11 +186,16 @@ def static_reasons(scene):
     return out
 
 
+#: whether runs take the route at all (False: every run the present path; validation and
+#: tests compare the two)
+ENABLED = True
+
+
 def route_for(scene, follows):
     """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
     (:func:`femadh.runner.adaptive._follow_trial` chose a follow band)."""
-    if not follows or static_reasons(scene):
+    if not ENABLED or not follows or static_reasons(scene):
         return None
     return pilot(scene)
 
@@ -222,16 +227,18 @@ class EdgeFamily:
         return self.runs[-1]
 
 
-def family(scene, pil, target, max_levels=MAX_LEVELS, max_nodes=None, on_member=None):
+def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None):
     """Grow the family h0 / sqrt2^j (node k at the pilot's c*, analysis radius a_run c* /
     (LOW c_fold)) until Richardson's relative error of the max adhesion is at most
-    ``target``: MIN_LEVELS members at least, ``max_levels`` at most, no member above
+    ``target``: MIN_LEVELS members at least, ``max_levels`` (default MAX_LEVELS) at most,
+    no member above
     ``max_nodes`` (default the family's node limit). ``on_member(j, branch, retract)`` after
     each member. Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
     where the budget ended first)."""
     from ..discretisation.family import MAX_NODES
 
     max_nodes = MAX_NODES if max_nodes is None else max_nodes
+    max_levels = MAX_LEVELS if max_levels is None else max_levels
     a_run = scene.analysis_radius
     c_star, c_fold, h0 = pil.c_star, pil.c_fold, pil.h0
     a0 = a_run * c_star / (LOW * c_fold)
@@ -284,8 +291,11 @@ MISSING = ("edge route: the curve is the retract's branch traced in its edge rad
 
 
 def _curve(br, r, a_run):
-    """The curve columns (curve.csv's) of the retract's states on the stable part (the
-    fold and deeper), in the order of the retract (c decreasing, d increasing)."""
+    """(curve columns, the first state the runner's stability test rejects or None): the
+    retract's states on the stable part in its order (c decreasing from deep contact, d
+    increasing), up to the fold or to the last state before one that is not an energy
+    minimum with its contact set held (:meth:`SigmaEdgeBranch.stable`: under displacement
+    control the retract leaves the branch there, before its fold)."""
     states = [r.fold] + [s for s in r.states if s.c > r.fold.c]
     if r.best is not r.fold and all(s is not r.best for s in states):
         states.append(r.best)
@@ -293,7 +303,11 @@ def _curve(br, r, a_run):
     force = runner_force(br, a_run)
     cols = {"d_m": [], "h0_m": [], "F_ex_N": [], "r_c_m": [], "n_iter": [],
             "residual_m": [], "converged": [], "stable": []}
+    lost = None
     for s in states:
+        if not br.stable(s):
+            lost = s
+            break
         cols["d_m"].append(s.d)
         cols["h0_m"].append(float(s.h[0]))
         cols["F_ex_N"].append(force(s))
@@ -301,9 +315,9 @@ def _curve(br, r, a_run):
         cols["n_iter"].append(s.n_iter)
         cols["residual_m"].append(s.residual)
         cols["converged"].append(True)
-        cols["stable"].append(bool(br.stable(s)))
+        cols["stable"].append(True)
     return {k: np.asarray(v, bool if k in ("converged", "stable") else
-                          int if k == "n_iter" else float) for k, v in cols.items()}
+                          int if k == "n_iter" else float) for k, v in cols.items()}, lost
 
 
 def _tolerance_part(br, scene):
@@ -372,14 +386,30 @@ def _route(scene, res, pil, target):
     res.timings["pilot_s"] = pil.seconds
     br, r = fam.finest
     res.nodes = br.nodes0 * r.best.lam
-    res.branches[CURVE] = _curve(br, r, a_run)
+    res.branches[CURVE], lost = _curve(br, r, a_run)
     hl = res.headline
     best = r.best
+    if lost is not None and lost.c >= best.c:
+        raise ConvergenceError(
+            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (c = "
+            f"{lost.c:.6g} m): it is not the retract's", d=best.d, residual=math.nan,
+            n_iter=0)
     hl["max_adhesion_N"] = fam.value
     hl["d_at_max_adhesion_m"] = float(best.d)
     hl["max_adhesion_branch"] = CURVE
     hl["r_c_at_max_adhesion_m"] = best.c
-    hl["jump_out_d_m"] = float(r.fold.d)
+    if lost is None:
+        hl["jump_out_d_m"] = float(r.fold.d)
+    else:
+        # the retract leaves the branch before its fold: the jump-out is there, between the
+        # last stable state and the first unstable one (its landing is not computed)
+        res.warnings.append(
+            f"edge route: the branch stops being stable (the runner's test, contact set "
+            f"held) at c = {lost.c * 1e6:.4g} um, d = {lost.d * 1e9:.5g} nm, before its fold "
+            f"(d = {r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
+            f"{res.branches[CURVE]['d_m'][-1] * 1e9:.5g} nm and that; jump_out_d_m is not "
+            "given")
     W = W_of(br._ref)
     R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
@@ -394,6 +424,7 @@ def _route(scene, res, pil, target):
     parts = {"max_adhesion_N": {"grid": fam.error, "tail": tail,
                                 "tolerance": _tolerance_part(br, scene)},
              "jump_out_d_m": {"grid": float(fam.fold_error)}}
+    parts = {k: v for k, v in parts.items() if k in hl}
     for k, comp in parts.items():
         comp["total"] = float(sum(abs(v) for v in comp.values()))
         hl[f"{k}_error"] = comp["total"]
