@@ -1683,6 +1683,36 @@ DEFECTS = [
       "femadh/contact/sigma_edge.py",
       (("    delta = c * c / R\n    d = branch.sigma - delta\n",
         "    delta = 2 * c * c / R\n    d = branch.sigma - delta\n"),)),
+    # -- the edge-branch route (femadh/runner/edge_route.py)
+    D("eroute_richardson_denominator", "edge route: Richardson's extrapolation over "
+      "(r^p + 1)", "femadh/runner/edge_route.py",
+      (("    ext = f3 + (f3 - f2) / (r ** p - 1)", "    ext = f3 + (f3 - f2) / (r ** p + 1)"),)),
+    D("eroute_guard_factor", "edge route: an erratic family's error without the guard's "
+      "factor", "femadh/runner/edge_route.py",
+      (("        return p, f3, GUARD * abs(f3 - f2)", "        return p, f3, abs(f3 - f2)"),)),
+    D("eroute_met_absolute", "edge route: the family stops on an absolute error (N) against "
+      "the relative target", "femadh/runner/edge_route.py",
+      (("            if fam.error <= target * abs(fam.value):",
+        "            if fam.error <= target:"),)),
+    D("eroute_no_stability", "edge route: the curve and the jump-out without the runner's "
+      "stability test", "femadh/runner/edge_route.py",
+      (("        if not br.stable(s):\n            lost = s",
+        "        if False:\n            lost = s"),)),
+    D("eroute_pilots_static", "edge route: pilots scenes whose grid would not follow the edge",
+      "femadh/runner/edge_route.py",
+      (("    if not ENABLED or not follows or static_reasons(scene):",
+        "    if not ENABLED or static_reasons(scene):"),)),
+    D("eroute_headline_extrapolated", "edge route: the headline the extrapolation, not the "
+      "finest member's state", "femadh/runner/edge_route.py",
+      (('    hl["max_adhesion_N"] = fam.value', '    hl["max_adhesion_N"] = fam.extrapolation'),)),
+    D("eroute_eq20_passes", "edge route: eq 20's adhesion passes the static conditions",
+      "femadh/runner/edge_route.py",
+      (('    if gap is None or gap.contact_model != "complementarity" or gap.adhesion:',
+        '    if gap is None or gap.contact_model != "complementarity":'),)),
+    D("eroute_lost_side", "edge route: the stability check on the wrong side of the largest "
+      "force", "femadh/runner/edge_route.py",
+      (("    if lost is not None and lost.c >= best.c:",
+        "    if lost is not None and lost.c <= best.c:"),)),
 ]
 
 

@@ -60,7 +60,7 @@ def test_small_scene_takes_the_route(routed):
     assert any("edge route" in w for w in res.warnings)     # what it does not compute
 
 
-def test_bundled_scenes_keep_their_path():
+def test_bundled_scenes_keep_their_path(small):
     """The bundled adaptive sigma-gap scene of the map (sigma = 1 nm, p/psat 0.95) passes
     every static condition, but its pilot finds no fold (the contact shrinks without a jump):
     the present path. Scenes with a grid of their own or eq 20's adhesion never pilot."""
@@ -68,6 +68,8 @@ def test_bundled_scenes_keep_their_path():
     assert edge_route.static_reasons(slider) == []
     assert edge_route.route_for(slider, True) is None
     assert edge_route.route_for(slider, False) is None          # a static band: no pilot
+    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot)
+    assert edge_route.route_for(small, False) is None
     fig6 = femadh.load_scene("validation/scenes/paper1_fig6_sigma0.20.toml")
     assert any("grid is set" in r for r in edge_route.static_reasons(fig6))
     fig8 = femadh.load_scene("validation/scenes/paper1_fig8_rho179.toml")
