@@ -1,6 +1,7 @@
 """A stiction map as a parameter study, and what parallel studies cost.
 
-``python -m validation.stiction_map`` runs the 2-mm slider of paper 1 with LJ forces, the
+``python -m validation.stiction_map`` (``--only map``: the map alone, ~10 min) runs the 2-mm
+slider of paper 1 with LJ forces, the
 sigma-gap and a condensed ethanol meniscus (validation/scenes/paper1_slider_meniscus.toml) over
 sigma = 0.3-2 nm x p/psat = 0.05-0.95 (10 x 10 points, each with its error estimate), exactly
 as
@@ -42,11 +43,18 @@ SCALING = {"effects.asperity_gap.sigma": "0.6 nm..2 nm:6",
 POINT_LIMIT = "90 s"
 
 
+#: the map asks for the max adhesion alone: a point whose pilot finds the retract's pull-off
+#: fold takes the edge route (femadh/runner/edge_route.py; [solver] route = "edge"), the
+#: others the adaptive sweep
+ROUTE = "edge"
+
+
 def stiction_map(out, sigma=None):
-    """The map at the scene's defaults: the adaptive grid to accuracy 1e-3 (points femadh
-    refuses, or that reach POINT_LIMIT, keep their reason); ``sigma`` (e.g. "0.3 nm"): only
-    that column."""
-    scene = femadh.load_scene(SCENE).replace({"solver.time_limit": POINT_LIMIT})
+    """The map at the scene's defaults: the adaptive grid to accuracy 1e-3, the points whose
+    retract has a pull-off fold by the edge route (ROUTE; points femadh refuses, or that
+    reach POINT_LIMIT, keep their reason); ``sigma`` (e.g. "0.3 nm"): only that column."""
+    scene = femadh.load_scene(SCENE).replace({"solver.time_limit": POINT_LIMIT,
+                                              "solver.route": ROUTE})
     t0 = time.perf_counter()
     vary = MAP if sigma is None else {**MAP, "effects.asperity_gap.sigma": [sigma]}
     points, records = run_study(scene, vary, out, workers=2,
@@ -176,18 +184,26 @@ def the_map():
     sig, rel, F, E, norm, wall, fails, n = stiction_map(out)
     load_end = os.getloadavg()
     figure(sig, rel, F, norm, RESULTS / "stiction_map.png")
+    routed = _routed(out)
     lines = ["# Stiction map: the 2-mm slider with LJ, the sigma-gap and an ethanol meniscus",
              "", "(`python -m validation.stiction_map`; scene "
              "`validation/scenes/paper1_slider_meniscus.toml`, bare meniscus, at its "
              "defaults: the adaptive banded grid to accuracy 1e-3, analysis radius planned "
-             f"from delta = 50 nm; at most {POINT_LIMIT} per point. Machine load (1-min "
+             f"from delta = 50 nm, [solver] route = '{ROUTE}' (the map asks for the max "
+             "adhesion alone: a point whose pilot finds the retract's pull-off fold is traced "
+             "in its edge radius, femadh/runner/edge_route.py; the others by the adaptive "
+             f"sweep); at most {POINT_LIMIT} per point. Machine load (1-min "
              f"average) {load[0]:.1f} at the start, {load_end[0]:.1f} at the end, 2 cores.)",
              "",
              f"{n} points on 2 local processes in {wall:.1f} s "
              f"({wall / n:.2f} s per point, each with its error estimate); {len(fails)} "
              "refused or failed (below, with femadh's reasons); largest estimated relative "
              f"error of the max adhesion {np.nanmax(E / F):.1e} (median "
-             f"{np.nanmedian(E / F):.1e}).", "",
+             f"{np.nanmedian(E / F):.1e}). By the edge route: {len(routed)} points "
+             f"({sum(x[2] == 'converged' for x in routed)} converged; largest estimated "
+             f"relative error {max([x[3] for x in routed] or [math.nan]):.1e}, wall "
+             f"{min([x[4] for x in routed] or [math.nan]):.1f}-"
+             f"{max([x[4] for x in routed] or [math.nan]):.1f} s per point).", "",
              f"Max adhesion / 4 pi R gamma (4 pi R gamma = {norm * 1e3:.4g} mN):", "",
              "| p/psat \\ sigma (nm) | " + " | ".join(f"{s * 1e9:.2f}" for s in sig) + " |",
              "|---|" + "---|" * len(sig)]
@@ -199,6 +215,23 @@ def the_map():
     lines += ["", "![](stiction_map.png)", ""]
     (RESULTS / "stiction_map.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
+
+
+def _routed(out):
+    """(sigma m, Kelvin radius m, status, estimated relative error, wall s) of every point of the
+    study folder ``out`` that took the edge route (its summary's grid.route)."""
+    import json
+
+    rows = []
+    for summ in sorted(Path(out).glob("points/*/summary.json")):
+        d = json.loads(summ.read_text())
+        if (d.get("grid") or {}).get("route") != "edge-branch":
+            continue
+        sc = d["scene"]
+        rows.append((sc["asperity_gap"]["sigma_m"], sc["effects"]["capillary"]["kelvin_radius"],
+                      d["status"], d["accuracy"].get("estimated_rel_error", math.nan),
+                      d.get("wall_time_s", math.nan)))
+    return rows
 
 
 def column(sigma):

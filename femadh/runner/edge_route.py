@@ -194,8 +194,22 @@ ENABLED = True
 def route_for(scene, follows):
     """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
-    (:func:`femadh.runner.adaptive._follow_trial` chose a follow band)."""
-    if not ENABLED or not follows or static_reasons(scene):
+    (:func:`femadh.runner.adaptive._follow_trial` chose a follow band). The scene's
+    ``[solver] route``: "grid" never, "auto" where its grid follows the edge, "edge"
+    wherever it can (a scene that cannot: SceneError naming the reason); the pilot then
+    decides."""
+    route = getattr(scene, "route", "auto")
+    if not ENABLED or route == "grid":
+        return None
+    reasons = static_reasons(scene)
+    if route == "edge" and reasons:
+        from ..errors import SceneError
+
+        raise SceneError(scene.path or scene.name, "solver.route", "edge",
+                         f"'auto' or 'grid' for this scene (the edge route needs "
+                         f"{reasons[0].replace('not ', '', 1)})" if reasons[0].startswith("not ")
+                         else f"'auto' or 'grid' for this scene ({reasons[0]})")
+    if reasons or (route == "auto" and not follows):
         return None
     return pilot(scene)
 

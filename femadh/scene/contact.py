@@ -140,6 +140,7 @@ class Scene(Replaceable):
     continuation = _Flat("discretisation")
     accuracy = _Flat("discretisation")
     time_limit = _Flat("discretisation")
+    route = _Flat("discretisation")
     d_values = _Flat("sweep", list)
     directions = _Flat("sweep")
     instrument = _Flat("sweep")
@@ -197,7 +198,9 @@ class Scene(Replaceable):
                        "continuation": self.continuation, "accuracy": self.accuracy,
                        "mesh": None if self.fe_settings is None else {
                            **dataclasses.asdict(self.fe_settings),
-                           "poisson_ratio": self.fe_poisson_ratio}},
+                           "poisson_ratio": self.fe_poisson_ratio},
+                       # (only when set: the ids of scenes without it stay as they were)
+                       **({"route": self.route} if self.route != "auto" else {})},
             "sweep": {"d_m": list(self.d_values), "directions": list(self.directions)},
             "instrument": None if self.instrument is None else self.instrument.as_dict(),
             "output_dir": self.output_dir,
@@ -270,7 +273,8 @@ def parse_contact(reader, data, file):
             nodes_explicit="nodes" in (data.get("solver") or {}),
             tolerance=so["tolerance"], max_iter=so["max_iter"],
             continuation=so["continuation"], fe_poisson_ratio=fe_nu, grid=so["grid"],
-            mesh=mesh, accuracy=so["accuracy"], time_limit=so["time_limit"]),
+            mesh=mesh, accuracy=so["accuracy"], time_limit=so["time_limit"],
+            route=so["route"]),
         sweep=Sweep(d_values=d_values, directions=sw["directions"], instrument=instrument),
         output=Output(output_dir=ou["dir"] or f"out/{name}", vtk=vtk),
         study=study, raw=copy.deepcopy(data))

@@ -85,6 +85,13 @@ SOLVER = Table("solver", "Discretisation and solver.", (
         "state kept, status 'time limit', exit code 6; --resume continues it), e.g. "
         "\"10 min\". Also `femadh run --time-limit`. Not part of the scene's identity.",
         default=None, lo=0.0),
+    Key("route", "choice", "How a sigma-gap complementarity scene's retract is solved: "
+        "'auto' - traced in its edge radius (femadh/runner/edge_route.py: the max adhesion "
+        "and the pull-off with their errors from a family of edge grids, not the approach, "
+        "jump-in or surface fields) where the adaptive grid would follow the contact edge "
+        "and a pilot finds the pull-off fold, else the sweep; 'edge' - the edge route "
+        "wherever the pilot finds a fold (a request of the max adhesion only, e.g. a stiction "
+        "map); 'grid' - always the sweep.", default="auto", choices=("auto", "edge", "grid")),
     Key("grid", "custom", "An explicit banded grid, see [solver.grid].", default=None,
         parse=lambda r, raw, path: None if raw is None else r.read(GRID, raw, path),
         expect="a table (see [solver.grid])"),
@@ -131,6 +138,9 @@ class Discretisation:
         Relative accuracy asked of the headline numbers.
     time_limit : float or None
         Wall time (s) after which a run stops cleanly (not in the scene's id).
+    route : str
+        "auto", "edge" or "grid": how a sigma-gap retract is solved
+        (:mod:`femadh.runner.edge_route`).
     """
 
     method: str
@@ -145,6 +155,7 @@ class Discretisation:
     mesh: FrozenMap | None = None
     accuracy: float | None = None
     time_limit: float | None = None
+    route: str = "auto"
 
     def __post_init__(self):
         object.__setattr__(self, "grid", frozen_map(self.grid))
