@@ -121,3 +121,20 @@ def test_richardson_guarded():
     p, ext, err = edge_route.richardson(h, [1.0, 1.5, 1.4])
     assert not 1.5 <= p <= 2.5
     assert ext == 1.4 and err == pytest.approx(edge_route.GUARD * 0.1, rel=1e-12)
+
+
+def test_route_key(small):
+    """[solver] route: "grid" keeps the sweep even where the grid would follow the edge (no
+    pilot); "edge" on a scene with a grid of its own is refused in one line naming the key;
+    the default leaves the scene's id as it was (old runs resume)."""
+    from femadh.errors import SceneError
+    from femadh.scene import scene_id
+
+    assert edge_route.route_for(small.replace({"solver.route": "grid"}), True) is None
+    fig6 = femadh.load_scene("validation/scenes/paper1_fig6_sigma0.20.toml")
+    with pytest.raises(SceneError) as exc:
+        femadh.run(fig6.replace({"solver.route": "edge"}), None, figures=False,
+                   progress=False)
+    assert "\n" not in str(exc.value) and "[solver.route] = 'edge'" in str(exc.value)
+    assert scene_id(fig6.replace({"solver.route": "auto"})) == scene_id(fig6)
+    assert scene_id(fig6.replace({"solver.route": "grid"})) != scene_id(fig6)
