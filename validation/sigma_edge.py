@@ -110,7 +110,18 @@ the branch's fixed grid agrees with the branch there to 6.4e-6; so the differenc
 runner's grid error (static band 4.04 nm, 1772 nodes, members lattice-trapped), which its
 estimate under-reads at this point.
 
-## How it should be wired into the runner (next session; not done here)
+## How it should be wired into the runner
+
+Wired in on branch `edgewire` (femadh/runner/edge_route.py; the map scan above now calls its
+pilot, family and Richardson): a run takes the edge route where its adaptive grid would follow
+the edge ([solver] route = "auto") or wherever it can ("edge", e.g. the stiction map) and the
+pilot finds a fold; the max adhesion and the pull-off come from the family to the scene's
+accuracy, the curve is the branch's own states. Not yet done of the plan below: the approach,
+the jump-out's landing and the rest of the retract on this route, the retract's states at the
+sweep's separations committed into the sink. (The map table above was made with the pilot at
+c = 1 um, h = 4 nm; the route's pilot takes c_ref = JKR's radius / 4, ~1 um, h = c_ref / 250.)
+
+The plan as it was written:
 
 - Which scenes: sigma-gap complementarity without eq 20's adhesion, on the Green operator
   (C = lam C^0 holds for the homogeneous half-space only, not for a layered FE body), stepping
