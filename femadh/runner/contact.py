@@ -38,10 +38,6 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
     claimed folder, then its figures. ``run``: the run of every kind
     (:func:`femadh.runner.run.run`), which the trials and the estimate's members go through
     (handed in: this module does not import its caller)."""
-    if getattr(scene, "route", "auto") == "edge" and not scene.adaptive:
-        from .edge_route import route_for
-
-        route_for(scene, False)         # a grid of the scene's own: refused in one line
     if getattr(scene, "adaptive", False):
         from .adaptive import run_adaptive
 

@@ -150,8 +150,9 @@ class Pilot:
 def pilot(scene):
     """The pilot trace of ``scene``'s retract on the coarse edge grid (c_ref, h0 = c_ref /
     PILOT_NODES): a :class:`Pilot`, or None where d(c) has no fold down to c_ref /
-    PILOT_SPAN (the contact shrinks to nothing without a jump). Any other failure is
-    raised."""
+    (PILOT_SPAN LOW) (the contact shrinks to nothing without a jump, or its fold lies too
+    near the pilot's lowest edge radius c_ref / PILOT_SPAN for the family's traces, which
+    reach down to LOW c_fold). Any other failure is raised."""
     a_run = scene.analysis_radius
     c_ref = pilot_radius(scene)
     h0 = c_ref / PILOT_NODES
@@ -163,6 +164,13 @@ def pilot(scene):
         if "no fold of d(c)" in str(exc):
             return None
         raise
+    if r.fold.c < c_ref / PILOT_SPAN / LOW:
+        # the family traces down to LOW c_fold: a fold this near the pilot's lowest edge
+        # radius was not bracketed with room below it (measured on the stiction map: at
+        # sigma = 0.87-1.06 nm, p/psat 0.65-0.75 the pilot's fold at ~0.046 um is not a
+        # fold of the finer members, whose traces end without one): not a fold the route
+        # can stand on, the sweep decides
+        return None
     return Pilot(c_ref, h0, r.fold.c, r.best.c, r, time.perf_counter() - t0)
 
 
@@ -196,20 +204,14 @@ def route_for(scene, follows):
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
     (:func:`femadh.runner.adaptive._follow_trial` chose a follow band). The scene's
     ``[solver] route``: "grid" never, "auto" where its grid follows the edge, "edge"
-    wherever it can (a scene that cannot: SceneError naming the reason); the pilot then
-    decides."""
+    wherever it can; the pilot then
+    decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
+    whatever its route: the adaptive loop's trials and the estimate's members are such
+    scenes (a grid of their own) and inherit the key."""
     route = getattr(scene, "route", "auto")
-    if not ENABLED or route == "grid":
+    if not ENABLED or route == "grid" or static_reasons(scene):
         return None
-    reasons = static_reasons(scene)
-    if route == "edge" and reasons:
-        from ..errors import SceneError
-
-        raise SceneError(scene.path or scene.name, "solver.route", "edge",
-                         f"'auto' or 'grid' for this scene (the edge route needs "
-                         f"{reasons[0].replace('not ', '', 1)})" if reasons[0].startswith("not ")
-                         else f"'auto' or 'grid' for this scene ({reasons[0]})")
-    if reasons or (route == "auto" and not follows):
+    if route == "auto" and not follows:
         return None
     return pilot(scene)
 

@@ -91,7 +91,9 @@ SOLVER = Table("solver", "Discretisation and solver.", (
         "jump-in or surface fields) where the adaptive grid would follow the contact edge "
         "and a pilot finds the pull-off fold, else the sweep; 'edge' - the edge route "
         "wherever the pilot finds a fold (a request of the max adhesion only, e.g. a stiction "
-        "map); 'grid' - always the sweep.", default="auto", choices=("auto", "edge", "grid")),
+        "map); 'grid' - always the sweep. A scene the route cannot carry (eq 20 adhesion, FE "
+        "or coated body, arclength, an instrument, [solver] nodes or [solver.grid]) keeps "
+        "the sweep whatever its route.", default="auto", choices=("auto", "edge", "grid")),
     Key("grid", "custom", "An explicit banded grid, see [solver.grid].", default=None,
         parse=lambda r, raw, path: None if raw is None else r.read(GRID, raw, path),
         expect="a table (see [solver.grid])"),
