@@ -1700,8 +1700,8 @@ DEFECTS = [
         "        if False:\n            lost = s"),)),
     D("eroute_pilots_static", "edge route: pilots scenes whose grid would not follow the edge",
       "femadh/runner/edge_route.py",
-      (("    if not ENABLED or not follows or static_reasons(scene):",
-        "    if not ENABLED or static_reasons(scene):"),)),
+      (("    if route == \"auto\" and not follows:\n",
+        "    if route == \"auto\" and not follows and False:\n"),)),
     D("eroute_headline_extrapolated", "edge route: the headline the extrapolation, not the "
       "finest member's state", "femadh/runner/edge_route.py",
       (('    hl["max_adhesion_N"] = fam.value', '    hl["max_adhesion_N"] = fam.extrapolation'),)),
@@ -1713,6 +1713,9 @@ DEFECTS = [
       "force", "femadh/runner/edge_route.py",
       (("    if lost is not None and lost.c >= best.c:",
         "    if lost is not None and lost.c <= best.c:"),)),
+    D("eroute_low_fold", "edge route: a pilot's fold at its lowest edge radius taken",
+      "femadh/runner/edge_route.py",
+      (("    if r.fold.c < c_ref / PILOT_SPAN / LOW:", "    if False:"),)),
 ]
 
 

@@ -76,6 +76,23 @@ def test_bundled_scenes_keep_their_path(small):
     assert any("eq 20" in r for r in edge_route.static_reasons(fig8))
 
 
+def test_pilot_fold_at_its_lowest_edge_radius_is_no_route():
+    """The map's point sigma = 0.867 nm, p/psat 0.65: the pilot's d(c) turns just below its
+    lowest edge radius (c ~ 0.046 um), where the finer members find no fold (measured: the
+    family's traces end without one); the pilot declines, the sweep decides. Its trace
+    down to the pilot's range does show the turn (the fold lies below c_ref / PILOT_SPAN /
+    LOW)."""
+    scene = femadh.load_scene(SCENE).replace({"effects.asperity_gap.sigma": "0.867 nm",
+                                              "effects.capillary.relative_pressure": 0.65})
+    assert edge_route.pilot(scene) is None
+    c_ref = edge_route.pilot_radius(scene)
+    h0, a_run = c_ref / edge_route.PILOT_NODES, scene.analysis_radius
+    _, r, _ = edge_route.trace(scene, c_ref, h0, h0, a_run * edge_route.PILOT_SPAN, a_run,
+                               c_ref / edge_route.PILOT_SPAN,
+                               edge_route.PILOT_SPAN_UP * c_ref)
+    assert r.fold.c < c_ref / edge_route.PILOT_SPAN / edge_route.LOW
+
+
 #: the present runner on the small scene (edge_route.ENABLED = False: its adaptive grid on a
 #: band following the edge, 74 nodes, accuracy 1e-2; 26 CPU-s, too slow for the suite, run
 #: by this branch's session): max adhesion and its estimated error (N)
