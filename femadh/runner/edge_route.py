@@ -396,6 +396,8 @@ def _route(scene, res, pil, target):
     from ..reference import dmt_pull_off, jkr_pull_off
 
     a_run = scene.analysis_radius
+    # the route is recorded from the start (a run stopped in the family says which it took)
+    res.grid = {"kind": "edge-branch", "route": "edge-branch"}
     t1 = time.perf_counter()
     fam = family(scene, pil, target)
     res.timings["family_s"] = time.perf_counter() - t1
