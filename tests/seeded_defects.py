@@ -1591,6 +1591,30 @@ DEFECTS = [
     D("snap_path_end_only", "landing: the downhill test samples the path's end only",
       "femadh/contact/landing.py",
       (("PATH_SAMPLES = 16", "PATH_SAMPLES = 1"),)),
+    # -- the solve made cheaper (branch fig4solve): the descent's round-off rejections, the
+    #    first refinement's order
+    D("lmrej_full_descent_too", "landing descent: rises within round-off settle the whole "
+      "descent too (roundoff off)", "femadh/contact/landing.py",
+      (("            if roundoff and ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n",
+        "            if ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n"),)),
+    D("lmrej_real_rise", "landing descent: a rise of 1000x the round-off counted as flat",
+      "femadh/contact/landing.py",
+      (("                    e_new - e <= _roundoff(problem, w_new, e_new):",
+        "                    e_new - e <= 1e3 * _roundoff(problem, w_new, e_new):"),)),
+    D("lmrej_takes_risen_step", "landing descent: settles on the risen trial point, not on w",
+      "femadh/contact/landing.py",
+      (("                if flat >= ROUNDOFF_STEPS:\n                    return w, True\n"
+        "            lam *= 4",
+        "                if flat >= ROUNDOFF_STEPS:\n                    return w_new, True\n"
+        "            lam *= 4"),)),
+    D("first_order_old", "adaptive loop: the first refinement at the assumed ORDER again",
+      "femadh/runner/adaptive.py",
+      (("        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))\n    return FIRST_ORDER\n",
+        "        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))\n    return ORDER\n"),)),
+    D("first_order_on_rise", "adaptive loop: an estimate that rose sized at FIRST_ORDER",
+      "femadh/runner/adaptive.py",
+      (("        if e0 <= e1:\n            return ORDER\n",
+        "        if e0 <= e1:\n            return FIRST_ORDER\n"),)),
 ]
 
 
