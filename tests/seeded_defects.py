@@ -1597,10 +1597,12 @@ DEFECTS = [
       "descent too (roundoff off)", "femadh/contact/landing.py",
       (("            if roundoff and ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n",
         "            if ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n"),)),
-    D("lmrej_real_rise", "landing descent: a rise of 1000x the round-off counted as flat",
-      "femadh/contact/landing.py",
-      (("                    e_new - e <= _roundoff(problem, w_new, e_new):",
-        "                    e_new - e <= 1e3 * _roundoff(problem, w_new, e_new):"),)),
+    D("lmrej_not_counted", "landing descent: a rise within round-off raises the damping "
+      "without counting towards settling", "femadh/contact/landing.py",
+      (("                flat += 1\n                if flat >= ROUNDOFF_STEPS:\n"
+        "                    return w, True\n",
+        "                flat += 0\n                if flat >= ROUNDOFF_STEPS:\n"
+        "                    return w, True\n"),)),
     D("lmrej_takes_risen_step", "landing descent: settles on the risen trial point, not on w",
       "femadh/contact/landing.py",
       (("                if flat >= ROUNDOFF_STEPS:\n                    return w, True\n"
