@@ -85,7 +85,8 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
     landing after a fold). Returns the final w and whether the gradient was driven to ~0 or
     (``roundoff``) the energy stopped falling beyond its round-off for ROUNDOFF_STEPS steps
     (settled: no descent step can tell a lower point of the basin from this one; the Newton
-    polish can).
+    polish can) - a trial rejected for a rise within that round-off counts as such a step
+    (ROUNDOFF_REJECTS), the descent staying at its lowest point.
     """
     b = problem.contour(d)
     upper = b - h_floor
