@@ -279,10 +279,14 @@ def _run(scene, args):
         if not limit > 0:
             raise SceneError("command line", "--time-limit", args.time_limit,
                              "a positive duration such as '10 min'")
-    res = run(scene, out, figures=not args.no_figures,
-              progress=False if args.quiet else None, overwrite=args.overwrite,
-              resume=args.resume, estimate="peak" if args.no_estimate else True,
-              time_limit=limit, resume_from=args.resume_from)
+    from .runner.figures import figure_worker
+
+    # a contact run's figures are drawn by a worker that gets ready while the run solves
+    with figure_worker(enabled=not args.no_figures and scene.kind == "contact"):
+        res = run(scene, out, figures=not args.no_figures,
+                  progress=False if args.quiet else None, overwrite=args.overwrite,
+                  resume=args.resume, estimate="peak" if args.no_estimate else True,
+                  time_limit=limit, resume_from=args.resume_from)
     for w in getattr(res, "warnings", ()):
         if w.startswith("resume: "):
             print(f"femadh: note: {w}", file=sys.stderr)

@@ -13,6 +13,7 @@ import csv
 import io
 import math
 import os
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -83,3 +84,102 @@ def test_a_run_writes_fields_whose_cells_are_their_own_shortest_repr(tmp_path):
     assert states == sorted(states)
     for r in body[:: max(1, len(body) // 400)]:
         assert all(repr(float(c)) == c for c in r[2:])
+
+
+# --------------------------------------------------------------------------- figure worker
+
+SCENE = os.path.join(os.path.dirname(__file__), "..", "validation", "scenes",
+                     "paper1_fig3.toml")
+
+
+def _small_scene(folder):
+    """The Fig 3 scene on 60 uniform nodes (a run of ~0.5 s with two figures)."""
+    text = open(SCENE).read().replace("[solver]\n", "[solver]\nnodes = 60\n", 1)
+    path = folder / "fig3_small.toml"
+    path.write_text(text)
+    return path
+
+
+def _pngs(folder):
+    return sorted(p.name for p in folder.iterdir() if p.suffix == ".png")
+
+
+def _no_temporary_files(folder):
+    return [p.name for p in folder.iterdir() if p.name.startswith(".")] == []
+
+
+def test_a_command_line_run_has_its_figures_drawn_by_the_worker(tmp_path, monkeypatch):
+    """The worker writes every figure (none left to the run), the same files an in-process
+    run draws, and is reaped when the command returns."""
+    import femadh
+    from femadh.cli import main
+    from femadh.io.plots import figure_names
+    from femadh.runner import figures
+
+    seen = {}
+    real = figures.FigureWorker.draw
+
+    def spy(self, res, folder):
+        seen["pid"], seen["names"] = self.pid, figure_names(res)
+        seen["left"] = real(self, res, folder)
+        return seen["left"]
+    monkeypatch.setattr(figures.FigureWorker, "draw", spy)
+    path = _small_scene(tmp_path)
+    assert main(["run", str(path), "--out", str(tmp_path / "cli"), "--quiet",
+                 "--no-estimate"]) == 0
+    assert seen["left"] == []
+    assert seen["names"] == ["force_curve.png", "profiles_and_forces.png"]
+    with pytest.raises(ChildProcessError):
+        os.waitpid(seen["pid"], os.WNOHANG)          # reaped
+    monkeypatch.setattr(figures.FigureWorker, "draw", real)
+    femadh.run(femadh.load_scene(path), tmp_path / "api", progress=False, estimate="peak")
+    assert _pngs(tmp_path / "cli") == _pngs(tmp_path / "api") == sorted(seen["names"])
+    for name in seen["names"]:
+        # the same data, the same matplotlib: the same picture, byte for byte
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "api" / name).read_bytes()
+    assert _no_temporary_files(tmp_path / "cli")
+
+
+def test_a_dead_worker_leaves_its_figures_to_the_run(tmp_path):
+    import signal
+
+    import femadh
+    from femadh.runner.figures import figure_worker
+
+    scene = femadh.load_scene(_small_scene(tmp_path))
+    with figure_worker() as worker:
+        os.kill(worker.pid, signal.SIGKILL)
+        res = femadh.run(scene, tmp_path / "out", progress=False, estimate="peak")
+    assert res.status == "converged" and "figures_s" in res.timings
+    assert _pngs(tmp_path / "out") == ["force_curve.png", "profiles_and_forces.png"]
+
+
+def test_a_signal_while_the_worker_draws_stops_the_run_and_the_worker(tmp_path, monkeypatch):
+    """SIGINT arriving while the run waits for its worker: the run ends "interrupted", the
+    worker is stopped and reaped, and the folder holds no temporary or partial figure."""
+    import signal
+
+    import femadh
+    from femadh import interrupt
+    from femadh.runner import figures
+    from PIL import Image
+
+    scene = femadh.load_scene(_small_scene(tmp_path))
+    res = femadh.run(scene, tmp_path / "out", progress=False, figures=False, estimate="peak")
+    real = figures._recv
+    with figures.figure_worker() as worker:
+        pid = worker.pid
+
+        def interrupted_recv(fd):
+            os.kill(os.getpid(), signal.SIGINT)       # the user's Ctrl-C, job sent
+            return real(fd)
+        monkeypatch.setattr(figures, "_recv", interrupted_recv)
+        with interrupt.interruptible():
+            figures.draw_figures(res, SimpleNamespace(path=tmp_path / "out"))
+    assert res.status == "interrupted" and "while drawing the figures" in res.error
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)
+    folder = tmp_path / "out"
+    assert _no_temporary_files(folder)
+    for name in _pngs(folder):                         # whole or absent
+        Image.open(folder / name).verify()
