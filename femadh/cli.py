@@ -155,7 +155,42 @@ def _error(msg):
 
 
 def main(argv=None):
-    """Entry point; returns the exit code."""
+    """Entry point; returns the exit code.
+
+    Run as the ``femadh`` program (``python -m femadh``, the ``femadh`` script: no ``argv``
+    given), the process ends as soon as the command is done, without the interpreter's
+    teardown of every module and array (~0.1 s of CPU after a run, ~10 % of a Fig 3 run
+    without figures): every file is closed by then (the csv logs are unbuffered, the rest
+    written whole and renamed), the figure worker reaped, stdout and stderr flushed."""
+    code = _main(argv)
+    if argv is None and _as_program():
+        _exit_now(code)
+    return code
+
+
+def _as_program():
+    """Whether this process is the ``femadh`` program (its script or ``python -m femadh``),
+    not a script that calls :func:`main`; a coverage run keeps its teardown (its data is
+    written at exit)."""
+    prog = os.path.normpath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    return (not os.environ.get("COVERAGE_PROCESS_START")
+            and (os.path.basename(prog).removesuffix(".exe") == "femadh"
+                 or prog.endswith(os.path.join("femadh", "__main__.py"))))
+
+
+def _exit_now(code):
+    """End the process with ``code`` at once (see :func:`main`)."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    if "logging" in sys.modules:
+        sys.modules["logging"].shutdown()       # (what its atexit hook would do)
+    os._exit(code if isinstance(code, int) else 0 if code is None else 1)
+
+
+def _main(argv):
     args = _parser().parse_args(argv)
     try:
         from ._threads import blas_threads
