@@ -100,6 +100,12 @@ def _small_scene(folder):
     return path
 
 
+needs_worker = pytest.mark.skipif(
+    not (hasattr(os, "fork") and hasattr(os, "sched_getaffinity")
+         and len(os.sched_getaffinity(0)) >= 2),
+    reason="the figure worker runs on Linux with two cores or more")
+
+
 def _pngs(folder):
     return sorted(p.name for p in folder.iterdir() if p.suffix == ".png")
 
@@ -108,6 +114,7 @@ def _no_temporary_files(folder):
     return [p.name for p in folder.iterdir() if p.name.startswith(".")] == []
 
 
+@needs_worker
 def test_a_command_line_run_has_its_figures_drawn_by_the_worker(tmp_path, monkeypatch):
     """The worker writes every figure (none left to the run), the same files an in-process
     run draws, and is reaped when the command returns."""
@@ -140,6 +147,7 @@ def test_a_command_line_run_has_its_figures_drawn_by_the_worker(tmp_path, monkey
     assert _no_temporary_files(tmp_path / "cli")
 
 
+@needs_worker
 def test_a_dead_worker_leaves_its_figures_to_the_run(tmp_path):
     import signal
 
@@ -154,6 +162,7 @@ def test_a_dead_worker_leaves_its_figures_to_the_run(tmp_path):
     assert _pngs(tmp_path / "out") == ["force_curve.png", "profiles_and_forces.png"]
 
 
+@needs_worker
 def test_a_signal_while_the_worker_draws_stops_the_run_and_the_worker(tmp_path, monkeypatch):
     """SIGINT arriving while the run waits for its worker: the run ends "interrupted", the
     worker is stopped and reaped, and the folder holds no temporary or partial figure."""
@@ -183,3 +192,21 @@ def test_a_signal_while_the_worker_draws_stops_the_run_and_the_worker(tmp_path, 
     assert _no_temporary_files(folder)
     for name in _pngs(folder):                         # whole or absent
         Image.open(folder / name).verify()
+
+
+def test_no_worker_without_figures_or_on_one_core(tmp_path, monkeypatch):
+    """--no-figures forks nothing; on one core the figures are drawn in-process."""
+    from femadh.cli import main
+    from femadh.runner import figures
+
+    def no_fork(self):
+        raise AssertionError("a figure worker was started")
+    monkeypatch.setattr(figures.FigureWorker, "__init__", no_fork)
+    path = _small_scene(tmp_path)
+    assert main(["run", str(path), "--out", str(tmp_path / "bare"), "--quiet",
+                 "--no-estimate", "--no-figures"]) == 0
+    assert _pngs(tmp_path / "bare") == []
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0}, raising=False)
+    assert main(["run", str(path), "--out", str(tmp_path / "one"), "--quiet",
+                 "--no-estimate"]) == 0
+    assert _pngs(tmp_path / "one") == ["force_curve.png", "profiles_and_forces.png"]

@@ -3,7 +3,7 @@
 Drawing them costs a run about as much as a small solve: importing matplotlib (~0.3-0.5 s on
 one core) and rendering (~0.2 s for ``force_curve.png``, ~0.5 s for the paper's panels,
 validation/results/benchmark.md). A command-line run therefore forks a **figure worker**
-before it solves (:func:`figure_worker`, Linux only): the worker imports matplotlib and
+before it solves (:func:`figure_worker`; Linux, two cores or more): the worker imports matplotlib and
 warms its fonts on the other core while the run solves, then draws the figures of the
 result handed to it (pickled over a pipe), each in a process of its own, side by side. The
 run waits for them: ``femadh run`` never returns before its figures are on disk, exactly as
@@ -14,7 +14,7 @@ Nothing is lost to the worker: each figure is written whole or not at all
 worker (SIGTERM: its temporary files are removed) and the run ends "interrupted" as before
 (--resume draws them); a worker that died, could not be reached, or reported an error leaves
 its figures to the run itself, drawn in-process as without a worker (an error then reaches
-the run as it always did). Without a worker (the Python API, other platforms,
+the run as it always did). Without a worker (the Python API, other platforms, one core,
 ``--no-figures``) the figures are drawn in-process.
 """
 from contextlib import contextmanager
@@ -53,9 +53,12 @@ def draw_figures(res, folder):
 
 @contextmanager
 def figure_worker(enabled=True):
-    """Fork a :class:`FigureWorker` for the block (``enabled`` and on Linux; else None) and
-    let :func:`draw_figures` use it; it is stopped and reaped when the block ends."""
-    if not enabled or not sys.platform.startswith("linux") or _WORKER[0] is not None:
+    """Fork a :class:`FigureWorker` for the block (``enabled``, on Linux with two cores or
+    more; else None) and let :func:`draw_figures` use it; it is stopped and reaped when the
+    block ends."""
+    if (not enabled or not sys.platform.startswith("linux") or _WORKER[0] is not None
+            or len(os.sched_getaffinity(0)) < 2):
+        # (on one core a worker would only add its start-up to the run's time)
         yield None
         return
     try:
