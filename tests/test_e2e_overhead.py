@@ -210,3 +210,25 @@ def test_no_worker_without_figures_or_on_one_core(tmp_path, monkeypatch):
     assert main(["run", str(path), "--out", str(tmp_path / "one"), "--quiet",
                  "--no-estimate"]) == 0
     assert _pngs(tmp_path / "one") == ["force_curve.png", "profiles_and_forces.png"]
+
+
+def test_the_program_ends_at_once_with_its_output_and_exit_code(tmp_path):
+    """``python -m femadh run`` skips the interpreter's teardown (cli.main): what it printed
+    into a pipe (block-buffered) still arrives, and its exit codes are kept."""
+    import subprocess
+    import sys
+
+    root = os.path.join(os.path.dirname(__file__), "..")
+    path = _small_scene(tmp_path)
+    cmd = [sys.executable, "-m", "femadh", "run", str(path), "--out", str(tmp_path / "o"),
+           "--no-estimate", "--no-figures"]
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("COVERAGE_PROCESS_START", None)
+    env.pop("PYTHONUNBUFFERED", None)                  # (a pipe is block-buffered)
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=root, env=env)
+    assert p.returncode == 0, p.stderr
+    assert "max adhesion" in p.stdout                 # the summary lines, from a pipe
+    assert (tmp_path / "o" / "summary.json").exists()
+    again = subprocess.run(cmd, capture_output=True, text=True, cwd=root, env=env)
+    assert again.returncode == 4                      # the folder holds a run
+    assert again.stderr.startswith("femadh: error: ") and "--overwrite" in again.stderr
