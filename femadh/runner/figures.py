@@ -159,11 +159,11 @@ class FigureWorker:
                     break
                 if msg[0] == "done":
                     done.add(msg[1])
-        except Interrupted:
-            self.stop()
-            raise
         except (OSError, EOFError, pickle.UnpicklingError, struct.error):
             pass                          # the worker died: what it did not write, here
+        except BaseException:             # a signal (Interrupted): the worker stops too
+            self.stop()
+            raise
         return [n for n in names if n not in done]
 
     def stop(self):
