@@ -37,6 +37,18 @@ ODD = [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 1.7976931348623157e3
        123456789.0, -3.0000000000000004e-09, 2 ** 53 + 1.0]
 
 
+SCENE = os.path.join(os.path.dirname(__file__), "..", "validation", "scenes",
+                     "paper1_fig3.toml")
+
+
+def _small_scene(folder):
+    """The Fig 3 scene on 60 uniform nodes (a run of ~0.5 s with two figures)."""
+    text = open(SCENE).read().replace("[solver]\n", "[solver]\nnodes = 60\n", 1)
+    path = folder / "fig3_small.toml"
+    path.write_text(text)
+    return path
+
+
 def test_field_lines_are_the_csv_of_the_per_cell_rows():
     rng = np.random.default_rng(21)
     n = 301
@@ -71,8 +83,7 @@ def test_a_run_writes_fields_whose_cells_are_their_own_shortest_repr(tmp_path):
     reads back to (what the per-cell writer wrote), rows in state order, header first."""
     import femadh
 
-    scene = femadh.load_scene(os.path.join(os.path.dirname(__file__), "..", "validation",
-                                           "scenes", "paper1_fig3.toml"))
+    scene = femadh.load_scene(_small_scene(tmp_path))
     res = femadh.run(scene, tmp_path / "out", figures=False, estimate=False, progress=False)
     assert res.status == "converged"
     with open(tmp_path / "out" / "fields.csv", newline="") as f:
@@ -87,18 +98,6 @@ def test_a_run_writes_fields_whose_cells_are_their_own_shortest_repr(tmp_path):
 
 
 # --------------------------------------------------------------------------- figure worker
-
-SCENE = os.path.join(os.path.dirname(__file__), "..", "validation", "scenes",
-                     "paper1_fig3.toml")
-
-
-def _small_scene(folder):
-    """The Fig 3 scene on 60 uniform nodes (a run of ~0.5 s with two figures)."""
-    text = open(SCENE).read().replace("[solver]\n", "[solver]\nnodes = 60\n", 1)
-    path = folder / "fig3_small.toml"
-    path.write_text(text)
-    return path
-
 
 needs_worker = pytest.mark.skipif(
     not (hasattr(os, "fork") and hasattr(os, "sched_getaffinity")
