@@ -158,12 +158,15 @@ def main(argv=None):
     """Entry point; returns the exit code.
 
     Run as the ``femadh`` program (``python -m femadh``, the ``femadh`` script: no ``argv``
-    given), ``femadh run`` ends the process as soon as it is done, without the interpreter's
-    teardown of every module and array (~0.1 s of CPU after a run, ~10 % of a Fig 3 run
-    without figures): every file is closed by then (the csv logs are unbuffered, the rest
-    written whole and renamed), the figure worker reaped, stdout and stderr flushed."""
-    code = _main(argv)
-    if argv is None and sys.argv[1:2] == ["run"] and _as_program():
+    given), the process is femadh's own: ``femadh run`` draws its figures in a worker process
+    (:mod:`femadh.runner.figures`) and ends the process as soon as it is done, without the
+    interpreter's teardown of every module and array (~0.1 s of CPU after a run, ~10 % of a
+    Fig 3 run without figures): every file is closed by then (the csv logs are unbuffered,
+    the rest written whole and renamed), the figure worker reaped, stdout and stderr
+    flushed. Called with ``argv`` (a script, a test) it forks nothing and returns."""
+    program = argv is None and _as_program()
+    code = _main(argv, program)
+    if program and sys.argv[1:2] == ["run"]:
         _exit_now(code)
     return code
 
@@ -190,8 +193,9 @@ def _exit_now(code):
     os._exit(code if isinstance(code, int) else 0 if code is None else 1)
 
 
-def _main(argv):
+def _main(argv, program=False):
     args = _parser().parse_args(argv)
+    args.program = program
     try:
         from ._threads import blas_threads
 
@@ -317,7 +321,8 @@ def _run(scene, args):
     from .runner.figures import figure_worker
 
     # a contact run's figures are drawn by a worker that gets ready while the run solves
-    with figure_worker(enabled=not args.no_figures and scene.kind == "contact"):
+    with figure_worker(enabled=getattr(args, "program", False) and not args.no_figures
+                       and scene.kind == "contact"):
         res = run(scene, out, figures=not args.no_figures,
                   progress=False if args.quiet else None, overwrite=args.overwrite,
                   resume=args.resume, estimate="peak" if args.no_estimate else True,

@@ -113,34 +113,49 @@ def _no_temporary_files(folder):
     return [p.name for p in folder.iterdir() if p.name.startswith(".")] == []
 
 
+def _program(tmp_path, args, spy=""):
+    """Run ``femadh ARGS`` as the program (its own process, sys.argv[0] 'femadh') with
+    ``spy`` (Python run first, e.g. patches that print to stderr); (exit code, stderr)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nsys.argv = ['femadh'] + sys.argv[1:]\n" + spy
+            + "\nfrom femadh.cli import main\nsys.exit(main())\n")
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("COVERAGE_PROCESS_START", None)
+    env.pop("PYTHONUNBUFFERED", None)                  # (a pipe is block-buffered)
+    p = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True,
+                       text=True, cwd=os.path.join(os.path.dirname(__file__), ".."), env=env)
+    return p.returncode, p.stderr
+
+
+#: prints what the figure worker was asked and left undrawn
+SPY = """
+from femadh.runner import figures
+real = figures.FigureWorker.draw
+def spy(self, res, folder):
+    left = real(self, res, folder)
+    print("WORKER LEFT", left, file=sys.stderr)
+    return left
+figures.FigureWorker.draw = spy
+"""
+
+
 @needs_worker
-def test_a_command_line_run_has_its_figures_drawn_by_the_worker(tmp_path, monkeypatch):
-    """The worker writes every figure (none left to the run), the same files an in-process
-    run draws, and is reaped when the command returns."""
+def test_the_program_has_its_figures_drawn_by_the_worker(tmp_path):
+    """The worker writes every figure (none left to the run): the same files, byte for
+    byte, as the run draws in-process (the Python API)."""
     import femadh
-    from femadh.cli import main
-    from femadh.io.plots import figure_names
-    from femadh.runner import figures
 
-    seen = {}
-    real = figures.FigureWorker.draw
-
-    def spy(self, res, folder):
-        seen["pid"], seen["names"] = self.pid, figure_names(res)
-        seen["left"] = real(self, res, folder)
-        return seen["left"]
-    monkeypatch.setattr(figures.FigureWorker, "draw", spy)
     path = _small_scene(tmp_path)
-    assert main(["run", str(path), "--out", str(tmp_path / "cli"), "--quiet",
-                 "--no-estimate"]) == 0
-    assert seen["left"] == []
-    assert seen["names"] == ["force_curve.png", "profiles_and_forces.png"]
-    with pytest.raises(ChildProcessError):
-        os.waitpid(seen["pid"], os.WNOHANG)          # reaped
-    monkeypatch.setattr(figures.FigureWorker, "draw", real)
+    code, err = _program(tmp_path, ["run", path, "--out", tmp_path / "cli", "--quiet",
+                                    "--no-estimate"], SPY)
+    assert code == 0, err
+    assert "WORKER LEFT []" in err
     femadh.run(femadh.load_scene(path), tmp_path / "api", progress=False, estimate="peak")
-    assert _pngs(tmp_path / "cli") == _pngs(tmp_path / "api") == sorted(seen["names"])
-    for name in seen["names"]:
+    names = ["force_curve.png", "profiles_and_forces.png"]
+    assert _pngs(tmp_path / "cli") == _pngs(tmp_path / "api") == names
+    for name in names:
         # the same data, the same matplotlib: the same picture, byte for byte
         assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "api" / name).read_bytes()
     assert _no_temporary_files(tmp_path / "cli")
@@ -193,22 +208,33 @@ def test_a_signal_while_the_worker_draws_stops_the_run_and_the_worker(tmp_path, 
         Image.open(folder / name).verify()
 
 
-def test_no_worker_without_figures_or_on_one_core(tmp_path, monkeypatch):
-    """--no-figures forks nothing; on one core the figures are drawn in-process."""
+def test_no_worker_without_figures_on_one_core_or_inside_a_script(tmp_path):
+    """--no-figures forks nothing; on one core, or when a script calls femadh.cli.main, the
+    figures are drawn in-process."""
     from femadh.cli import main
     from femadh.runner import figures
 
-    def no_fork(self):
-        raise AssertionError("a figure worker was started")
-    monkeypatch.setattr(figures.FigureWorker, "__init__", no_fork)
+    forked = ("from femadh.runner import figures\nreal = figures.FigureWorker.__init__\n"
+              "def init(self):\n    print('FORKED', file=sys.stderr)\n    real(self)\n"
+              "figures.FigureWorker.__init__ = init\n")
     path = _small_scene(tmp_path)
-    assert main(["run", str(path), "--out", str(tmp_path / "bare"), "--quiet",
-                 "--no-estimate", "--no-figures"]) == 0
+    run = ["run", path, "--quiet", "--no-estimate"]
+    code, err = _program(tmp_path, run + ["--out", tmp_path / "bare", "--no-figures"], forked)
+    assert code == 0 and "FORKED" not in err, err
     assert _pngs(tmp_path / "bare") == []
-    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0}, raising=False)
-    assert main(["run", str(path), "--out", str(tmp_path / "one"), "--quiet",
-                 "--no-estimate"]) == 0
+    one = "import os\nos.sched_getaffinity = lambda pid: {0}\n"
+    code, err = _program(tmp_path, run + ["--out", tmp_path / "one"], one + forked)
+    assert code == 0 and "FORKED" not in err, err
     assert _pngs(tmp_path / "one") == ["force_curve.png", "profiles_and_forces.png"]
+    real = figures.FigureWorker.__init__
+    try:
+        def no_fork(self):
+            raise AssertionError("a figure worker was started")
+        figures.FigureWorker.__init__ = no_fork
+        assert main([str(a) for a in run + ["--out", tmp_path / "script"]]) == 0
+    finally:
+        figures.FigureWorker.__init__ = real
+    assert _pngs(tmp_path / "script") == ["force_curve.png", "profiles_and_forces.png"]
 
 
 def test_the_program_ends_at_once_with_its_output_and_exit_code(tmp_path):

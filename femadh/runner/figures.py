@@ -2,8 +2,9 @@
 
 Drawing them costs a run about as much as a small solve: importing matplotlib (~0.3-0.5 s on
 one core) and rendering (~0.2 s for ``force_curve.png``, ~0.5 s for the paper's panels,
-validation/results/benchmark.md). A command-line run therefore forks a **figure worker**
-before it solves (:func:`figure_worker`; Linux, two cores or more): the worker imports matplotlib and
+validation/results/benchmark.md). The ``femadh`` program (``femadh run``, in a process of
+its own; not :func:`femadh.cli.main` called from a script) therefore forks a **figure
+worker** before it solves (:func:`figure_worker`; Linux, two cores or more): the worker imports matplotlib and
 warms its fonts on the other core while the run solves, then draws the figures of the
 result handed to it (pickled over a pipe), each in a process of its own, side by side. The
 run waits for them: ``femadh run`` never returns before its figures are on disk, exactly as
