@@ -182,3 +182,56 @@ def fields_by_state(out):
         for row in csv.DictReader(f):
             rows.setdefault(row["state"], []).append((float(row["r_m"]), float(row["h_m"])))
     return {k: tuple(np.array(v).T) for k, v in rows.items()}
+
+
+#: the band spacing (m) of the stiction map's sigma = 0.3 nm corner member whose approach's
+#: second landing needs the landing's fallbacks (tests/test_landing_relax.py)
+CORNER_SPACING = 26e-9
+#: that approach, through both its folds
+CORNER_D_VALUES = np.array([1.2, 1.0]) * 1e-9
+
+
+@pytest.fixture(scope="session")
+def corner_approach():
+    """The 2-mm slider with LJ, the sigma = 0.3 nm gap and an ethanol meniscus at p/psat =
+    0.05 on the banded member of 26 nm band spacing (253 nodes), and its approach through
+    both folds with the double-precision preconditioner (the path that reaches the landing
+    needing a fallback; see test_landing_relax): (scene, problem, sweep, [(d, w_start,
+    descent (w, contact set))] of every landing.land call that went to its fallbacks).
+
+    Traced once for test_landing_relax and test_landing_scan (each traced it, the same
+    path, ~2 CPU-s): the spies record and call through, so the path is the one each traced."""
+    import femadh
+    from femadh.contact import landing, linalg, stepping, trace
+    from femadh.discretisation import plan_grid
+    from femadh.elastic import GreenOperator
+    from femadh.scene import build_problem
+
+    scene = femadh.load_scene(Path(__file__).resolve().parents[1] / "validation" / "scenes"
+                              / "paper1_slider_meniscus.toml").replace(
+        {"effects.asperity_gap.sigma": "0.3 nm", "effects.capillary.relative_pressure": 0.05,
+         "sweep.start": "4 nm"})
+    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
+                     scene.d_values, scene.target_accuracy)
+    p = build_problem(scene, operator=GreenOperator(plan.family.member(CORNER_SPACING),
+                                                    scene.e_star))
+    starts, fallbacks = [], []
+    real_land, real_relaxed = stepping.land, landing._relaxed
+
+    def land_spy(problem, d, w_start, **kw):
+        starts.append(np.array(w_start))
+        return real_land(problem, d, w_start, **kw)
+
+    def relaxed_spy(problem, d, st, descent, **kw):
+        fallbacks.append((d, starts[-1], descent))
+        return real_relaxed(problem, d, st, descent, **kw)
+    dtype = linalg.PRECONDITIONER_DTYPE
+    try:
+        stepping.land, landing._relaxed = land_spy, relaxed_spy
+        linalg.PRECONDITIONER_DTYPE = np.float64
+        sweep = trace(p, CORNER_D_VALUES, branch="approach", tol=scene.tolerance,
+                      max_iter=scene.max_iter)
+    finally:
+        stepping.land, landing._relaxed = real_land, real_relaxed
+        linalg.PRECONDITIONER_DTYPE = dtype
+    return scene, p, sweep, fallbacks

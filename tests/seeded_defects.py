@@ -1488,8 +1488,8 @@ DEFECTS = [
         "if False and not _downhill(problem, d, start, e_start, st.w):"),)),
     D("snap_downhill_loose", "landing: the downhill test lets the energy rise by its own size",
       "femadh/contact/landing.py",
-      (("if not np.isfinite(e) or e > e_prev + noise:",
-        "if not np.isfinite(e) or e > e_prev + abs(e_prev) + noise:"),)),
+      (("if not np.isfinite(e) or e > e_prev + _roundoff(problem, w, e):",
+        "if not np.isfinite(e) or e > e_prev + abs(e_prev) + _roundoff(problem, w, e):"),)),
     D("snap_rhythm_past", "snap: the rhythm's first trial aimed past the expected fold",
       "femadh/contact/snap.py",
       (("self.target = d_fold + direction * (s - SNAP_MARGIN) * min_step",
@@ -1716,6 +1716,33 @@ DEFECTS = [
     D("eroute_low_fold", "edge route: a pilot's fold at its lowest edge radius taken",
       "femadh/runner/edge_route.py",
       (("    if r.fold.c < c_ref / PILOT_SPAN / LOW:", "    if False:"),)),
+
+    # -- the solve made cheaper (branch fig4solve): the descent's round-off rejections, the
+    #    first refinement's order
+    D("lmrej_full_descent_too", "landing descent: rises within round-off settle the whole "
+      "descent too (roundoff off)", "femadh/contact/landing.py",
+      (("            if roundoff and ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n",
+        "            if ROUNDOFF_REJECTS and np.isfinite(e_new) and \\\n"),)),
+    D("lmrej_not_counted", "landing descent: a rise within round-off raises the damping "
+      "without counting towards settling", "femadh/contact/landing.py",
+      (("                flat += 1\n                if flat >= ROUNDOFF_STEPS:\n"
+        "                    return w, True\n",
+        "                flat += 0\n                if flat >= ROUNDOFF_STEPS:\n"
+        "                    return w, True\n"),)),
+    D("lmrej_takes_risen_step", "landing descent: settles on the risen trial point, not on w",
+      "femadh/contact/landing.py",
+      (("                if flat >= ROUNDOFF_STEPS:\n                    return w, True\n"
+        "            lam *= 4",
+        "                if flat >= ROUNDOFF_STEPS:\n                    return w_new, True\n"
+        "            lam *= 4"),)),
+    D("first_order_old", "adaptive loop: the first refinement at the assumed ORDER again",
+      "femadh/runner/adaptive.py",
+      (("        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))\n    return FIRST_ORDER\n",
+        "        return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))\n    return ORDER\n"),)),
+    D("first_order_on_rise", "adaptive loop: an estimate that rose sized at FIRST_ORDER",
+      "femadh/runner/adaptive.py",
+      (("        if e0 <= e1:\n            return ORDER\n",
+        "        if e0 <= e1:\n            return FIRST_ORDER\n"),)),
 ]
 
 

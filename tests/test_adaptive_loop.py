@@ -93,8 +93,9 @@ def test_members_failed_refine_and_a_last_run_without_them_is_not_judged():
 
 def test_a_budget_spent_names_the_accuracy_reached_the_nodes_the_time_and_the_need():
     """An estimate that stays at 1.5x the target: each refinement takes the factor
-    (s / 1.5)^(1/ORDER), s the aim near the target (AIM^(1/c) 1.5^(-(1-c)/c), c =
-    ORDER_SPREAD), the assumed order throughout (an estimate that did not fall shows none);
+    (s / 1.5)^(1/p), s the aim near the target (AIM^(1/c) 1.5^(-(1-c)/c), c =
+    ORDER_SPREAD), p = FIRST_ORDER for the first, then the assumed ORDER (an estimate that
+    did not fall shows none);
     MAX_TRIALS runs, then one line naming the accuracy reached,
     the nodes, the runs, the time and about how many nodes the request needs (the family's
     count at the spacing the assumed order gives)."""
@@ -105,9 +106,11 @@ def test_a_budget_spent_names_the_accuracy_reached_the_nodes_the_time_and_the_ne
     res = adaptive.run_adaptive(sc, None, run=run)
     assert len(seen) == adaptive.MAX_TRIALS
     c = adaptive.ORDER_SPREAD
-    factor = (adaptive.AIM ** (1 / c) * 1.5 ** (-(1 - c) / c) / 1.5) ** (1 / adaptive.ORDER)
-    for (h, *_), (h_next, *_) in zip(seen, seen[1:]):
-        assert h_next == pytest.approx(factor * h, rel=1e-12, abs=0)
+    aim = adaptive.AIM ** (1 / c) * 1.5 ** (-(1 - c) / c) / 1.5
+    for i, ((h, *_), (h_next, *_)) in enumerate(zip(seen, seen[1:])):
+        # the first refinement at FIRST_ORDER (no earlier run), then ORDER (no fall)
+        p = adaptive.FIRST_ORDER if i == 0 else adaptive.ORDER
+        assert h_next == pytest.approx(aim ** (1 / p) * h, rel=1e-12, abs=0)
     last = res.accuracy["steps"][-1]
     fam = family_mod.GridFamily(last["analysis_radius_m"], last["band_m"],
                                 GRADING_FRACTION * last["band_m"])

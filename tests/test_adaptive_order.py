@@ -1,8 +1,8 @@
 """The adaptive loop sizes its next member from the order its estimate showed.
 
 After two converged runs of one grid family the next band spacing follows the estimate's
-observed order p = log(e0 / e1) / log(h0 / h1) (clamped to ORDER_BOUNDS; the assumed ORDER for
-the first step and where the estimate did not fall), aiming at a fraction of the target that
+observed order p = log(e0 / e1) / log(h0 / h1) (clamped to ORDER_BOUNDS; FIRST_ORDER for
+the first step, ORDER where the estimate did not fall), aiming at a fraction of the target that
 is closer to it the nearer the estimate is (``_safety``). The loop is driven by a ``run`` whose
 estimate is a power law of the trial's band spacing, e(h) = C h^q, so the observed order is
 q and where the loop lands is known in closed form; one real run (the Fig 3 scene at 3e-4)
@@ -50,15 +50,16 @@ def _factor(ratio, order):
 @pytest.mark.parametrize("q", [1.0, 1.31, 2.5])
 def test_the_third_member_follows_the_observed_order(q):
     """Estimate 4x the target on the first run (order q): the second spacing is sized with the
-    assumed ORDER, the third with the order the two estimates show, which is q (to round-off:
+    assumed FIRST_ORDER, the third with the order the two estimates show, which is q (to round-off:
     the spacings the runs record are the ones the estimate was computed on); the steps record
     the order each refinement used."""
     target = 1e-2
     run, seen = power_law(q, 4.0, target)
     res = adaptive.run_adaptive(adaptive_scene(accuracy=target), None, run=run)
     steps = res.accuracy["steps"]
-    assert steps[0]["order_used"] == adaptive.ORDER
-    assert seen[1] == pytest.approx(seen[0] * _factor(4.0, adaptive.ORDER), rel=1e-12, abs=0)
+    assert steps[0]["order_used"] == adaptive.FIRST_ORDER
+    assert seen[1] == pytest.approx(seen[0] * _factor(4.0, adaptive.FIRST_ORDER), rel=1e-12,
+                                    abs=0)
     e1 = 4.0 * (seen[1] / seen[0]) ** q
     if e1 <= 1.0:
         assert len(seen) == 2 and res.accuracy["met"]
@@ -70,13 +71,13 @@ def test_the_third_member_follows_the_observed_order(q):
 
 
 def test_fig4_in_miniature_meets_in_two_runs_on_a_coarser_second_member():
-    """Fig 4 at 1e-3 in miniature (measured: first estimate 2.03x the target, the estimate's
-    order 1.29 between its runs under the old rule): an order 1.31 (above ORDER_SPREAD x
-    ORDER = 1.305) lands the second member, sized at the near aim, at ratio (s / ratio)^(1.31
-    / 1.5) <= AIM in two runs, on a spacing coarser than the old rule's (SAFETY 0.6 at every
-    distance: 0.444 of the first; now 0.470)."""
+    """Fig 4 at 1e-3 in miniature (measured: first estimate 2.04x the target, the estimate's
+    order 1.73-1.80 between its runs, validation/results/fig4solve.md): an order 1.75 (above
+    ORDER_SPREAD x FIRST_ORDER = 1.74) lands the second member, sized at the near aim, at
+    ratio (s / ratio)^(1.75 / 2) <= AIM in two runs, on a spacing coarser than the older
+    rules' (SAFETY 0.6 at every distance and ORDER: 0.444 of the first; now 0.568)."""
     target = 1e-3
-    run, seen = power_law(1.31, 2.03, target)
+    run, seen = power_law(1.75, 2.03, target)
     res = adaptive.run_adaptive(adaptive_scene(accuracy=target), None, run=run)
     e = [s["grid_rel_error"] / target for s in res.accuracy["steps"]]
     assert len(e) == 2 and res.accuracy["met"] and e[1] <= adaptive.AIM
@@ -94,8 +95,8 @@ def test_an_observed_order_outside_the_bounds_is_clamped(q, expect):
 
 def test_the_observed_order_needs_the_same_family_and_a_falling_estimate():
     """Another analysis radius or band, a static band against one following the edge, a failed
-    or unjudged earlier run, an estimate that rose: the assumed ORDER; the latest qualifying
-    step is the one used."""
+    or unjudged earlier run: the first refinement's FIRST_ORDER; an estimate that rose: the
+    assumed ORDER; the latest qualifying step is the one used."""
     step = {"spacing_m": 1e-9, "grid_rel_error": 2e-3, "tail_rel_error": 1e-4,
             "band_m": 1e-6, "analysis_radius_m": 1e-5, "status": "converged"}
     good = dict(step, spacing_m=2e-9, grid_rel_error=2e-3 * 2**2.0 + 1e-4 * (2**2.0 - 1))
@@ -103,9 +104,9 @@ def test_the_observed_order_needs_the_same_family_and_a_falling_estimate():
     for other in (dict(good, analysis_radius_m=2e-5), dict(good, band_m=2e-6),
                   dict(good, follow_m=5e-8),
                   dict(good, status="failed"), dict(good, members_failed=True),
-                  dict(good, grid_rel_error=1e-3), dict(good, grid_rel_error=math.nan),
-                  dict(good, spacing_m=1e-9)):
-        assert adaptive._order(step, [other]) == adaptive.ORDER, other
+                  dict(good, grid_rel_error=math.nan), dict(good, spacing_m=1e-9)):
+        assert adaptive._order(step, [other]) == adaptive.FIRST_ORDER, other
+    assert adaptive._order(step, [dict(good, grid_rel_error=1e-3)]) == adaptive.ORDER
     older = dict(good, spacing_m=4e-9, grid_rel_error=2e-3 * 4.0 + 1e-4 * 3)
     assert adaptive._order(step, [older, good]) == pytest.approx(2.0, rel=1e-12, abs=0)
     assert adaptive._order(step, [good, dict(good, status="failed")]) == pytest.approx(
@@ -140,9 +141,9 @@ def test_a_real_run_sizes_its_second_member_by_the_rule():
     assert res.status == "converged" and res.accuracy["met"]
     assert len(steps) == 2
     ratio = (steps[0]["grid_rel_error"] + steps[0]["tail_rel_error"]) / target
-    assert steps[0]["order_used"] == adaptive.ORDER
+    assert steps[0]["order_used"] == adaptive.FIRST_ORDER
     assert steps[0]["safety"] == adaptive._safety(ratio) > adaptive.SAFETY
-    asked = steps[0]["spacing_m"] * _factor(ratio, adaptive.ORDER)
+    asked = steps[0]["spacing_m"] * _factor(ratio, adaptive.FIRST_ORDER)
     assert steps[1]["spacing_m"] == pytest.approx(asked, rel=1e-12, abs=0)
     assert steps[1]["nodes"] < steps[0]["nodes"] * (ratio / adaptive.SAFETY) ** (
         1 / adaptive.ORDER)

@@ -11,69 +11,38 @@ K w = P - p_c has no equilibrium on that contact set near it: the Newton polish 
 200 iterations at a residual of ~7e-14 m and the run failed. The corrector from the
 neighbouring contact edges, or the pseudo-time relaxation of the collocation equations past
 the vanished root, lands on the set whose equilibrium exists (71 nodes)."""
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-import femadh
-from femadh.contact import landing, linalg, stepping, trace
+from conftest import CORNER_D_VALUES, CORNER_SPACING
+from femadh.contact import landing
 from femadh.contact.complementarity import solve_complementarity
 from femadh.contact.stability import is_stable
-from femadh.discretisation import plan_grid
-from femadh.elastic import GreenOperator
-from femadh.scene import build_problem
 
-SCENE = Path(__file__).resolve().parents[1] / "validation" / "scenes" / \
-    "paper1_slider_meniscus.toml"
-#: the band spacing of the member (m) whose second landing failed before the fallbacks
-SPACING = 26e-9
-#: the approach through both folds
-D_VALUES = np.array([1.2, 1.0]) * 1e-9
+#: the band spacing of the member (m) whose second landing failed before the fallbacks, and
+#: the approach through both folds (the case is traced once, by conftest.corner_approach)
+SPACING, D_VALUES = CORNER_SPACING, CORNER_D_VALUES
 
 
 @pytest.fixture(scope="module")
-def slider():
-    scene = femadh.load_scene(SCENE).replace({"effects.asperity_gap.sigma": "0.3 nm",
-                                              "effects.capillary.relative_pressure": 0.05,
-                                              "sweep.start": "4 nm"})
-    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
-                     scene.d_values, scene.target_accuracy)
-    op = GreenOperator(plan.family.member(SPACING), scene.e_star)
-    return scene, build_problem(scene, operator=op)
+def slider(corner_approach):
+    scene, p, _, _ = corner_approach
+    return scene, p
 
 
 @pytest.fixture(scope="module")
-def landed(slider):
+def landed(corner_approach):
     """The approach through both folds, and every landing that needed a fallback:
     (d, w_start, descent (w, contact set)) - what :func:`landing.land` and its fallbacks
-    were called with."""
-    scene, p = slider
-    starts, fallbacks = [], []
-    real_land, real_relaxed = stepping.land, landing._relaxed
+    were called with.
 
-    def land_spy(problem, d, w_start, **kw):
-        starts.append(np.array(w_start))
-        return real_land(problem, d, w_start, **kw)
-
-    def relaxed_spy(problem, d, st, descent, **kw):
-        fallbacks.append((d, starts[-1], descent))
-        return real_relaxed(problem, d, st, descent, **kw)
-    # which fold's landing loses its equilibrium depends on the path to it at round-off: with
-    # the Krylov preconditioner's factor kept in single precision (linalg.PRECONDITIONER_DTYPE,
-    # the solver's default) the approach on this member passes both folds without needing a
-    # fallback (measured: 2 jumps, 0 fallbacks), with it in double it reaches the landing
-    # described above (2 jumps, 1 fallback). The landing itself is what is tested here: the
-    # double-precision path is taken to reach it
-    dtype = linalg.PRECONDITIONER_DTYPE
-    try:
-        stepping.land, landing._relaxed = land_spy, relaxed_spy
-        linalg.PRECONDITIONER_DTYPE = np.float64
-        sweep = trace(p, D_VALUES, branch="approach", tol=scene.tolerance,
-                      max_iter=scene.max_iter)
-    finally:
-        stepping.land, landing._relaxed = real_land, real_relaxed
-        linalg.PRECONDITIONER_DTYPE = dtype
+    Which fold's landing loses its equilibrium depends on the path to it at round-off: with
+    the Krylov preconditioner's factor kept in single precision (linalg.PRECONDITIONER_DTYPE,
+    the solver's default) the approach on this member passes both folds without needing a
+    fallback (measured: 2 jumps, 0 fallbacks), with it in double it reaches the landing
+    described above (2 jumps, 1 fallback). The landing itself is what is tested here: the
+    double-precision path is taken to reach it (conftest.corner_approach)."""
+    _, _, sweep, fallbacks = corner_approach
     return sweep, fallbacks
 
 

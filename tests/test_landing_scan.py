@@ -11,53 +11,23 @@ costs minutes; here the same situation is made on the small landing of
 tests/test_landing_relax.py (the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05, 253 nodes,
 26 nm band spacing, its approach's second fold) by letting the corrector fail from every
 disk within EDGE_SHIFTS of the descent's, as it did there."""
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-import femadh
-from femadh.contact import landing, linalg, trace
+from femadh.contact import landing
 from femadh.contact.linalg import disk_size
-from femadh.discretisation import plan_grid
-from femadh.elastic import GreenOperator
-from femadh.scene import build_problem
 
-from test_landing_relax import D_VALUES, SPACING, _check_landing
-
-SCENE = Path(__file__).resolve().parents[1] / "validation" / "scenes" / \
-    "paper1_slider_meniscus.toml"
+from test_landing_relax import _check_landing
 
 
 @pytest.fixture(scope="module")
-def case():
+def case(corner_approach):
     """(scene, problem, d, descent (w, contact set), the state before the fold) of the
     approach's second landing, the one whose polish from the descent fails
-    (test_landing_relax's case, same path)."""
-    scene = femadh.load_scene(SCENE).replace({"effects.asperity_gap.sigma": "0.3 nm",
-                                              "effects.capillary.relative_pressure": 0.05,
-                                              "sweep.start": "4 nm"})
-    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
-                     scene.d_values, scene.target_accuracy)
-    p = build_problem(scene, operator=GreenOperator(plan.family.member(SPACING),
-                                                    scene.e_star))
-    found = []
-    real = landing._relaxed
-
-    def spy(problem, d, st, descent, **kw):
-        found.append((d, descent))
-        return real(problem, d, st, descent, **kw)
-    dtype = linalg.PRECONDITIONER_DTYPE
-    try:
-        landing._relaxed = spy
-        linalg.PRECONDITIONER_DTYPE = np.float64     # the path to that landing (see there)
-        sweep = trace(p, D_VALUES, branch="approach", tol=scene.tolerance,
-                      max_iter=scene.max_iter)
-    finally:
-        landing._relaxed = real
-        linalg.PRECONDITIONER_DTYPE = dtype
-    assert found, "the case's landing no longer needs a fallback"
-    d, descent = found[0]
+    (test_landing_relax's case: the same trace, conftest.corner_approach)."""
+    scene, p, sweep, fallbacks = corner_approach
+    assert fallbacks, "the case's landing no longer needs a fallback"
+    d, _, descent = fallbacks[0]
     before = [j.before for j in sweep.jumps if j.d_land == d]
     assert len(before) == 1
     return scene, p, d, descent, before[0]

@@ -2,6 +2,7 @@
 analytic integrals of a known spectrum, McCool's relations against a summit count, the
 paper 1 Table 2 composite, the spectrum's tail criterion, the CLI and scenes naming a
 topography. Every file here is written by SurfaceTopography's own NetCDF writer."""
+from importlib.util import find_spec
 import json
 import math
 import subprocess
@@ -11,17 +12,31 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-pytest.importorskip("SurfaceTopography")
+from femadh.cli import main
+from femadh.roughness.reading import read_topography
+from femadh.laws.gw import Summits
+from femadh.roughness import SpectralMoments, composite, mccool, profile_moments
+from femadh.roughness import table2_rule
+from femadh.roughness.spectrum import tail_check
 
-from SurfaceTopography import Topography  # noqa: E402
-from SurfaceTopography.Generation import fourier_synthesis  # noqa: E402
+# SurfaceTopography is imported where a test uses it, not here: importing it (scipy.stats
+# with it) costs ~1.2 CPU-s, which every xdist worker paid while collecting, whether or not
+# it ran a test of this file
+pytestmark = pytest.mark.skipif(find_spec("SurfaceTopography") is None,
+                                reason="SurfaceTopography not installed")
 
-from femadh.cli import main  # noqa: E402
-from femadh.roughness.reading import read_topography  # noqa: E402
-from femadh.laws.gw import Summits  # noqa: E402
-from femadh.roughness import SpectralMoments, composite, mccool, profile_moments  # noqa: E402
-from femadh.roughness import table2_rule  # noqa: E402
-from femadh.roughness.spectrum import tail_check  # noqa: E402
+
+def Topography(*args, **kw):
+    from SurfaceTopography import Topography as topography
+
+    return topography(*args, **kw)
+
+
+def fourier_synthesis(*args, **kw):
+    from SurfaceTopography.Generation import fourier_synthesis as synthesis
+
+    return synthesis(*args, **kw)
+
 
 #: the synthetic self-affine surface: Hurst exponent, side, prefactor of C2D = C0 q^(-2-2H)
 HURST, SIDE, C0 = 0.8, 1e-6, 1e-30

@@ -24,7 +24,7 @@ import math
 UNIFORM_MAX_NODES = 3200
 #: largest member of a banded grid family (:class:`femadh.discretisation.GridFamily`), the
 #: adaptive run's node budget (:mod:`femadh.runner.adaptive`): the family puts its nodes in
-#: the band (the Fig 4 scene meets 1e-3 with ~600, README "Accuracy"), so a member needing
+#: the band (the Fig 4 scene meets 1e-3 with ~500, README "Accuracy"), so a member needing
 #: more is a request to refuse; the dense operator of 4000 nodes is 128 MB per copy
 BANDED_MAX_NODES = 4000
 #: node budget of the regime map's refinements (:mod:`femadh.studies.regime`): its arclength

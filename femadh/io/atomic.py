@@ -121,7 +121,13 @@ class RowLog:
     def append(self, rows):
         """Append the rows (lists) as one chunk; on failure the file is cut back to its size
         before the chunk and OutputError names the file."""
-        blob = csv_text(rows).encode()
+        self.append_text(csv_text(rows))
+
+    def append_text(self, text):
+        """Append ``text`` - whole csv lines, formatted by the caller exactly as
+        :func:`csv_text` would (see :func:`femadh.io.writers.field_lines`) - as one chunk,
+        like :meth:`append`."""
+        blob = text.encode()
         done = 0
         try:
             while done < len(blob):

@@ -48,18 +48,44 @@ def length_unit(values):
     return 1e3, "mm"
 
 
-def contact_figures(res, folder):
-    """The figures of a contact run into ``folder``; returns their paths."""
-    from pathlib import Path
-
-    folder = Path(folder)
-    paths = [force_curve(res, folder / "force_curve.png")]
+def figure_names(res):
+    """The file names of a contact run's figures, in the order they are drawn."""
+    names = ["force_curve.png"]
     sc = res.scene
     if "lj" in sc.effects and sc.gap is not None and res.profiles:
-        paths.append(paper1_panels(res, folder / "profiles_and_forces.png"))
+        names.append("profiles_and_forces.png")
     if getattr(res, "instrument", None) is not None:
-        paths.append(instrument_figure(res, folder / "instrument.png"))
-    return paths
+        names.append("instrument.png")
+    return names
+
+
+def contact_figures(res, folder, only=None):
+    """The figures of a contact run into ``folder`` (``only``: those of these file names);
+    returns their paths."""
+    from pathlib import Path
+
+    draw = {"force_curve.png": force_curve, "profiles_and_forces.png": paper1_panels,
+            "instrument.png": instrument_figure}
+    folder = Path(folder)
+    return [draw[name](res, folder / name) for name in figure_names(res)
+            if only is None or name in only]
+
+
+def warm_up():
+    """Import matplotlib and draw a small figure off-screen: its fonts, text layout and
+    mathtext caches are then ready (a figure worker does this while the run solves)."""
+    import io
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(2, 1.5))
+    ax.plot([0, 1], [0, 1], "-o", label="µ σ")
+    ax.plot([], [], marker=r"$\rightarrow$", ls="")
+    ax.set(xlabel="d (nm)", title="warm-up")
+    ax.legend(fontsize=7)
+    fig.savefig(io.BytesIO(), format="png", dpi=50)
+    plt.close(fig)
+    from .. import reference  # noqa: F401  (the panels' JKR/DMT lines)
+    from ..laws import registry  # noqa: F401  (the effects' labels)
 
 
 def instrument_figure(res, path):

@@ -10,7 +10,7 @@ until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
     h <- h * clamp((s * target / error)^(1/p), MIN_FACTOR, MAX_FACTOR)
 
 with p the order the estimate showed between the last two converged runs of the same family
-(clamped to ORDER_BOUNDS; the assumed ORDER for the first refinement) and s the aim, SAFETY
+(clamped to ORDER_BOUNDS; the assumed FIRST_ORDER for the first refinement) and s the aim, SAFETY
 far from the target, closer to AIM the nearer the estimate is to it (:func:`_safety`;
 measured on every adaptive row of validation/accuracy.py: validation/results/adaptive_order.md).
 
@@ -58,8 +58,21 @@ MAX_TRIALS = 5
 #: (from about 3.7x the target on; nearer it, :func:`_safety` aims closer)
 SAFETY = 0.6
 #: assumed convergence order of the headline numbers in the band spacing (local orders
-#: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order)
+#: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order): the first member's
+#: plan for a request other than REFERENCE_ACCURACY, and the order where the estimate did not
+#: fall between two runs
 ORDER = 1.5
+#: the order the first refinement sizes its member with (no earlier run of the family shows
+#: one): the median of the estimate's order between the first two runs, measured on the five
+#: requests of validation/accuracy.py's scenes that refine (validation/results/fig4solve.md):
+#: Fig 3 at 2e-3 1.43, Fig 4 at 1e-3 1.80, Fig 3 at 3e-3 1.99, the slider + meniscus at
+#: 1e-2 4.10, Fig 4 at 2e-3 7.09. The near aim (:func:`_safety`) covers a true order down to
+#: ORDER_SPREAD x FIRST_ORDER = 1.74; the lowest, 1.43, sized so from its 1.58x lands at
+#: 0.86 of the target. With ORDER here (1.5) Fig 4 at 1e-3 asked for 595 nodes; now 493
+#: (estimate 7.7e-4). The estimate is not smooth in h: neighbouring members differ by up to
+#: 4x (Fig 3 at 116 and 118 nodes: 4.1e-3 and 1.85e-3), so Fig 3 at 3e-3 now takes a third
+#: run (87, 109, 150 nodes: its estimate at 109 did not fall) where 118 met
+FIRST_ORDER = 2.0
 #: limits of one refinement factor of h
 MIN_FACTOR, MAX_FACTOR = 0.3, 0.8
 #: range an order observed between two runs of one family is clamped to (outside it the two
@@ -412,7 +425,7 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):
     unjudged one (``estimate`` not True) ends the loop. An estimate above the target sizes
     the next member with the order the estimate showed between this run and the last
     converged one of the same family (``history``, the earlier steps; :func:`_order`), the
-    assumed ORDER without one, aiming closer the nearer the target it is (:func:`_safety`)."""
+    assumed FIRST_ORDER without one, aiming closer the nearer the target it is (:func:`_safety`)."""
     family, h = tr.family, tr.spacing
     ahead["next"] = ahead["failure"] = None
     if res.status in STOPPED:
@@ -473,9 +486,9 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):
 def _order(step, history):
     """The order the next member is sized with: the estimate's observed order between
     ``step`` and the latest earlier converged step of the same family (band, analysis radius,
-    a static band or one following the edge) at another spacing, p = log(e0 / e1) / log(h0 / h1), clamped to ORDER_BOUNDS; ORDER
-    where there is none or the estimate did not fall with the spacing (its order says
-    nothing then)."""
+    a static band or one following the edge) at another spacing, p = log(e0 / e1) /
+    log(h0 / h1), clamped to ORDER_BOUNDS; FIRST_ORDER where there is none, ORDER where the
+    estimate did not fall with the spacing (its order says nothing then)."""
     h1, e1 = step["spacing_m"], step["grid_rel_error"] + step["tail_rel_error"]
     for prev in reversed(history):
         if (prev.get("status") != "converged" or prev.get("members_failed")
@@ -491,7 +504,7 @@ def _order(step, history):
             return ORDER
         p = math.log(e0 / e1) / math.log(h0 / h1)
         return min(ORDER_BOUNDS[1], max(ORDER_BOUNDS[0], p))
-    return ORDER
+    return FIRST_ORDER
 
 
 def _safety(ratio):
