@@ -1689,7 +1689,8 @@ DEFECTS = [
       (("    ext = f3 + (f3 - f2) / (r ** p - 1)", "    ext = f3 + (f3 - f2) / (r ** p + 1)"),)),
     D("eroute_guard_factor", "edge route: an erratic family's error without the guard's "
       "factor", "femadh/runner/edge_route.py",
-      (("        return p, f3, GUARD * abs(f3 - f2)", "        return p, f3, abs(f3 - f2)"),)),
+      (("    bound = max(abs(f3 - f2), abs(f2 - f1) / q) / (q - 1)",
+        "    bound = abs(f3 - f2)"),)),
     D("eroute_met_absolute", "edge route: the family stops on an absolute error (N) against "
       "the relative target", "femadh/runner/edge_route.py",
       (("            if fam.error <= target * abs(fam.value):",
@@ -1743,6 +1744,16 @@ DEFECTS = [
       "femadh/runner/adaptive.py",
       (("        if e0 <= e1:\n            return ORDER\n",
         "        if e0 <= e1:\n            return FIRST_ORDER\n"),)),
+    D("eroute_alternating_extrapolated", "edge route: alternating differences extrapolated "
+      "(the sign test dropped: a ratio of sizes reads them as an order)",
+      "femadh/runner/edge_route.py",
+      (("    if not (f1 - f2) * (f2 - f3) > 0:\n        return math.nan, f3, bound\n    p = math.log((f1 - f2) / (f2 - f3)) / math.log(r)",
+        "    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r)"),)),
+    D("sedge_problem_subgrid_unscaled", "sigma edge: a state's problem keeps the sub-grid "
+      "step on the reference nodes (its pressure off by lam^-2)",
+      "femadh/contact/sigma_edge.py",
+      (("        if pb.integrated:\n            pb.integrated = {",
+        "        if False:\n            pb.integrated = {"),)),
 ]
 
 

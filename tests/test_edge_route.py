@@ -51,13 +51,41 @@ def test_small_scene_takes_the_route(routed):
     # jump-out), the largest F_ex the headline's
     assert all(a > b for a, b in zip(c["r_c_m"], c["r_c_m"][1:]))
     assert all(a < b for a, b in zip(c["d_m"], c["d_m"][1:]))
-    # (here the branch stops being stable before its fold: the retract jumps out there)
-    assert "jump_out_d_m" not in res.headline
-    assert any("stops being stable" in w for w in res.warnings)
+    # every state stable to the fold (the runner's test on each state's scaled grid, its
+    # sub-grid step built there): the jump-out is the fold's d, beyond the last state's
+    assert res.headline["jump_out_d_m"] >= c["d_m"][-1]
+    assert res.headline["jump_out_d_m"] > res.headline["d_at_max_adhesion_m"]
+    assert not any("stops being stable" in w for w in res.warnings)
     assert max(c["F_ex_N"]) == pytest.approx(res.headline["max_adhesion_N"], rel=1e-12,
                                              abs=0)
     assert c["stable"].all()
     assert any("edge route" in w for w in res.warnings)     # what it does not compute
+
+
+def test_a_branch_that_stops_being_stable_ends_the_curve_there(small, routed, monkeypatch):
+    """Where the runner's stability test rejects a branch state between the largest force and
+    the fold (here made so: every state of edge radius below the midpoint of c* and the fold's
+    c reads unstable), the curve ends at the last stable state, the jump-out is not given
+    (it lies between that state and the first unstable one) and a warning says where; the
+    max adhesion, on the stable side, is the same number. A loss of stability above c* (the
+    largest force not on the retract) fails the run with that reason."""
+    from femadh.contact.sigma_edge import SigmaEdgeBranch
+
+    ref, _ = routed
+    c = ref.branches[edge_route.CURVE]["r_c_m"]
+    c_star = ref.headline["r_c_at_max_adhesion_m"]
+    cut = 0.5 * (c_star + c[-1])
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c >= cut)
+    res = femadh.run(small, None, figures=False, progress=False)
+    assert res.status == "converged", res.error
+    kept = res.branches[edge_route.CURVE]["r_c_m"]
+    assert kept.min() >= cut and len(kept) < len(c)
+    assert "jump_out_d_m" not in res.headline
+    assert any("stops being stable" in w for w in res.warnings)
+    assert res.headline["max_adhesion_N"] == ref.headline["max_adhesion_N"]
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c > 1.01 * c_star)
+    res = femadh.run(small, None, figures=False, progress=False)
+    assert res.status == "failed" and "not the retract's" in res.error
 
 
 def test_bundled_scenes_keep_their_path(small):
@@ -128,8 +156,12 @@ def test_accuracy_out_of_reach_is_one_line(small, monkeypatch):
 
 def test_richardson_guarded():
     """Second-order data extrapolate exactly (F = 1 + h^2 on h, h/sqrt2, h/2: the limit 1,
-    order 2); erratic differences (order outside 1.5-2.5) keep the finest member with GUARD x
-    its last difference."""
+    order 2); erratic differences (order outside 1.5-2.5) keep the finest member with the
+    first-order bound max(|f3 - f2|, |f2 - f1| / sqrt2) / (sqrt2 - 1);
+    alternating differences of second-order sizes (F = 1 + A, 1 - A/2, 1 + A/4: a ratio of sizes reads order 2) are not extrapolated - the
+    bound 1.81 A covers the finest member's true error A/4, where extrapolating would move
+    away from the limit; a vanishing last difference keeps the earlier one's bound;
+    first-order data (F = 1 + h) are bounded from above by the guard, not under-read."""
     h = [1e-9 / math.sqrt(2) ** j for j in range(3)]
     F = [1 + (x / 1e-9) ** 2 for x in h]
     p, ext, err = edge_route.richardson(h, F)
@@ -137,7 +169,16 @@ def test_richardson_guarded():
     assert err == pytest.approx(0.25, rel=1e-9)
     p, ext, err = edge_route.richardson(h, [1.0, 1.5, 1.4])
     assert not 1.5 <= p <= 2.5
-    assert ext == 1.4 and err == pytest.approx(edge_route.GUARD * 0.1, rel=1e-12)
+    assert ext == 1.4
+    assert err == pytest.approx(max(0.1, 0.5 / math.sqrt(2)) / (math.sqrt(2) - 1), rel=1e-12)
+    A = 1e-3
+    p, ext, err = edge_route.richardson(h, [1 + A, 1 - A / 2, 1 + A / 4])
+    assert ext == 1 + A / 4 and err >= A / 4
+    p, ext, err = edge_route.richardson(h, [1.0, 1.1, 1.1])
+    assert ext == 1.1 and err > 0
+    F = [1 + x / 1e-9 for x in h]
+    p, ext, err = edge_route.richardson(h, F)
+    assert err >= (F[-1] - 1) * (1 - 1e-12)
 
 
 def test_route_key(small):

@@ -234,9 +234,15 @@ class SigmaEdgeBranch:
     # -- what a state is -------------------------------------------------------------------
     def problem(self, c):
         """The runner's :class:`ContactProblem` on the grid whose node k sits at c (m): the
-        reference problem with its operator scaled (sub-grid laws keep their nodal
-        pressure: both force and area scale like lam^2)."""
+        reference problem with its operator scaled. Its sub-grid laws are built again on
+        the scaled nodes: the branch's own Newton may reuse the reference's nodal pressure
+        (force and area both scale like lam^2), but a problem's ``pressure``,
+        ``law_jacobian`` and energy divide a sub-grid force by its own nodes' areas, so a
+        law kept on the reference nodes would be off by lam^-2 (and a stability verdict
+        with it)."""
         import copy
+
+        from .subgrid import SubgridStep
 
         lam = c / self.r0
         op = ScaledOperator(self.base, lam)
@@ -246,6 +252,9 @@ class SigmaEdgeBranch:
         pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
         pb.S_sym = lam * self._ref.S_sym
         pb._finest = None
+        if pb.integrated:
+            pb.integrated = {name: SubgridStep(step.law, op.grid.nodes, op.grid.radius)
+                             for name, step in self._ref.integrated.items()}
         return pb
 
     def force(self, st):

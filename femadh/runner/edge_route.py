@@ -70,21 +70,31 @@ C_HIGH = 3
 #: divided by sqrt 2 from one to the next
 MIN_LEVELS, MAX_LEVELS = 3, 6
 #: observed orders accepted for the extrapolation (the branch converges at 2: measured 2.00
-#: on every clean family); outside, the finest member is kept and its error bounded by GUARD
-#: times its difference from the next coarser
-ORDER_RANGE, GUARD = (1.5, 2.5), 2.0
+#: on every clean family); outside - or when the last two differences change sign, which a
+#: ratio of their sizes cannot see - the finest member is kept and its error bounded as if
+#: the order were GUARD_ORDER: |f3 - f2| / (r^GUARD_ORDER - 1), 2.41 x the last difference
+#: at r = sqrt 2. First order is the lowest the branch shows (d and F at fixed c in Hertz's
+#: limit, tests/test_sigma_edge.py); a bound at a higher assumed order would under-read it
+ORDER_RANGE, GUARD_ORDER = (1.5, 2.5), 1.0
 
 
 def richardson(h, F):
     """(observed order, extrapolation, error estimate of the finest member) from the last
-    three of F(h) (spacings in ratio sqrt 2); an order outside ORDER_RANGE (or two equal
-    members): the finest member itself and GUARD x its difference from the next coarser."""
+    three of F(h) (spacings in ratio r, sqrt 2 in the family). Differences of one sign with
+    an order inside ORDER_RANGE extrapolate; anything else (an order outside, alternating or
+    vanishing differences; the order is then nan unless one was observed) keeps the finest
+    member with the bound max(|f3 - f2|, |f2 - f1| / r^q) / (r^q - 1), q = GUARD_ORDER (the
+    earlier difference scaled down too, so that a last difference that happens to vanish
+    does not read as no error)."""
     f1, f2, f3 = F[-3:]
     r = h[-2] / h[-1]
-    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r) if f2 != f3 and f1 != f2 \
-        else math.inf
+    q = r ** GUARD_ORDER
+    bound = max(abs(f3 - f2), abs(f2 - f1) / q) / (q - 1)
+    if not (f1 - f2) * (f2 - f3) > 0:
+        return math.nan, f3, bound
+    p = math.log((f1 - f2) / (f2 - f3)) / math.log(r)
     if not ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
-        return p, f3, GUARD * abs(f3 - f2)
+        return p, f3, bound
     ext = f3 + (f3 - f2) / (r ** p - 1)
     return p, ext, abs(f3 - ext)
 
