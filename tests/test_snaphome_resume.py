@@ -25,8 +25,8 @@ def unzipping_scene(folder):
     1.1 -> 0.5 -> 1.1 nm in 0.2-nm steps (the range must exceed sigma; the retract ends at
     1.1 nm, so a resume from 0.9 nm traces one unzipping grid step, not two: 4.8 instead of
     6.0 CPU-s for the module, measured). Measured: the approach jumps in at 1.097 nm; the
-    retract releases 29 contact nodes, every one a lattice snap (no jump), 81 -> 69 nodes
-    from 0.9 to 1.1 nm, and its 0.9-nm grid state (the 7th committed: four of the approach,
+    retract releases 29 contact nodes (98 -> 69) in 21 lattice snaps and no jump, 81 -> 69
+    nodes from 0.9 to 1.1 nm, and its 0.9-nm grid state (the 7th committed: four of the approach,
     the retract's 0.5 and 0.7 nm) leaves the rhythm full: three snaps (0.847, 0.868,
     0.888 nm), an aim at 0.9078 nm, as when the sweep was 1.3 -> 0.7 -> 1.3 nm."""
     text = (ROOT / "validation" / "scenes" / "paper1_slider_meniscus.toml").read_text()
