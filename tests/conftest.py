@@ -136,6 +136,27 @@ def tiny_fe_text():
     return text.replace('step = "0.2 nm"', 'step = "1 nm"')
 
 
+@pytest.fixture(scope="session")
+def tiny_fe_run(tmp_path_factory):
+    """A copier of one ``femadh run`` of tiny_fe_text (--no-figures --no-estimate): the render
+    and VTK tests each draw from a copy (render writes into the folder), the FE run done once
+    a test process. Call it with a folder; returns the copy's path."""
+    import shutil
+
+    from femadh.cli import main
+
+    tmp = tmp_path_factory.mktemp("tiny_fe")
+    (tmp / "fe.toml").write_text(tiny_fe_text())
+    assert main(["run", str(tmp / "fe.toml"), "--out", str(tmp / "run"), "--quiet",
+                 "--no-figures", "--no-estimate"]) == 0
+
+    def copy(folder):
+        out = Path(folder) / "run"
+        shutil.copytree(tmp / "run", out)
+        return out
+    return copy
+
+
 def adaptive_scene(path="validation/scenes/paper1_fig3.toml", **solver):
     """A bundled scene (default Fig 3) without its ``[solver] nodes``: the adaptive grid,
     with ``solver`` entries (e.g. ``accuracy=1e-2``) set."""

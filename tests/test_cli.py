@@ -10,7 +10,6 @@ import pytest
 import femadh
 from femadh.cli import main
 
-from conftest import tiny_fe_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,15 +32,14 @@ def test_keys_prints_the_reference(capsys):
 
 
 @pytest.mark.slow
-def test_render_an_fe_run_to_png(tmp_path):
+def test_render_an_fe_run_to_png(tmp_path, tiny_fe_run):
     """femadh render on an FE run: a PNG of the deformed zone, read back: the size asked for
-    and a picture (many distinct colours), not an empty canvas."""
+    and a picture (many distinct colours), not an empty canvas. (The run is conftest's
+    tiny_fe_run, shared with test_output's render test: without the error estimate, whose
+    coarser FE members the render never reads.)"""
     import matplotlib.image as mpimg
 
-    (tmp_path / "fe.toml").write_text(tiny_fe_text())
-    out = tmp_path / "run"
-    assert main(["run", str(tmp_path / "fe.toml"), "--out", str(out), "--quiet",
-                 "--no-figures"]) == 0
+    out = tiny_fe_run(tmp_path)
     assert main(["render", str(out)]) == 0
     img = mpimg.imread(out / "render.png")
     assert img.shape[:2] == (700, 1100)

@@ -141,23 +141,54 @@ figures.FigureWorker.draw = spy
 """
 
 
-@needs_worker
-def test_the_program_has_its_figures_drawn_by_the_worker(tmp_path):
-    """The worker writes every figure (none left to the run): the same files, byte for
-    byte, as the run draws in-process (the Python API)."""
-    import femadh
+FIGURES = ["force_curve.png", "profiles_and_forces.png"]
 
-    path = _small_scene(tmp_path)
+
+@pytest.fixture(scope="module")
+def drawn_here(tmp_path_factory):
+    """The small scene and two of its command-line runs (--quiet --no-estimate) whose
+    figures are drawn in this process, with FigureWorker made to fail if started: ``one``,
+    the program on one core (:func:`femadh.cli._main` as the program, the affinity one CPU;
+    the program's own start-up and exit are the tests' below that run it as a process),
+    ``script``, :func:`femadh.cli.main` called by a script. They are the worker test's
+    reference pictures too (they were a run of the Python API: the same in-process drawing)."""
+    from femadh import cli
+    from femadh.runner import figures
+
+    tmp = tmp_path_factory.mktemp("drawn_here")
+    path = _small_scene(tmp)
+    run = ["run", str(path), "--quiet", "--no-estimate"]
+    real_init, real_aff = figures.FigureWorker.__init__, os.sched_getaffinity
+
+    def no_fork(self):
+        raise AssertionError("a figure worker was started")
+    try:
+        figures.FigureWorker.__init__ = no_fork
+        os.sched_getaffinity = lambda pid: {0}
+        one = cli._main(run + ["--out", str(tmp / "one")], program=True)
+        os.sched_getaffinity = real_aff
+        script = cli.main(run + ["--out", str(tmp / "script")])
+    finally:
+        figures.FigureWorker.__init__, os.sched_getaffinity = real_init, real_aff
+    return path, {"one": (one, tmp / "one"), "script": (script, tmp / "script")}
+
+
+@needs_worker
+def test_the_program_has_its_figures_drawn_by_the_worker(tmp_path, drawn_here):
+    """The worker writes every figure (none left to the run): the same files, byte for
+    byte, as a run draws in-process."""
+    path, here = drawn_here
     code, err = _program(tmp_path, ["run", path, "--out", tmp_path / "cli", "--quiet",
                                     "--no-estimate"], SPY)
     assert code == 0, err
     assert "WORKER LEFT []" in err
-    femadh.run(femadh.load_scene(path), tmp_path / "api", progress=False, estimate="peak")
-    names = ["force_curve.png", "profiles_and_forces.png"]
-    assert _pngs(tmp_path / "cli") == _pngs(tmp_path / "api") == names
-    for name in names:
+    for code, folder in here.values():
+        assert code == 0 and _pngs(folder) == FIGURES
+    assert _pngs(tmp_path / "cli") == FIGURES
+    for name in FIGURES:
         # the same data, the same matplotlib: the same picture, byte for byte
-        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "api" / name).read_bytes()
+        for _, folder in here.values():
+            assert (tmp_path / "cli" / name).read_bytes() == (folder / name).read_bytes()
     assert _no_temporary_files(tmp_path / "cli")
 
 
@@ -208,33 +239,19 @@ def test_a_signal_while_the_worker_draws_stops_the_run_and_the_worker(tmp_path, 
         Image.open(folder / name).verify()
 
 
-def test_no_worker_without_figures_on_one_core_or_inside_a_script(tmp_path):
+def test_no_worker_without_figures_on_one_core_or_inside_a_script(tmp_path, drawn_here):
     """--no-figures forks nothing; on one core, or when a script calls femadh.cli.main, the
-    figures are drawn in-process."""
-    from femadh.cli import main
-    from femadh.runner import figures
-
+    figures are drawn in-process (drawn_here: a worker started there fails its run)."""
     forked = ("from femadh.runner import figures\nreal = figures.FigureWorker.__init__\n"
               "def init(self):\n    print('FORKED', file=sys.stderr)\n    real(self)\n"
               "figures.FigureWorker.__init__ = init\n")
-    path = _small_scene(tmp_path)
+    path, here = drawn_here
     run = ["run", path, "--quiet", "--no-estimate"]
     code, err = _program(tmp_path, run + ["--out", tmp_path / "bare", "--no-figures"], forked)
     assert code == 0 and "FORKED" not in err, err
     assert _pngs(tmp_path / "bare") == []
-    one = "import os\nos.sched_getaffinity = lambda pid: {0}\n"
-    code, err = _program(tmp_path, run + ["--out", tmp_path / "one"], one + forked)
-    assert code == 0 and "FORKED" not in err, err
-    assert _pngs(tmp_path / "one") == ["force_curve.png", "profiles_and_forces.png"]
-    real = figures.FigureWorker.__init__
-    try:
-        def no_fork(self):
-            raise AssertionError("a figure worker was started")
-        figures.FigureWorker.__init__ = no_fork
-        assert main([str(a) for a in run + ["--out", tmp_path / "script"]]) == 0
-    finally:
-        figures.FigureWorker.__init__ = real
-    assert _pngs(tmp_path / "script") == ["force_curve.png", "profiles_and_forces.png"]
+    for code, folder in here.values():
+        assert code == 0 and _pngs(folder) == FIGURES
 
 
 def test_the_program_ends_at_once_with_its_output_and_exit_code(tmp_path):

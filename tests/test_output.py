@@ -12,7 +12,6 @@ from femadh.io import progress
 from femadh.runner.run import run
 from validation.paper1 import scene as paper1_scene
 
-from conftest import tiny_fe_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -193,7 +192,7 @@ def test_regime_prints_a_short_table_and_keeps_the_csv_in_the_file(tmp_path, cap
     assert header == ",".join(REGIME_HEADER) and len(REGIME_HEADER) > 20
 
 
-def test_render_exports_the_state_it_draws_headless_and_quiet(tmp_path, capfd):
+def test_render_exports_the_state_it_draws_headless_and_quiet(tmp_path, capfd, tiny_fe_run):
     """An FE run writes no per-state VTK by default; `femadh render --state K` exports that
     state from fields.csv (its .vtu and a .pvd listing it), draws it, and says nothing on
     stderr (no VTK X-server warning on a machine without a display); the exported volume
@@ -205,10 +204,7 @@ def test_render_exports_the_state_it_draws_headless_and_quiet(tmp_path, capfd):
     from femadh.cli import main
     from femadh.io.writers import read_fields_state
 
-    (tmp_path / "fe.toml").write_text(tiny_fe_text())
-    out = tmp_path / "run"
-    assert main(["run", str(tmp_path / "fe.toml"), "--out", str(out), "--quiet",
-                 "--no-figures", "--no-estimate"]) == 0
+    out = tiny_fe_run(tmp_path)                   # conftest: shared with test_cli's render
     assert not (out / "vtk").exists()
     capfd.readouterr()
     env = os.environ.pop("DISPLAY", None)

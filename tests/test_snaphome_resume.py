@@ -22,18 +22,20 @@ def unzipping_scene(folder):
     """The slider + meniscus scene at the stiction map's sigma = 0.489 nm, p/psat = 0.15
     point (validation/results/snap_cost.md) on 120 uniform nodes of a 1.2-nm analysis radius
     (18-nm spacing: coarser, as on 100 nodes of 2 nm, every release is a jump), swept
-    1.3 -> 0.7 -> 1.3 nm in 0.2-nm steps (the range must exceed sigma). Measured: the
-    retract releases 34 contact nodes, every one a lattice snap (no jump), 81 -> 69 nodes
-    from 0.9 to 1.1 nm, and its 0.9-nm grid state (the 6th committed: four of the
-    approach, the retract's first) leaves the rhythm full: three snaps, an aim at
-    0.9078 nm."""
+    1.1 -> 0.5 -> 1.1 nm in 0.2-nm steps (the range must exceed sigma; the retract ends at
+    1.1 nm, so a resume from 0.9 nm traces one unzipping grid step, not two: 4.8 instead of
+    6.0 CPU-s for the module, measured). Measured: the approach jumps in at 1.097 nm; the
+    retract releases 29 contact nodes (98 -> 69) in 21 lattice snaps and no jump, 81 -> 69
+    nodes from 0.9 to 1.1 nm, and its 0.9-nm grid state (the 7th committed: four of the approach,
+    the retract's 0.5 and 0.7 nm) leaves the rhythm full: three snaps (0.847, 0.868,
+    0.888 nm), an aim at 0.9078 nm, as when the sweep was 1.3 -> 0.7 -> 1.3 nm."""
     text = (ROOT / "validation" / "scenes" / "paper1_slider_meniscus.toml").read_text()
     for old, new in (('analysis_radius = { delta = "50 nm" }',
                       'analysis_radius = { delta = "1.2 nm" }\nnodes = 120'),
                      ('sigma = "1.0 nm"', 'sigma = "0.489 nm"'),
                      ("relative_pressure = 0.95", "relative_pressure = 0.15"),
-                     ('start = "2 nm"', 'start = "1.3 nm"'),
-                     ('stop = "-5 nm"', 'stop = "0.7 nm"')):
+                     ('start = "2 nm"', 'start = "1.1 nm"'),
+                     ('stop = "-5 nm"', 'stop = "0.5 nm"')):
         assert text.count(old) == 1, old
         text = text.replace(old, new)
     path = Path(folder) / "unzip.toml"
@@ -41,8 +43,9 @@ def unzipping_scene(folder):
     return path
 
 
-#: the checkpoint's state: the retract's 0.9-nm grid state, the 6th committed (k = 5)
-K_MID, D_MID = 5, 0.9e-9
+#: the checkpoint's state: the retract's 0.9-nm grid state, the 7th committed (k = 6); its
+#: separation to the bit as the sweep computes it (1.1 nm - 0.2 nm in floating point)
+K_MID, D_MID = 6, 9.000000000000001e-10
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +100,7 @@ def test_an_older_checkpoint_without_the_rhythm_still_resumes(unzip, tmp_path):
     a, b = (np.genfromtxt(f / "fields.csv", delimiter=",", names=True, dtype=None,
                           encoding="utf-8") for f in (ref, out))
     assert np.array_equal(a["d_m"], b["d_m"]) and np.array_equal(a["branch"], b["branch"])
-    # every node's gap within the scene's Newton tolerance (1e-19 m; measured 1.4e-24 m),
+    # every node's gap within the scene's Newton tolerance (1e-19 m; measured 7.2e-25 m),
     # the contact sets (the nodes whose elastic pressure is nonzero) the same
     assert np.max(np.abs(a["w_m"] - b["w_m"])) <= 1e-19
     assert np.array_equal(a["P_el_Pa"] != 0, b["P_el_Pa"] != 0)
