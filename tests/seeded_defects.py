@@ -1754,6 +1754,22 @@ DEFECTS = [
       "femadh/contact/sigma_edge.py",
       (("        if pb.integrated:\n            pb.integrated = {",
         "        if False:\n            pb.integrated = {"),)),
+    D("eroute_sweep_range", "edge route: taken where the sweep never presses in to the largest "
+      "force's state", "femadh/runner/edge_route.py",
+      (("    if pil is not None and min(scene.d_values) >= pil.retract.best.d:",
+        "    if pil is not None and min(scene.d_values) >= pil.retract.best.d + 1.0:"),)),
+    D("eroute_fold_beyond_sweep", "edge route: a jump-out reported beyond the sweep's end",
+      "femadh/runner/edge_route.py",
+      (("    if lost is None and r.fold.d > max(scene.d_values):",
+        "    if lost is None and r.fold.d > max(scene.d_values) + 1.0:"),)),
+    D("eroute_resume_sweep_folder", "edge route: a resumed folder of the sweep's path taken "
+      "down the route", "femadh/runner/adaptive.py",
+      (('    return grid.get("route") != "edge-branch"',
+        '    return grid.get("route") == "edge-branch"'),)),
+    D("eroute_pilot_failure_raised", "edge route: a pilot that cannot be traced raises out of "
+      "the run", "femadh/runner/edge_route.py",
+      (("    except (ConvergenceError, ValueError):\n        # a pilot that cannot be traced",
+        "    except ValueError:\n        # a pilot that cannot be traced"),)),
 ]
 
 

@@ -28,7 +28,7 @@ def small():
 @pytest.fixture(scope="module")
 def routed(small, tmp_path_factory):
     out = tmp_path_factory.mktemp("edge") / "run"
-    return femadh.run(small, out, figures=False, progress=False), out
+    return femadh.run(small, out, figures=True, progress=False), out
 
 
 def test_small_scene_takes_the_route(routed):
@@ -52,10 +52,12 @@ def test_small_scene_takes_the_route(routed):
     assert all(a > b for a, b in zip(c["r_c_m"], c["r_c_m"][1:]))
     assert all(a < b for a, b in zip(c["d_m"], c["d_m"][1:]))
     # every state stable to the fold (the runner's test on each state's scaled grid, its
-    # sub-grid step built there): the jump-out is the fold's d, beyond the last state's
-    assert res.headline["jump_out_d_m"] >= c["d_m"][-1]
-    assert res.headline["jump_out_d_m"] > res.headline["d_at_max_adhesion_m"]
+    # sub-grid step built there); the fold (2.67 nm) lies beyond the sweep's 2-nm end, so
+    # the sweep ends in contact: no jump-out, and a warning says why; the figure is drawn
     assert not any("stops being stable" in w for w in res.warnings)
+    assert c["d_m"][-1] > 2e-9 and "jump_out_d_m" not in res.headline
+    assert any("beyond the sweep's end" in w for w in res.warnings)
+    assert (out / "force_curve.png").stat().st_size > 0
     assert max(c["F_ex_N"]) == pytest.approx(res.headline["max_adhesion_N"], rel=1e-12,
                                              abs=0)
     assert c["stable"].all()
@@ -194,3 +196,36 @@ def test_route_key(small):
     assert edge_route.route_for(fig6.replace({"solver.route": "edge"}), True) is None
     assert scene_id(fig6.replace({"solver.route": "auto"})) == scene_id(fig6)
     assert scene_id(fig6.replace({"solver.route": "grid"})) != scene_id(fig6)
+
+
+def test_a_sweep_that_stops_short_of_the_largest_force_keeps_its_path(small, monkeypatch):
+    """A sweep whose deepest separation (1.6 nm) does not press in to the largest force's
+    state (d = 1.45 nm) keeps the sweep, whose max adhesion is a state of its own curve; a
+    pilot that cannot be traced sends the scene to the sweep too, not out of femadh.run."""
+    from femadh.errors import ConvergenceError
+
+    short = small.replace({"sweep.stop": "1.6 nm", "solver.route": "edge"})
+    assert edge_route.route_for(short, True) is None
+    assert edge_route.route_for(short.replace({"sweep.stop": "1.4 nm"}), True) is not None
+
+    def broken(*a, **k):
+        raise ConvergenceError("pilot: Newton did not converge", d=0.0, residual=1.0,
+                               n_iter=40)
+    monkeypatch.setattr(edge_route, "trace", broken)
+    assert edge_route.route_for(small.replace({"solver.route": "edge"}), True) is None
+
+
+def test_a_resumed_sweep_folder_keeps_the_sweep(tmp_path):
+    """--resume of a folder that holds a run of the sweep's path (its summary names no edge
+    route, e.g. one stopped before the route existed) continues it there: the route would
+    start the folder over and drop its states; a routed folder, or none, may take the route."""
+    import json
+
+    from femadh.runner.adaptive import _sweep_folder
+
+    assert not _sweep_folder(tmp_path) and not _sweep_folder(None)
+    (tmp_path / "summary.json").write_text(json.dumps({"grid": {"kind": "banded"}}))
+    assert _sweep_folder(tmp_path)
+    (tmp_path / "summary.json").write_text(json.dumps(
+        {"grid": {"kind": "edge-branch", "route": "edge-branch"}}))
+    assert not _sweep_folder(tmp_path)

@@ -339,7 +339,9 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         # where its pilot finds a fold, the branch in its edge radius instead (edge_route)
         from .edge_route import route_for, run_edge_route
 
-        pil = route_for(scene, first.follow is not None)
+        # (a resumed folder of the sweep's path keeps that path: the route would start over)
+        pil = (None if resume and _sweep_folder(out_dir)
+               else route_for(scene, first.follow is not None))
         if pil is not None:
             return run_edge_route(scene, out_dir, pil, figures=figures, overwrite=overwrite,
                                   resume=resume, folder_id=scene_id(scene))
@@ -410,6 +412,22 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                     draw_figures(res, folder)
             folder.write_summary(summary(res))
     return res
+
+
+def _sweep_folder(out_dir):
+    """Whether ``out_dir`` holds a run of the sweep's path (its summary names no edge route):
+    a resume continues it there."""
+    import json
+    from pathlib import Path
+
+    path = Path(out_dir) / "summary.json" if out_dir is not None else None
+    if path is None or not path.is_file():
+        return False
+    try:
+        grid = json.loads(path.read_text()).get("grid") or {}
+    except (OSError, ValueError):
+        return True             # unreadable: the sweep's own resume says what is wrong
+    return grid.get("route") != "edge-branch"
 
 
 def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):

@@ -223,7 +223,16 @@ def route_for(scene, follows):
         return None
     if route == "auto" and not follows:
         return None
-    return pilot(scene)
+    try:
+        pil = pilot(scene)
+    except (ConvergenceError, ValueError):
+        # a pilot that cannot be traced says nothing about the route: the sweep decides
+        return None
+    if pil is not None and min(scene.d_values) >= pil.retract.best.d:
+        # the sweep never presses in to the largest force's contact radius: its max
+        # adhesion is another state of its own curve, which only the sweep computes
+        return None
+    return pil
 
 
 @dataclass
@@ -393,6 +402,22 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
             # the estimate does not support the request: one line, what was reached
             res.status, res.error, res.failure_kind = "failed", short, "accuracy"
             write()
+        if res.status in ("interrupted", "time limit"):
+            # (the CLI's line says a stopped run's states are kept: not on this route)
+            res.warnings.append("resume: the edge route keeps no states of a stopped run (its "
+                                "family is not checkpointed); --resume traces its pilot and "
+                                "family again")
+            write()
+        if (figures and folder is not None and res.status in ("converged", "failed")
+                and len(res.branches.get(CURVE, {}).get("d_m", ()))):
+            from ..io.progress import phase
+            from .figures import draw_figures
+
+            # every run comes with its figure (the branch's curve), as on the sweep path
+            # (runner/adaptive.py: a signal stops them at once)
+            with phase("figures"):
+                draw_figures(res, folder)
+            write()
     finally:
         if folder is not None:
             folder.__exit__(None, None, None)
@@ -427,7 +452,17 @@ def _route(scene, res, pil, target):
     hl["d_at_max_adhesion_m"] = float(best.d)
     hl["max_adhesion_branch"] = CURVE
     hl["r_c_at_max_adhesion_m"] = best.c
-    if lost is None:
+    if best.d <= min(scene.d_values):
+        raise ConvergenceError(
+            f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
+            f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
+            "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
+    if lost is None and r.fold.d > max(scene.d_values):
+        res.warnings.append(
+            f"edge route: the retract's fold (d = {r.fold.d * 1e9:.5g} nm) lies beyond the "
+            f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
+            "jump_out_d_m is not given")
+    elif lost is None:
         hl["jump_out_d_m"] = float(r.fold.d)
     else:
         # the retract leaves the branch before its fold: the jump-out is there, between the
