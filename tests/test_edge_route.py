@@ -221,11 +221,11 @@ def test_a_resumed_sweep_folder_keeps_the_sweep(tmp_path):
     start the folder over and drop its states; a routed folder, or none, may take the route."""
     import json
 
-    from femadh.runner.adaptive import _sweep_folder
+    from femadh.runner.adaptive import holds_sweep_run
 
-    assert not _sweep_folder(tmp_path) and not _sweep_folder(None)
+    assert not holds_sweep_run(tmp_path) and not holds_sweep_run(None)
     (tmp_path / "summary.json").write_text(json.dumps({"grid": {"kind": "banded"}}))
-    assert _sweep_folder(tmp_path)
+    assert holds_sweep_run(tmp_path)
     (tmp_path / "summary.json").write_text(json.dumps(
         {"grid": {"kind": "edge-branch", "route": "edge-branch"}}))
-    assert not _sweep_folder(tmp_path)
+    assert not holds_sweep_run(tmp_path)

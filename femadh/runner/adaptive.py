@@ -340,7 +340,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         from .edge_route import route_for, run_edge_route
 
         # (a resumed folder of the sweep's path keeps that path: the route would start over)
-        pil = (None if resume and _sweep_folder(out_dir)
+        pil = (None if resume and holds_sweep_run(out_dir)
                else route_for(scene, first.follow is not None))
         if pil is not None:
             return run_edge_route(scene, out_dir, pil, figures=figures, overwrite=overwrite,
@@ -414,7 +414,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     return res
 
 
-def _sweep_folder(out_dir):
+def holds_sweep_run(out_dir):
     """Whether ``out_dir`` holds a run of the sweep's path (its summary names no edge route):
     a resume continues it there."""
     import json
