@@ -135,9 +135,11 @@ def test_headline_agrees_with_the_present_runner(routed):
     res, _ = routed
     F, E = res.headline["max_adhesion_N"], res.headline["max_adhesion_N_error"]
     assert abs(F - RUNNER[0]) <= E + RUNNER[1]
-    # and the estimate is the family's: order ~2 (measured 2.01), the extrapolation within it
+    # and the estimate is the family's extrapolated one: order ~2 (measured 2.01); (that the
+    # extrapolation lies within E of F holds by construction, so it is not asserted: the
+    # estimate's honesty is checked against the runner above and against 5-member families
+    # in validation/results/edge_route.md, effectivity 0.9-2.1)
     assert 1.5 <= res.grid["observed_order"] <= 2.5
-    assert abs(res.grid["extrapolation_N"] - F) <= E
 
 
 def test_accuracy_out_of_reach_is_one_line(small, monkeypatch):
