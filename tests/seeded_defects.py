@@ -1770,6 +1770,10 @@ DEFECTS = [
       "the run", "femadh/runner/edge_route.py",
       (("    except (ConvergenceError, ValueError):\n        # a pilot that cannot be traced",
         "    except ValueError:\n        # a pilot that cannot be traced"),)),
+    D("eroute_failure_part", "edge route: an unmet request blames the smallest error part",
+      "femadh/runner/edge_route.py",
+      (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
+        '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
 ]
 
 

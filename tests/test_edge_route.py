@@ -231,3 +231,16 @@ def test_a_resumed_sweep_folder_keeps_the_sweep(tmp_path):
     (tmp_path / "summary.json").write_text(json.dumps(
         {"grid": {"kind": "edge-branch", "route": "edge-branch"}}))
     assert not holds_sweep_run(tmp_path)
+
+
+def test_a_tail_beyond_the_request_is_named(small):
+    """A disk too small for the request (analysis radius from delta = 3 nm, 0.35 um, at 1e-3):
+    the family's grid part meets it (measured 1.0e-9 N), the force beyond the disk does not
+    (1.7e-8 N, 2.9e-3 of the max adhesion): the run fails in one line naming that part and the
+    radius, not "stopped: met"."""
+    sc = small.replace({"solver.analysis_radius": {"delta": "3 nm"}, "solver.accuracy": 1e-3})
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "failed" and res.failure_kind == "accuracy"
+    assert "force beyond the analysis radius" in res.error and "stopped: met" not in res.error
+    comp = res.estimates["max_adhesion_N"]
+    assert abs(comp["tail"]) > max(abs(comp["grid"]), abs(comp["tolerance"]))

@@ -513,8 +513,17 @@ def _route(scene, res, pil, target):
 
     guard_bounds(res, br._ref)
     if rel > target:
+        comp = parts["max_adhesion_N"]
+        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))
+        # the family grows only the grid part's resolution: say which part is too large
+        why = {"grid": f"stopped: {fam.stop}",
+               "tail": (f"the largest part is the force beyond the analysis radius "
+                        f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N): a wider "
+                        f"[solver] analysis_radius (now {a_run:.3g} m) would reduce it"),
+               "tolerance": (f"the largest part is the solver tolerance's "
+                             f"({abs(comp['tolerance']):.3g} N): a tighter [solver] tolerance "
+                             "would reduce it")}[big]
         return (f"accuracy {target:g} not met on the edge route: estimated relative error "
                 f"{rel:.2g} of the max adhesion with {len(fam.h)} members ({fam.nodes[0]}-"
-                f"{fam.nodes[-1]} nodes, {sum(fam.seconds) + pil.seconds:.3g} s); stopped: "
-                f"{fam.stop}")
+                f"{fam.nodes[-1]} nodes, {sum(fam.seconds) + pil.seconds:.3g} s); {why}")
     return None
