@@ -47,6 +47,34 @@ def fig4_sweeps(p):
     return ap, re
 
 
+@pytest.fixture(scope="session")
+def fig4_jump150():
+    """(problem, jump): the Fig 4 disk (sigma = 0.5 nm) on 150 uniform nodes and its
+    approach's jump-in, whose landing follows a fold (test_fold, test_fig4solve_landing)."""
+    from femadh.contact import trace
+
+    p = fig4_problem(150)
+    return p, trace(p, FIG4_D_VALUES, branch="approach", tol=FIG4_TOL).jumps[0]
+
+
+@pytest.fixture
+def cholesky_count(monkeypatch):
+    """A one-element list counting the landing's Cholesky factorisations
+    (``landing.sla.cho_factor``) from here on; reset it by assigning ``count[0] = 0``."""
+    from scipy import linalg as sla
+
+    from femadh.contact import landing
+
+    count = [0]
+    real = sla.cho_factor
+
+    def counted(*a, **k):
+        count[0] += 1
+        return real(*a, **k)
+    monkeypatch.setattr(landing.sla, "cho_factor", counted)
+    return count
+
+
 def hertz_annulus_averages(edges, a, radius, e_star):
     """Annulus averages (Pa) of the Hertz pressure (paper 1 eq 9, p_m = 2 E* a/(pi R)) by
     adaptive quadrature of the judge's pointwise pressure (a test-side load, independent of

@@ -1751,9 +1751,9 @@ DEFECTS = [
         "    p = math.log(abs((f1 - f2) / (f2 - f3))) / math.log(r)"),)),
     D("sedge_problem_subgrid_unscaled", "sigma edge: a state's problem keeps the sub-grid "
       "step on the reference nodes (its pressure off by lam^-2)",
-      "femadh/contact/sigma_edge.py",
-      (("        if pb.integrated:\n            pb.integrated = {",
-        "        if False:\n            pb.integrated = {"),)),
+      "femadh/contact/edge_branch.py",
+      (("    if ref.integrated:\n        pb.integrated = {",
+        "    if False:\n        pb.integrated = {"),)),
     D("eroute_sweep_range", "edge route: taken where the sweep never presses in to the largest "
       "force's state", "femadh/runner/edge_route.py",
       (("    if pil is not None and min(scene.d_values) >= pil.retract.best.d:",

@@ -7,32 +7,16 @@ untouched, bit for bit."""
 import numpy as np
 import pytest
 
-from femadh.contact import landing, trace
+from femadh.contact import landing
 from femadh.contact.forces import state_forces
 
-from conftest import FIG4_D_VALUES as D_VALUES, FIG4_TOL as TOL, fig4_problem
-
-#: the Fig 4 disk (sigma = 0.5 nm) on 150 uniform nodes: its jump-in lands after a fold
-N = 150
+from conftest import FIG4_TOL as TOL
 
 
 @pytest.fixture(scope="module")
-def jump():
-    p = fig4_problem(N)
-    return p, trace(p, D_VALUES, branch="approach", tol=TOL).jumps[0]
-
-
-def _counted(monkeypatch):
-    from scipy import linalg as sla
-
-    count = [0]
-    real = sla.cho_factor
-
-    def counted(*a, **k):
-        count[0] += 1
-        return real(*a, **k)
-    monkeypatch.setattr(landing.sla, "cho_factor", counted)
-    return count
+def jump(fig4_jump150):
+    """The Fig 4 disk (sigma = 0.5 nm) on 150 uniform nodes: its jump-in lands after a fold."""
+    return fig4_jump150
 
 
 def _descend(p, j, monkeypatch, rejects, count, **kw):
@@ -42,13 +26,13 @@ def _descend(p, j, monkeypatch, rejects, count, **kw):
     return w, settled, count[0]
 
 
-def test_rises_within_round_off_settle_the_descent_sooner_on_the_same_minimum(jump,
-                                                                               monkeypatch):
+def test_rises_within_round_off_settle_the_descent_sooner_on_the_same_minimum(
+        jump, cholesky_count, monkeypatch):
     """Measured on 150 nodes: 50 -> 43 factorisations (300 nodes: 38 -> 30), the two minima's
     energies 4e-16 apart relative (the energy's round-off is 64 ulps of its parts' magnitudes:
     the criterion itself, checked here)."""
     p, j = jump
-    count = _counted(monkeypatch)
+    count = cholesky_count
     w0, s0, c0 = _descend(p, j, monkeypatch, False, count)
     w1, s1, c1 = _descend(p, j, monkeypatch, True, count)
     assert s0 and s1
@@ -74,11 +58,11 @@ def test_the_polished_landing_is_the_same_state(jump, monkeypatch):
     assert state_forces(p, b)[2] == pytest.approx(state_forces(p, a)[2], rel=1e-14, abs=0)
 
 
-def test_the_whole_descent_is_untouched(jump, monkeypatch):
+def test_the_whole_descent_is_untouched(jump, monkeypatch, cholesky_count):
     """With the round-off stop off (a trapped grid; the retry after a polish that failed) the
     descent runs as before: the same iterate, bit for bit, the same factorisations."""
     p, j = jump
-    count = _counted(monkeypatch)
+    count = cholesky_count
     w0, s0, c0 = _descend(p, j, monkeypatch, False, count, roundoff=False, max_iter=60)
     w1, s1, c1 = _descend(p, j, monkeypatch, True, count, roundoff=False, max_iter=60)
     assert c0 == c1 and s0 == s1

@@ -139,23 +139,15 @@ def test_a_landing_that_does_not_polish_falls_back_to_halving(fig4, monkeypatch)
         trace(p, D_VALUES, branch="approach", tol=TOL)
 
 
-def test_the_energy_descent_stops_once_settled_at_round_off(monkeypatch):
+def test_the_energy_descent_stops_once_settled_at_round_off(monkeypatch, fig4_jump150,
+                                                           cholesky_count):
     """The jump-in's landing on 150 nodes: the descent reaches its basin's minimum within a
     few dozen steps and then can no longer lower the energy beyond its round-off; it stops
     there (measured 50 Cholesky factorisations, where it used to spin to its 400-step cap:
     721; 39 against 723 on the Fig 4 scene's 632 nodes) and the Newton polish lands on the
     state the full descent lands on, to the tolerance."""
-    from scipy import linalg as sla
-
-    p = fig4_problem(150)
-    j = trace(p, D_VALUES, branch="approach", tol=TOL).jumps[0]
-    count = [0]
-    real = sla.cho_factor
-
-    def counted(*a, **k):
-        count[0] += 1
-        return real(*a, **k)
-    monkeypatch.setattr(landing.sla, "cho_factor", counted)
+    p, j = fig4_jump150
+    count = cholesky_count
     w, settled = landing._lm_descent(p, j.d_land, j.before.w, p.sigma)
     assert settled and count[0] < 100, count[0]
     short = count[0]

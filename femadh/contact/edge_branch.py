@@ -141,6 +141,28 @@ class ScaledOperator:
         self.lam = lam
 
 
+def scaled_problem(ref, base, sphere, lam):
+    """The :class:`ContactProblem` ``ref`` (on the operator ``base``) on the grid scaled by
+    ``lam`` (r = lam r0): the operator scaled (:class:`ScaledOperator`; the energy stiffness
+    diag(area) K scales like lam), the sphere's shape on the new nodes, and sub-grid laws
+    built again on them - a problem's ``pressure``, ``law_jacobian`` and energy divide a
+    sub-grid force by its own nodes' areas, so a law kept on the reference nodes would be off
+    by lam^-2 (and a stability verdict with it)."""
+    from .subgrid import SubgridStep
+
+    op = ScaledOperator(base, lam)
+    pb = copy.copy(ref)
+    pb.operator, pb.grid = op, op.grid
+    pb.shape = sphere.shape(op.grid.nodes)
+    pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
+    pb.S_sym = lam * ref.S_sym
+    pb._finest = None
+    if ref.integrated:
+        pb.integrated = {name: SubgridStep(step.law, op.grid.nodes, op.grid.radius)
+                         for name, step in ref.integrated.items()}
+    return pb
+
+
 @dataclass
 class EdgeState:
     """A state of the contact branch: edge radius c (m), separation d (m), displacements w (m)
@@ -334,15 +356,7 @@ class EdgeBranch(_Newton):
     def problem(self, c):
         """The problem on the grid whose node k sits at c (m): the reference problem with its
         operator scaled (its energy stiffness diag(area) K scales like lambda too)."""
-        lam = c / self.r0
-        op = ScaledOperator(self.base, lam)
-        pb = copy.copy(self._base)
-        pb.operator, pb.grid = op, op.grid
-        pb.shape = self.sphere.shape(op.grid.nodes)
-        pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
-        pb.S_sym = lam * self._base.S_sym
-        pb._finest = None
-        return pb
+        return scaled_problem(self._base, self.base, self.sphere, c / self.r0)
 
     def softening_ratio(self):
         """The largest softening stiffness of the laws against the edge node's own stiffness

@@ -57,7 +57,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from ..interrupt import check as safe_point
-from .edge_branch import GAP_CLOSURE, EdgeState, ScaledOperator
+from .edge_branch import GAP_CLOSURE, EdgeState, scaled_problem
 from .problem import ContactProblem
 
 #: Newton iterations allowed per state
@@ -234,28 +234,10 @@ class SigmaEdgeBranch:
     # -- what a state is -------------------------------------------------------------------
     def problem(self, c):
         """The runner's :class:`ContactProblem` on the grid whose node k sits at c (m): the
-        reference problem with its operator scaled. Its sub-grid laws are built again on
-        the scaled nodes: the branch's own Newton may reuse the reference's nodal pressure
-        (force and area both scale like lam^2), but a problem's ``pressure``,
-        ``law_jacobian`` and energy divide a sub-grid force by its own nodes' areas, so a
-        law kept on the reference nodes would be off by lam^-2 (and a stability verdict
-        with it)."""
-        import copy
-
-        from .subgrid import SubgridStep
-
-        lam = c / self.r0
-        op = ScaledOperator(self.base, lam)
-        pb = copy.copy(self._ref)
-        pb.operator, pb.grid = op, op.grid
-        pb.shape = self.sphere.shape(op.grid.nodes)
-        pb.K, pb.C, pb.areas = op.stiffness, op.compliance, op.grid.areas
-        pb.S_sym = lam * self._ref.S_sym
-        pb._finest = None
-        if pb.integrated:
-            pb.integrated = {name: SubgridStep(step.law, op.grid.nodes, op.grid.radius)
-                             for name, step in self._ref.integrated.items()}
-        return pb
+        reference problem scaled (:func:`~femadh.contact.edge_branch.scaled_problem`, its
+        sub-grid laws built on the scaled nodes; the branch's own Newton reuses the
+        reference's nodal pressure instead: force and area both scale like lam^2)."""
+        return scaled_problem(self._ref, self.base, self.sphere, c / self.r0)
 
     def force(self, st):
         """F_ex (N, attractive positive) on the analysis disk of the state's scaled grid:
