@@ -17,6 +17,9 @@ import numpy as np
 from .atomic import save_atomic
 
 
+#: legend names of branches whose key is not what a reader should see
+BRANCH_LABELS = {"retract_edge_branch": "retract (edge route, no approach)"}
+
 def _pyplot():
     import matplotlib
     matplotlib.use("Agg")
@@ -195,14 +198,17 @@ def force_curve(res, path):
         for b, c in res.branches.items():
             if col not in c or (col != "F_ex_N" and not np.any(c[col])):
                 continue
+            # a retract traced another way (the edge route's branch) draws as the retract
+            kind = "retract" if b.startswith("retract") else b
+            name = BRANCH_LABELS.get(b, b)
             if col == "F_ex_N":
                 d, F = branch_with_folds(res, b, c)
-                ax.plot(d * ls, -F * fs, styles.get(b, "-"), color=BRANCH_COLOURS.get(b, "k"),
-                        lw=2, label=f"{label}, {b}")
+                ax.plot(d * ls, -F * fs, styles.get(kind, "-"),
+                        color=BRANCH_COLOURS.get(kind, "k"), lw=2, label=f"{label}, {name}")
                 continue
-            ax.plot(c["d_m"] * ls, sign * c[col] * fs, styles.get(b, "-"),
+            ax.plot(c["d_m"] * ls, sign * c[col] * fs, styles.get(kind, "-"),
                     color=EFFECT_COLOURS[(i - 1) % len(EFFECT_COLOURS)], lw=1,
-                    label=f"{label}, {b}")
+                    label=f"{label}, {name}")
     if res.equilibrium_curve is not None and len(res.equilibrium_curve["d_m"]):
         e = res.equilibrium_curve
         Fu = np.where(~e["stable"], -e["F_ex_N"], np.nan)

@@ -49,6 +49,7 @@ import numpy as np
 from ..contact.edge_branch import edge_grid
 from ..contact.sigma_edge import SigmaEdgeBranch, tail_between, trace_retract
 from ..errors import ConvergenceError
+from ..io.progress import phase
 
 #: half-width and grading of the edge grids in units of the pilot's spacing h0 (fixed
 #: across a family: one mesh density). The grading sets the spacing at the meniscus edge,
@@ -224,7 +225,8 @@ def route_for(scene, follows):
     if route == "auto" and not follows:
         return None
     try:
-        pil = pilot(scene)
+        with phase("edge route: pilot"):
+            pil = pilot(scene)
     except (ConvergenceError, ValueError):
         # a pilot that cannot be traced says nothing about the route: the sweep decides
         return None
@@ -283,7 +285,8 @@ def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None):
         if j and _nodes_of(a0, c_star, h, h0) > max_nodes:
             fam.stop = f"the next member would exceed {max_nodes} nodes"
             break
-        br, r, sec = trace(scene, c_star, h, h0, a0, a_run, LOW * c_fold, C_HIGH * c_star)
+        with phase(f"edge route: grid {j + 1} ({_nodes_of(a0, c_star, h, h0)} nodes)"):
+            br, r, sec = trace(scene, c_star, h, h0, a0, a_run, LOW * c_fold, C_HIGH * c_star)
         fam.h.append(h)
         fam.nodes.append(br.n)
         fam.runs.append((br, r))
@@ -410,7 +413,6 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
             write()
         if (figures and folder is not None and res.status in ("converged", "failed")
                 and len(res.branches.get(CURVE, {}).get("d_m", ()))):
-            from ..io.progress import phase
             from .figures import draw_figures
 
             # every run comes with its figure (the branch's curve), as on the sweep path
@@ -459,7 +461,7 @@ def _route(scene, res, pil, target):
             "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
     if lost is None and r.fold.d > max(scene.d_values):
         res.warnings.append(
-            f"edge route: the retract's fold (d = {r.fold.d * 1e9:.5g} nm) lies beyond the "
+            f"edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond the "
             f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
             "jump_out_d_m is not given")
     elif lost is None:

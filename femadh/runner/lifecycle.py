@@ -128,5 +128,6 @@ def raise_if_stopped(result):
         return result
     if result.exit_code == 128 + signal.SIGTERM:
         raise SystemExit(result.exit_code)
-    raise KeyboardInterrupt(f"{result.error}: the states computed before it are kept"
-                            + (f" in {result.out_dir}" if result.out_dir else ""))
+    raise KeyboardInterrupt(f"{result.error}: the states computed before it are kept in "
+                            f"{result.out_dir}" if result.out_dir else
+                            f"{result.error} (no output folder: nothing was kept)")

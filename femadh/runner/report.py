@@ -50,6 +50,11 @@ def headline_lines(res):
                   if a.get("analysis_radius_m") is not None else "")
         out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}"
                    f"{radius} after {len(a.get('steps', ()))} run(s)")
+    if res.accuracy and res.accuracy.get("route") == "edge-branch":
+        a = res.accuracy
+        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'} on the edge "
+                   f"route: {a['members']} grids, the finest {a['nodes']} nodes, estimated "
+                   f"relative error {a['estimated_rel_error']:.1g} of the max adhesion")
     for j in res.jumps:
         where = (f"±{j['resolution_m'] * 1e9:.1e} nm" if j["resolution_m"] > 0 else
                  "traced fold, dd/ds = 0")
