@@ -262,8 +262,14 @@ def _krylov_step(problem, h, A, m, F_I, pre):
     a, K_II = problem.areas[m:], problem.K[m:, m:]
     fr = slice(m, None)
 
-    def apply_a(v):
-        return a * (K_II @ v + apply_jacobian(D, fr, v))
+    if D.ndim == 1:
+        D_I = D[fr]     # apply_jacobian's own product, its slice taken once per step
+
+        def apply_a(v):
+            return a * (K_II @ v + D_I * v)
+    else:
+        def apply_a(v):
+            return a * (K_II @ v + apply_jacobian(D, fr, v))
 
     rhs = -a * F_I
     n_factor = 0
