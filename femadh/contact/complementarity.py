@@ -153,7 +153,10 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
     stagnated = None
     # (h, P, K w) after the last step: the next iteration's own when its active set is the
-    # same (w on the set is then already b - sigma, so w, h and the products are those bits)
+    # same or a part of it - only releases (w on the set was put at b - sigma when the set
+    # was entered and the step moves the free nodes alone, so w, h and the products are those
+    # bits: a contact unzipping node by node at its edge, one release per iteration, skips
+    # a product with K and a pressure evaluation per iteration)
     carried = None
     for it in range(1, max_iter + 1):
         # a signal (or the time limit) stops the run here, between iterations: nothing of
@@ -215,7 +218,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # additions/removals adjacent to the current contact boundary to break the cycle.
             new_A = _restrict_change(A, new_A)
         seen.add(key)
-        if sigma is not None and np.array_equal(new_A, A):
+        if sigma is not None and not np.any(new_A & I):
             carried = (h, P, Kw)
         if not np.array_equal(new_A, A):
             # a new active set: its first residual is not comparable with the last one, so
