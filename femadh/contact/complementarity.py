@@ -113,6 +113,9 @@ KRYLOV_MIN_FREE = 150
 #: set, two solves fewer; every grid state the same within 4e-22 m); every bundled scene's
 #: headline numbers move by < 5e-7 of their estimated errors (validation/results/corrector.md)
 GMRES_RTOL_NEW_SET = 1e-4
+#: an iteration whose new active set only releases nodes carries its gaps, pressures and
+#: K w to the next (False: recomputed from w, the same bits - tests/test_corrector.py)
+CARRY_RELEASES = True
 
 
 def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor=None,
@@ -231,7 +234,8 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             # additions/removals adjacent to the current contact boundary to break the cycle.
             new_A = _restrict_change(A, new_A)
         seen.add(key)
-        if sigma is not None and not np.any(new_A & I):
+        if sigma is not None and (np.array_equal(new_A, A) or
+                                  CARRY_RELEASES and not np.any(new_A & I)):
             carried = (h, P, Kw)
         if not np.array_equal(new_A, A):
             # a new active set: its first residual is not comparable with the last one, so
