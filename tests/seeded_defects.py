@@ -1774,6 +1774,32 @@ DEFECTS = [
       "femadh/runner/edge_route.py",
       (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
         '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
+    # -- the corrector made cheaper (branch corrector): releases carry h, P, K w; the first
+    #    step at a set solved to GMRES_RTOL_NEW_SET; GMRES's rotations in Python floats; the
+    #    preconditioner's block size checked once
+    D("corr_carry_additions", "corrector: an iteration that adds contact nodes carries its "
+      "gaps and products too (the new nodes never put on the floor)",
+      "femadh/contact/complementarity.py",
+      (("CARRY_RELEASES and not np.any(new_A & I)):", "CARRY_RELEASES):"),)),
+    D("corr_carry_inverted", "corrector: carried only when nodes are added, not released",
+      "femadh/contact/complementarity.py",
+      (("CARRY_RELEASES and not np.any(new_A & I)):", "CARRY_RELEASES and np.any(new_A & I)):"),)),
+    D("corr_loose_every_step", "corrector: every Newton step solved to the loose tolerance",
+      "femadh/contact/complementarity.py",
+      (("GMRES_RTOL_NEW_SET if res == math.inf else GMRES_RTOL)", "GMRES_RTOL_NEW_SET)"),)),
+    D("corr_loose_1e-2", "corrector: the first step at a set solved to 1e-2",
+      "femadh/contact/complementarity.py",
+      (("GMRES_RTOL_NEW_SET = 1e-4\n", "GMRES_RTOL_NEW_SET = 1e-2\n"),)),
+    D("corr_gmres_rotation_sign", "GMRES: an earlier rotation applied with the wrong sign",
+      "femadh/contact/linalg.py",
+      (("col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c",
+        "col[i], col[i + 1] = cs[i] * a + sn[i] * c, sn[i] * a + cs[i] * c"),)),
+    D("corr_gmres_norm_squared", "GMRES: the new direction's norm squared, not its norm",
+      "femadh/contact/linalg.py",
+      (("col.append(math.sqrt(w @ w))", "col.append(w @ w)"),)),
+    D("corr_block_unchecked", "preconditioner: a solve reuses the last block whatever its size",
+      "femadh/contact/linalg.py",
+      (("        if blk[0] != k or k <= 0:\n", "        if blk[0] is None or k <= 0:\n"),)),
 ]
 
 
