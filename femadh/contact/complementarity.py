@@ -443,8 +443,12 @@ def tangent(problem, state):
     D = problem.law_jacobian(state.h)
     # with a sub-grid law J_II 1 (a free node's pressure also moves with its free
     # neighbours' gaps; the held nodes' gaps stay at sigma)
-    rhs = jacobian_row_sums(D, I) - problem.K[np.ix_(I, A)].sum(axis=1)
     m = disk_size(A)
+    # K_IA 1: on a disk the block K[m:, :m], copied by slicing (contiguous rows: the same
+    # array, so the same sums, as the fancy-indexed copy, at a tenth of its cost)
+    K_IA = (np.ascontiguousarray(problem.K[m:, :m]) if m is not None
+            else problem.K[np.ix_(I, A)])
+    rhs = jacobian_row_sums(D, I) - K_IA.sum(axis=1)
     if isinstance(state.lu, TrailingCholesky) and m is not None and state.lu.covers(m):
         a, K_II = problem.areas[m:], problem.K[m:, m:]
         t_I, _, ok = gmres(lambda v: a * (K_II @ v + apply_jacobian(D, slice(m, None), v)),
