@@ -272,7 +272,8 @@ def _krylov_step(problem, h, A, m, F_I, pre, rtol=GMRES_RTOL):
     """A Newton step dw on the free nodes m..n-1 of a disk contact: GMRES on the area-scaled
     Jacobian diag(area)(K + diag(P'(h)))_II, preconditioned by ``pre`` (a
     :class:`TrailingCholesky` of the energy Hessian), refreshed at h when it does not cover
-    the disk or GMRES does not reach GMRES_RTOL within its Krylov dimension.
+    the disk or GMRES does not reach ``rtol`` (its relative residual: GMRES_RTOL, or
+    GMRES_RTOL_NEW_SET on the first step at an active set) within its Krylov dimension.
 
     Returns (dw or None, preconditioner, factorisations); None when the Hessian at h is not
     positive definite on the free nodes (an iterate off the stable branch): the LU path
