@@ -192,9 +192,15 @@ def _pool_init():
     """Set-up of a local pool worker: a Ctrl-C in the terminal reaches every process of the
     group; an idle worker ignores it (the driver stops it with SIGTERM, without a
     KeyboardInterrupt traceback), while a run in progress takes it at its next safe point
-    (the run installs its own handlers and restores this one)."""
+    (the run installs its own handlers and restores this one: a handler that does nothing,
+    not SIG_IGN, which a run leaves in place as its parent's wish)."""
     _worker_init()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:   # (a nohup'ed study's stays)
+        signal.signal(signal.SIGINT, _idle_sigint)
+
+
+def _idle_sigint(signum, frame):
+    """An idle pool worker's SIGINT: nothing (the driver decides, see :func:`_pool_init`)."""
 
 
 _MALLOC_TUNED = False
@@ -242,7 +248,9 @@ def driver_signals():
             raise Interrupted(flag[0])
         flag.append(signum)
 
-    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    # (a signal the parent set to SIG_IGN stays ignored, as in femadh.interrupt)
+    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)
+           if signal.getsignal(s) is not signal.SIG_IGN}
     try:
         yield flag
     finally:
