@@ -41,6 +41,17 @@ def force_unit(values):
     return 1.0, "N"
 
 
+def force_text(x, err=None):
+    """A force as femadh states it, in the terminal and in a figure alike: five significant
+    digits in the unit that fits the force itself (:func:`force_unit` of ``x`` alone), its
+    estimated error to one significant digit in the same unit (``"31.152 ± 0.03 µN"``);
+    without an error (None or not finite) the number alone. ``x``, ``err`` in N."""
+    s, unit = force_unit([x])
+    if err is not None and np.isfinite(err):
+        return f"{x * s:.5g} ± {err * s:.1g} {unit}"
+    return f"{x * s:.5g} {unit}"
+
+
 def length_unit(values):
     """(scale, label) for lengths: nm below 1 um, else um (mm above 1 mm)."""
     m = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
@@ -366,11 +377,10 @@ def _adhesion_zoom(ax, res, fs, ls, fl, ll):
             ins.axhline(-hl[key] * fs, color="grey", ls=st, lw=0.8)
     if "max_adhesion_N" in hl:
         F, dm = hl["max_adhesion_N"], hl["d_at_max_adhesion_m"]
-        err = hl.get("max_adhesion_N_error")
         ins.plot([dm * ls], [-F * fs], "v", color="C3")
-        pm = f" ± {err * fs:.2g}" if err is not None else ""
-        ins.set_title(f"largest adhesion {F * fs:.4g}{pm} {fl} at d = {dm * ls:.4g} "
-                      f"{ll}", fontsize=7)
+        # the very words and digits of the terminal's line (femadh.runner.report)
+        ins.set_title(f"max adhesion {force_text(F, hl.get('max_adhesion_N_error'))} at "
+                      f"d = {dm * 1e9:.4g} nm", fontsize=7)
     ins.set_xlabel(f"d ({ll})", fontsize=6, labelpad=1)
     ins.set_ylabel(f"force ({fl})", fontsize=6, labelpad=1)
     ins.tick_params(labelsize=6)
@@ -420,7 +430,8 @@ def paper1_panels(res, path):
                    ms=3, label=f"-log10(residual/nm) {b}")
     for j in res.jumps:
         ax[3].axvline(j["d_fold_m"] * 1e9, color="grey", lw=0.8, ls=":")
-    ax[3].set(xlabel="d (nm)", ylabel=f"force on slider ({fl})", title="(d) forces vs separation")
+    ax[3].set(xlabel="d (nm)", ylabel=f"force on the sphere ({fl}), adhesion < 0",
+              title="(d) forces vs separation")
     ax[3].legend(fontsize=7)
     W = res.headline.get("work_of_adhesion_J_per_m2")
     if W:
@@ -431,7 +442,7 @@ def paper1_panels(res, path):
                    label=f"JKR (W = {W:.3g} J/m²)")
         ax[4].plot(F * fs, [dmt_contact_radius(f, R, E, W) * rs for f in F], "k--", lw=1,
                    label="DMT")
-    ax[4].set(xlabel=f"-F_ex, force on slider ({fl})", ylabel=f"r_c ({rl})",
+    ax[4].set(xlabel=f"-F_ex, force on the sphere ({fl})", ylabel=f"r_c ({rl})",
               title="(e) contact radius")
     ax[4].legend(fontsize=7)
     ax[5].set(xlabel="d (nm)", ylabel="iterations; -log10(residual / nm)",
