@@ -61,3 +61,29 @@ def test_every_figure_calls_the_force_the_force_on_the_sphere(fig3_small):
     # panels (d) and (e) both: the force axis of each
     assert len([t for t in texts["profiles_and_forces.png"]
                 if "force on the sphere" in t]) == 2
+
+
+def test_a_prepared_six_panel_figure_is_the_same_picture(fig3_small, tmp_path, monkeypatch):
+    """The figure worker lays the six panels out before the result arrives
+    (plots.prepare): the PNG is the same, byte for byte, as one drawn from nothing, and
+    the draw then makes none of the ~120 Tick objects of its 12 axes (measured: 121 made
+    from nothing on this run; validation/figure_pace.py times both)."""
+    import matplotlib.axis as maxis
+
+    res, _ = fig3_small
+    made, real = [0], maxis.Tick.__init__
+
+    def count(self, *a, **k):
+        made[0] += 1
+        real(self, *a, **k)
+    monkeypatch.setattr(maxis.Tick, "__init__", count)
+    plots.paper1_panels(res, tmp_path / "new.png")
+    from_nothing, made[0] = made[0], 0
+    plots.prepare()
+    # (prepare makes 12 a major axis, and a first minor tick: 156; a draw from nothing
+    # makes what its axes show: 121 on this run)
+    assert made[0] >= from_nothing >= 60
+    made[0] = 0
+    plots.paper1_panels(res, tmp_path / "prepared.png")
+    assert made[0] == 0
+    assert (tmp_path / "prepared.png").read_bytes() == (tmp_path / "new.png").read_bytes()
