@@ -143,6 +143,9 @@ def _parser():
     g2.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
     g2.add_argument("--scheduler", help="a dask.distributed scheduler address "
                     "(tcp://host:8786) or local:N for a LocalCluster of N workers")
+    sw.add_argument("--no-estimate", action="store_true",
+                    help="skip each point's error estimates (as `femadh run --no-estimate`); "
+                         "a later run with estimates runs such points again")
     sw.add_argument("--quantity", default="max_adhesion_N",
                     help="the number the figure shows (default max_adhesion_N)")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -433,7 +436,8 @@ def _sweep(scene, args):
         study = run_study(scene, vary, out, zip_=zip_, workers=args.workers,
                           scheduler=args.scheduler,
                           progress=not args.quiet and sys.stderr.isatty(),
-                          quantity=args.quantity)
+                          quantity=args.quantity,
+                          estimate="peak" if args.no_estimate else True)
     except Interrupted as exc:
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())

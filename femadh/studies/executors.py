@@ -86,6 +86,12 @@ def worker_operator(sc):
     return OPERATOR_CACHE[key], False
 
 
+#: what a point's run estimated, as its record says it (``estimate`` of femadh.run): the
+#: error estimates of the headline numbers ("errors"), only the located peak ("peak", the
+#: command line's --no-estimate), neither ("none"); in increasing order of what it holds
+ESTIMATE_NAMES = {True: "errors", "peak": "peak", False: "none"}
+
+
 def finished(rec):
     """Whether a point's record is final: converged, or failed for a physical reason."""
     if "finished" in rec:
@@ -118,7 +124,7 @@ def run_point(point, root, estimate=True):
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
            "status": "running", "finished": False, "error": None, "operator_reused": False,
-           "pid": os.getpid()}
+           "estimate": ESTIMATE_NAMES[estimate], "pid": os.getpid()}
     write_record(folder, rec)       # a dead worker's point is known by this record's pid
     signum = None
     try:
