@@ -34,7 +34,10 @@ def _stop_at_once(signum, frame):
     :func:`main` runs) or after the command has ended: one line, exit 130, at once. Nothing
     is being written then (the line says what stands), and a KeyboardInterrupt raised in the
     middle of an import would end in a traceback of the import machinery instead."""
-    os.write(2, _STOP_LINE[0])
+    try:
+        os.write(2, _STOP_LINE[0])
+    except OSError:
+        pass                        # (no stderr: the exit code still says it)
     os._exit(130)
 
 
