@@ -25,9 +25,11 @@ from femadh.errors import Interrupted
 ROOT = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 
-#: the child: ``python -m femadh`` (runpy, as the program runs) with an audit hook that sends
-#: this process SIGINT when the module named in FEMADH_TEST_SIGINT_AT starts to be imported,
-#: or writes one byte to the fd in FEMADH_TEST_READY_FD when femadh.cli starts to be imported
+#: the child: ``python -m femadh`` (runpy, as the program runs), or with FEMADH_TEST_SCRIPT
+#: what the ``femadh`` script pip writes does (``from femadh.cli import main``: no __main__
+#: module), with an audit hook that sends this process SIGINT when the module named in
+#: FEMADH_TEST_SIGINT_AT starts to be imported, or writes one byte to the fd in
+#: FEMADH_TEST_READY_FD when femadh.cli starts to be imported
 CHILD = r"""
 import os, signal, sys
 at, ready = os.environ.get("FEMADH_TEST_SIGINT_AT"), os.environ.get("FEMADH_TEST_READY_FD")
@@ -42,6 +44,10 @@ def hook(event, args):
         fired.append(1)
         os.write(int(ready), b"!")
 sys.addaudithook(hook)
+if os.environ.get("FEMADH_TEST_SCRIPT"):
+    sys.argv[0] = os.path.join(os.path.dirname(sys.executable), "femadh")
+    from femadh.cli import main
+    sys.exit(main())
 import runpy
 runpy.run_module("femadh", run_name="__main__", alter_sys=True)
 """
@@ -67,16 +73,20 @@ def _one_line(err):
     return lines[0]
 
 
-# the moments: femadh.cli being imported (before its handler: __main__ takes it), argparse
-# (cli's first import after its handler), shutil (argparse's, while the parser is built),
-# femadh.scene (the scene is read), scipy (the runner's lazy import: the reviewer's case)
-@pytest.mark.parametrize("module", ["femadh.cli", "argparse", "shutil", "femadh.scene",
-                                    "scipy"])
-def test_sigint_while_starting_is_one_line_and_exit_130(tmp_path, module):
+# the moments: femadh.cli being imported (before its handler: python -m femadh's __main__
+# takes it), argparse (cli's first import after its handler: the script has no __main__ to
+# take it), shutil (argparse's, while the parser is built), femadh.scene (the scene is
+# read), scipy (the runner's lazy import: the reviewer's case)
+@pytest.mark.parametrize("launcher, module", [
+    ("-m", "femadh.cli"), ("script", "argparse"), ("script", "shutil"), ("-m", "shutil"),
+    ("-m", "femadh.scene"), ("-m", "scipy")])
+def test_sigint_while_starting_is_one_line_and_exit_130(tmp_path, launcher, module):
     out = tmp_path / "out"
+    env = dict(ENV, FEMADH_TEST_SIGINT_AT=module)
+    if launcher == "script":
+        env["FEMADH_TEST_SCRIPT"] = "1"
     p = subprocess.run([sys.executable, "-c", CHILD, *_run_args(_scene(tmp_path), out)],
-                       cwd=ROOT, env=dict(ENV, FEMADH_TEST_SIGINT_AT=module),
-                       capture_output=True, text=True, timeout=120)
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 130, p.stderr
     _one_line(p.stderr)
     assert p.stdout == ""
