@@ -27,18 +27,21 @@ def _as_program():
 
 #: the line a Ctrl-C prints while the program starts (see :func:`_stop_at_once`)
 _STOP_LINE = [b"femadh: error: interrupted by SIGINT while starting; nothing was written\n"]
+#: its exit code: 130 while starting; the command's own once it has ended
+_STOP_CODE = [130]
 
 
 def _stop_at_once(signum, frame):
     """SIGINT to the program outside :func:`main`'s guard - while it imports itself (before
-    :func:`main` runs) or after the command has ended: one line, exit 130, at once. Nothing
+    :func:`main` runs) or after the command has ended: one line, at once, exit 130 (or the
+    ended command's own code). Nothing
     is being written then (the line says what stands), and a KeyboardInterrupt raised in the
     middle of an import would end in a traceback of the import machinery instead."""
     try:
         os.write(2, _STOP_LINE[0])
     except OSError:
         pass                        # (no stderr: the exit code still says it)
-    os._exit(130)
+    os._exit(_STOP_CODE[0])
 
 
 # First thing, before the imports below: the program's Ctrl-C is one line from here on. Not
@@ -208,6 +211,7 @@ def main(argv=None):
         # the command has ended: a Ctrl-C now (the interpreter's teardown) is one line too
         _STOP_LINE[0] = (f"femadh: error: interrupted by SIGINT while exiting; the command "
                          f"had ended (exit code {code})\n").encode()
+        _STOP_CODE[0] = code
         signal.signal(signal.SIGINT, _stop_at_once)
     if program and sys.argv[1:2] == ["run"]:
         _exit_now(code)

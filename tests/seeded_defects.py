@@ -1845,8 +1845,12 @@ DEFECTS = [
         "    return True"),)),
     D("ui_study_legacy_as_estimated", "an earlier femadh's record taken as estimated",
       "femadh/studies/sweep.py",
-      (('    return "errors" if any(k.endswith("_error") for k in rec) else "none"',
+      (('    return ("errors" if any(k.endswith("_error") or k.startswith("max_force_N[")\n'
+        '                            for k in rec) else "none")',
         '    return "errors"'),)),
+    D("study_meniscus_estimate_as_asked", "a meniscus point's record says what it was asked "
+      "(peak), not what its run did (errors)", "femadh/studies/executors.py",
+      (('            rec["estimate"] = "errors"\n', '            pass\n'),)),
     D("ui_study_estimate_unrecorded", "a point's record says 'errors' whatever its run "
       "estimated", "femadh/studies/executors.py",
       (('           "estimate": ESTIMATE_NAMES[estimate], "pid": os.getpid()}',

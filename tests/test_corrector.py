@@ -79,8 +79,8 @@ def test_releasing_iterations_carry_the_same_bits(problem, monkeypatch):
 def test_an_inexact_first_step_at_each_set_reaches_the_same_states(problem, monkeypatch):
     """GMRES to 1e-4 on the first step at each active set against 1e-6 on every step: the
     same separations, contact sets and folds; every grid state within 3x the tolerance of
-    the other (measured 7.6e-21 m on N = 240, tolerance 1e-19 m: both meet the residual
-    tolerance); every state's residual recomputed here within the tolerance (measured at
+    the other within 2x the measured 7.6e-21 m (N = 240; tolerance 1e-19 m: GMRES to 1e-2
+    on the first step moves them 8.8e-20 m, to 1e-4 on every step 3.6e-20 m); every state's residual recomputed here within the tolerance (measured at
     most 6.6e-20 m: the corrector's own test); fewer Krylov iterations (measured 2736 ->
     2348) and no more Newton iterations (measured 589 on both)."""
     p = problem
@@ -91,7 +91,7 @@ def test_an_inexact_first_step_at_each_set_reaches_the_same_states(problem, monk
         assert [s.d for s in new.states] == [s.d for s in old.states]
         for a, b in zip(new.states, old.states):
             assert np.array_equal(a.active, b.active)
-            assert np.max(np.abs(a.w - b.w)) <= 3 * TOL
+            assert np.max(np.abs(a.w - b.w)) <= 2 * 7.6e-21
             # the residual of eq (6)/(10), recomputed: w - C (P(h) - pc) with pc on the set
             pc = np.where(a.active, p.pressure(a.h) - p.K @ a.w, 0.0)
             assert np.max(np.abs(a.w - p.C @ (p.pressure(a.h) - pc))) <= TOL

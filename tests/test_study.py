@@ -432,3 +432,28 @@ def test_points_without_estimates_are_not_reused_by_a_study_that_asks_for_them(t
                                     if k != "estimate" and not k.endswith("_error")}))
     assert main(args) == 0
     assert "reused 0, redone 1, new 0" in capsys.readouterr().out
+
+
+def test_a_meniscus_point_records_the_estimate_its_run_made(tmp_path, capsys):
+    """A meniscus run estimates its force's error whatever it is asked (run_meniscus takes no
+    ``estimate``): its point's record says "errors" under --no-estimate too, so a later study
+    with estimates reuses it (no false "run again" note); an earlier femadh's meniscus record
+    (no "estimate" field, no ``*_error`` key) is taken for estimated by its forces."""
+    from femadh.studies.sweep import point_estimate
+
+    scene = Path(__file__).parent.parent / "validation" / "scenes" / "paper2_ethanol_100nm.toml"
+    out = tmp_path / "st"
+    args = ["study", "sweep", str(scene), "--vary", "meniscus.temperature=298.15 K",
+            "--out", str(out), "--workers", "1", "--quiet"]
+    assert main(args + ["--no-estimate"]) == 0
+    rec_file, = (out / "points").glob("*/record.json")
+    rec = json.loads(rec_file.read_text())
+    assert rec["estimate"] == "errors"
+    assert main(args) == 0
+    cap = capsys.readouterr()
+    assert "reused 1, redone 0, new 0" in cap.out and "run again" not in cap.err
+    old = {k: v for k, v in rec.items() if k != "estimate"}
+    assert any(k.startswith("max_force_N[") for k in old)
+    assert point_estimate(old) == "errors"
+    assert point_estimate({k: v for k, v in old.items()
+                           if not k.startswith("max_force_N[")}) == "none"

@@ -208,7 +208,8 @@ class TrailingCholesky:
 
             kept = self.kept
             blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])
-            self._block = (k, blk, blas.strsv if blk.dtype == np.float32 else blas.dtrsv)
+            # (the routine's name, not the f2py routine: a factor stays picklable)
+            self._block = (k, blk, "strsv" if blk.dtype == np.float32 else "dtrsv")
         return self._block[1]
 
     def solve(self, m, rhs):
@@ -227,7 +228,9 @@ class TrailingCholesky:
                                  f"{self.m0}, positive definite leading size {self.k_valid})")
             self._factor_block(k)
             blk = self._block
-        u, trsv = blk[1], blk[2]
+        from scipy.linalg import blas
+
+        u, trsv = blk[1], getattr(blas, blk[2])
         # (a double vector would be converted by the wrapper anyway; reversed, contiguous)
         r = np.array(rhs[::-1], dtype=u.dtype)
         y = trsv(u, r, trans=1, overwrite_x=1)          # U^T y = r

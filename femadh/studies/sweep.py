@@ -135,11 +135,14 @@ _ORDER = ("none", "peak", "errors")
 def point_estimate(rec):
     """What a finished point's run estimated: its record's ``estimate`` ("errors", "peak" or
     "none", :data:`~femadh.studies.executors.ESTIMATE_NAMES`). A record of an earlier femadh
-    (no such field) counts as "errors" when it holds an estimated error, else as "none": not
-    knowing, it is never taken for more than it shows."""
+    (no such field) counts as "errors" when it holds an estimated error or a meniscus force
+    (meniscus runs always estimate it), else as "none": not knowing, it is never taken for
+    more than it shows."""
     if rec.get("estimate") in _ORDER:
         return rec["estimate"]
-    return "errors" if any(k.endswith("_error") for k in rec) else "none"
+    # (a meniscus run has always estimated its force's error, recorded or not)
+    return ("errors" if any(k.endswith("_error") or k.startswith("max_force_N[")
+                            for k in rec) else "none")
 
 
 def serves(rec, estimate):
@@ -208,7 +211,9 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
                           redone=sum(p.id in old for p in todo),
                           new=sum(p.id not in old for p in todo))
         if short:
-            what = ("without error estimates (--no-estimate) run again with them"
+            old_femadh = any("estimate" not in old[k] for k in short)
+            what = ("without error estimates (--no-estimate"
+                    f"{' or an earlier femadh' * old_femadh}) run again with them"
                     if estimate is True else "without their peak located run again with it")
             result.notes.append(f"{len(short)} finished point{'s' * (len(short) > 1)} "
                                 f"computed {what}")
