@@ -8,6 +8,15 @@ os.environ.setdefault("FEMADH_MESH_PATH", str(Path(__file__).resolve().parents[1
 # condensed FE operators cached per test process, not in the user's ~/.cache
 os.environ.setdefault("FEMADH_OPERATOR_CACHE", __import__("tempfile").mkdtemp(
     prefix="femadh-operators-"))
+# The signal tests send SIGINT to the runs they start, which must take it. A suite started
+# with SIGINT ignored (a non-interactive shell's background job, nohup'ed CI) would pass that
+# SIG_IGN to every child, and femadh keeps an ignored SIGINT ignored (as a user's background
+# job wants): the suite's own processes take SIGINT as a terminal would (a Python handler is
+# reset to the default at exec, so the children start with Python's KeyboardInterrupt).
+import signal  # noqa: E402
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 import numpy as np
 import pytest
