@@ -45,6 +45,7 @@ from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # fresh states between grid states and the peak search: their own home (members and the
 # instrument use them too)
+from . import peak as _peak
 from .peak import peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
@@ -112,11 +113,17 @@ def refine_peak(scene, res, problem, sink):
     if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
         return 0.0
     branch, f_grid, prev, best, nxt = sink.peak
-    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)
+    fresh = []
+    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,
+                               record=fresh)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
     sink.peak_fold = fold_end_error(sink, res, branch, prev, best, nxt, d)
+    # the state the maximum was read at (a fresh state, or the grid state itself): the
+    # estimate's lattice part starts from it (femadh.runner.peak.lattice_tooth)
+    at = [st for x, f, st in fresh if st is not None and x == d and f == F]
+    sink.peak_state = at[0] if at else (best if best.d == d else None)
     return half
 
 
@@ -198,6 +205,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
+    # the lattice: the peak state's contact edge bistable a node in or out (a sawtooth
+    # F_ex(d) whose tooth the peak search reads; femadh.runner.peak.lattice_tooth)
+    peak_state = getattr(sink, "peak_state", None)
+    if _peak.LATTICE_PART and peak_state is not None and "max_adhesion_N" in hl:
+        tooth = _peak.lattice_tooth(getattr(sink, "peak_problem", problem), peak_state, scene,
+                              hl["max_adhesion_N"])
+        if tooth > 0:
+            parts.setdefault("max_adhesion_N", {})["lattice"] = tooth
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
     # a layered body has none: its mesh part is the difference to the next coarser mesh,
     # Richardson with the P2 body's observed order 3 - validation/results/layered_fe.md)
@@ -232,7 +247,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 f"({_short(g.error)}); the FE mesh part of the error is not "
                                 "estimated: the stated errors lack it")
     levels = []
-    ratio, members = coarser_members(scene, problem, green)
+    ratio, members, ratio2 = coarser_members(scene, problem, green)
     # the forces at the deepest separation: members placed by its contact edge (the same
     # fraction of a spacing as the fine grid's), where they can be; the family's reduced
     # members then skip that state (its grid part would be replaced)
@@ -261,12 +276,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         levels.append(dict(r.headline))
     res.grid["member_solves"] = solved
     res.grid["member_ratio"] = ratio
+    if ratio2 is not None:
+        res.grid["member_ratio2"] = ratio2
     res.grid["members"] = [lb for lb, _ in members][:len(levels)]
     if scene.grid is not None:
         res.grid["member_spacings_m"] = [m.grid["spacing"] for _, m in members][:len(levels)]
     if levels:
         for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
-                                   ratio=ratio).items():
+                                   ratio=ratio, ratio2=ratio2).items():
             parts.setdefault(k, {})["grid"] = v
     if locked is not None and levels:
         (h1, h2), (lv1, lv2) = locked
@@ -401,19 +418,52 @@ def guard_bounds(res, problem):
             "accuracy)")
 
 
-def coarser_members(scene, problem, green=None):
-    """(ratio r, [(label, scene)]) of the two coarser members of the scene's grid family.
+#: a uniform grid whose N/4 member would soften beyond the plan's TRAP_SAFE (its softening
+#: ratio 4x the run's own) takes members at N/sqrt2 and N/2 instead of N/2 and N/4
+#: (:func:`uniform_member_nodes`). False: N/2 and N/4 always (as before)
+UNIFORM_SQRT2_MEMBERS = True
 
-    Uniform grids: N/2 and N/4 (r = 2). Banded grids: spacings r h and r^2 h of the same
-    family (same band, grading and radius), r = sqrt 2
+
+def uniform_member_nodes(problem, n):
+    """(N1, N2) of a uniform grid's two coarser members: N/2 and N/4, or round(N/sqrt2) and
+    N/2 where the N/4 member would soften beyond TRAP_SAFE.
+
+    A member's trapping ratio (:func:`femadh.discretisation.plan.trapping_ratio`) grows like
+    its spacing, a / (N - 1/2): the Fig 4 scene's N = 200 run (0.24) has its N = 100 and
+    N = 50 members at 0.48 and 0.96 of a node's own stiffness; they land micro-jump after
+    micro-jump and made the largest adhesion's grid part 3.2x its error and the pull-off's 6
+    lattice steps (validation/results/effectivity.md, sec 3-4). The plan keeps a banded
+    family's coarsest member below TRAP_SAFE (:func:`~femadh.discretisation.plan.safe_spacing`);
+    an explicit N gets the finer pair where its N/4 would not be."""
+    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
+
+    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5) if n // 4 >= 1 else math.inf
+    if UNIFORM_SQRT2_MEMBERS and quarter > TRAP_SAFE:
+        return int(round(n / 2**0.5)), n // 2
+    return n // 2, n // 4
+
+
+def coarser_members(scene, problem, green=None):
+    """(ratio r, [(label, scene)], ratio2) of the two coarser members of the scene's grid
+    family; ratio2 is the second member's spacing over the first's where it differs from r
+    (else None).
+
+    Uniform grids: N/2 and N/4 (r = 2), or N/sqrt2 and N/2 where N/4 would be near-trapped
+    (:func:`uniform_member_nodes`; r and ratio2 the spacings' actual ratios,
+    (N - 1/2) / (N1 - 1/2) and (N1 - 1/2) / (N2 - 1/2)). Banded grids: spacings r h and r^2 h
+    of the same family (same band, grading and radius), r = sqrt 2
     (:func:`femadh.discretisation.plan.member_ratio`): members that stay asymptotic and,
     with the adaptive plan's spacing cap, below the trapping limit (a lattice-trapped member
     lands fold after fold and makes the estimate pessimistic: the Fig 4 scene's uniform
     N = 50 and 100 members, effectivity 9.8)."""
     green = green or {}
     if scene.grid is None:
-        return 2.0, [(f"N = {n}", variant(scene, nodes=n, **green))
-                     for n in (scene.nodes // 2, scene.nodes // 4) if n >= 8]
+        n = scene.nodes
+        n1, n2 = uniform_member_nodes(problem, n)
+        out = [(f"N = {k}", variant(scene, nodes=k, **green)) for k in (n1, n2) if k >= 8]
+        if n1 == n // 2:
+            return 2.0, out, None
+        return (n - 0.5) / (n1 - 0.5), out, (n1 - 0.5) / (n2 - 0.5)
     from ..discretisation.plan import member_ratio
 
     r = member_ratio(problem)
@@ -424,7 +474,7 @@ def coarser_members(scene, problem, green=None):
         if h > g["band"] / 8:
             break
         out.append((f"spacing {h * 1e9:.4g} nm", variant(scene, grid={**g, "spacing": h})))
-    return r, out
+    return r, out, None
 
 
 QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",
