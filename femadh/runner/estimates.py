@@ -45,8 +45,7 @@ from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # fresh states between grid states and the peak search: their own home (members and the
 # instrument use them too)
-from . import peak as _peak
-from .peak import peak_adhesion
+from .peak import lattice_tooth, peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
@@ -116,14 +115,11 @@ def refine_peak(scene, res, problem, sink):
     fresh = []
     F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,
                                record=fresh)
+    sink.peak_fresh = fresh          # (the estimate's lattice part samples around the peak)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
     sink.peak_fold = fold_end_error(sink, res, branch, prev, best, nxt, d)
-    # the state the maximum was read at (a fresh state, or the grid state itself): the
-    # estimate's lattice part starts from it (femadh.runner.peak.lattice_tooth)
-    at = [st for x, f, st in fresh if st is not None and x == d and f == F]
-    sink.peak_state = at[0] if at else (best if best.d == d else None)
     return half
 
 
@@ -205,12 +201,15 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
-    # the lattice: the peak state's contact edge bistable a node in or out (a sawtooth
-    # F_ex(d) whose tooth the peak search reads; femadh.runner.peak.lattice_tooth)
-    peak_state = getattr(sink, "peak_state", None)
-    if _peak.LATTICE_PART and peak_state is not None and "max_adhesion_N" in hl:
-        tooth = _peak.lattice_tooth(getattr(sink, "peak_problem", problem), peak_state, scene,
-                              hl["max_adhesion_N"])
+    # the lattice: where a sub-grid step's cohesive zone acts at the contact edge, the peak
+    # search reads a tooth's tip of the sawtooth the edge's node releases make, which the
+    # members cannot see (femadh.runner.peak.lattice_tooth)
+    peak_problem = getattr(sink, "peak_problem", problem)
+    if LATTICE_PART and "max_adhesion_N" in hl and getattr(sink, "peak_fresh", None) \
+            is not None and cohesive_edge(peak_problem):
+        _, _, prev, best, nxt = sink.peak
+        tooth = lattice_tooth(peak_problem, prev, best, nxt, scene, hl["max_adhesion_N"],
+                              hl["d_at_max_adhesion_m"], sink.peak_fresh)
         if tooth > 0:
             parts.setdefault("max_adhesion_N", {})["lattice"] = tooth
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
@@ -330,6 +329,45 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     # search, which locates the headline's largest adhesion itself
     res.timings["error_estimate_s"] = time.perf_counter() - t0
     return parts
+
+
+#: the largest adhesion gets a lattice part (:func:`femadh.runner.peak.lattice_tooth`) where
+#: a sub-grid step's cohesive zone acts at the contact edge (:func:`cohesive_edge`). False:
+#: no such part (as before)
+LATTICE_PART = True
+
+
+def cohesive_edge(problem):
+    """True where a sub-grid step law (the capillary condensate, :mod:`femadh.contact.subgrid`)
+    has its edge just above the sigma floor and softens, by its secant across that edge
+    (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`: a Dugdale cohesive zone at the
+    contact edge), more than every collocated law does at its steepest
+    (:meth:`~femadh.contact.problem.ContactProblem.surface_force_stiffness`).
+
+    There the sawtooth of the contact edge's node releases that the peak search reads
+    (femadh.runner.peak.lattice_tooth) puts its tips above the smooth trend by about a tooth
+    at every spacing. Measured on the stiction map's sigma = 0.489 nm, p/psat 0.15 point
+    (secant 9.8e17 Pa/m against LJ's 2.77e17), against the sigma-edge branch's order-2
+    family (1.564850e-4 N, 6.3e-5; validation/results/sigma_edge.md): the static 5.885-um
+    band's largest adhesion at 13.48, 8.09, 5.72 and 4.04 nm lies +6.04e-3, +3.01e-3,
+    +2.01e-3 and +1.42e-3 above it (the 8.09- and 5.72-nm values the 4.04-nm run's reduced
+    members), each of the finer three ~6-8e-4 above the edge family's own h^2 errors (the
+    members' differences see only those); the estimate said 8.6e-4 of the force and the run
+    was converged at 1e-3 (effectivity 0.61); the tooth there 8.2e-4 (with it 1.19). Where
+    no step acts at the edge the tips are the lattice's faithful states: the Fig 4 scene's
+    uniform N = 200, 400, 800 lie +2.17e-3, +5.0e-4, +9.1e-5 above the same branch's limit
+    on their disk (1.0921001e-4 N; orders 2.1 and 2.5) while its teeth at the peak are
+    2.5e-3 to 3.8e-3 of the force."""
+    from ..laws.step import SmoothStepLaw
+
+    if problem.sigma is None:
+        return False
+    steps = [law for law in problem.effects.values()
+             if isinstance(law, SmoothStepLaw) and getattr(law, "SUBGRID", False)]
+    if not steps:
+        return False
+    secant = max(law.edge_softening(problem.sigma) for law in steps)
+    return secant > 0 and secant > problem.surface_force_stiffness()[2]
 
 
 def fe_against_green(fe, green):

@@ -398,53 +398,81 @@ def _vertex_proposal(ds, fs, i, a, c):
     return x if a < x < c else None
 
 
-#: the largest adhesion's estimate gets a lattice part (:func:`lattice_tooth`): the F_ex
-#: jump between the refined peak state and a stable state of the same separation with its
-#: contact edge one node in or out. False: no such part (as before)
-LATTICE_PART = True
-#: contact-set trials of :func:`lattice_tooth`, in order: nodes released from (negative)
-#: or joined to (positive) the peak state's outermost contact node
-LATTICE_TRIALS = (-1, -2, 1, 2)
+#: fresh states :func:`lattice_tooth` adds on each side of the peak, at these fractions of
+#: the release period (the peak search's own states within a period count too)
+TOOTH_SAMPLES = (0.5, 1.0)
 
 
-def lattice_tooth(problem, state, scene, f_peak):
-    """The F_ex jump (N, >= 0) between a sigma-gap peak state and the nearest other stable
-    equilibrium at its separation whose contact edge sits a node in or out, or 0.0 where
-    there is none (the contact releases or joins a node continuously).
+def release_period(prev, nxt):
+    """Separation (m) over which the contact edge releases (or joins) one node between the
+    grid states ``prev`` and ``nxt`` around a peak: |d_next - d_prev| over the difference
+    of their contact node counts; None where the counts are equal (no node released in the
+    bracket) or a state has no contact set."""
+    if prev.active is None or nxt.active is None:
+        return None
+    dn = abs(int(np.count_nonzero(prev.active)) - int(np.count_nonzero(nxt.active)))
+    return abs(nxt.d - prev.d) / dn if dn else None
 
-    On a fixed lattice a contact edge that moves through a softening cohesive zone (the LJ
-    well or a meniscus edge just above sigma: a node's softening a sizeable share of its own
-    stiffness) does not move continuously: each node is held until its own micro-fold and
-    then released, so F_ex(d) is a sawtooth and the states of one separation are bistable
-    (m and m - 1 contact nodes). The continuous edge lies between them, and the bounded peak
-    search (:func:`peak_adhesion`), which maximises over the stable states it finds, reads
-    a tooth's tip: the largest adhesion is uncertain by the tooth's height there, a part of
-    the error no member solved from the fine run's states sees (each member's state keeps
-    the fine run's edge). Measured on the stiction map's sigma = 0.489 nm, p/psat 0.15 point
-    (13.48-nm band, 532 nodes): at the refined peak (d = 0.9224 nm, 110 contact nodes) the
-    state with 109 nodes is stable too, 7.4e-3 of the force lower, while the limit (the
-    sigma-edge branch's order-2 family, 1.564850e-4 N) lies 6.0e-3 below the peak.
 
-    Each trial of LATTICE_TRIALS starts the corrector from the peak state's surface with its
-    contact set cut or extended by that many nodes; the first that converges to a stable
-    state with another contact set gives the jump. The trials start at the peak's own
-    surface, so a state they reach is of the same separation and branch neighbourhood (a
-    trial that converges onto the saddle between the two, unstable, is passed over)."""
-    from ..contact import solve_state
+def lattice_tooth(problem, prev, best, nxt, scene, f_peak, d_peak, fresh=()):
+    """How far (N, >= 0) F_ex falls from the refined peak (``f_peak`` at ``d_peak``) within one
+    release period of the contact edge on either side of it (:func:`release_period`), the
+    curve's own fall over that distance (the parabola through the grid states ``prev``,
+    ``best``, ``nxt``) taken off; 0.0 without a sigma-gap contact or a release in the
+    bracket.
+
+    On a fixed lattice the contact edge of a sigma-gap contact moves a node at a time: a
+    contact node is held until its multiplier vanishes and is then released, so F_ex(d) is
+    a sawtooth, and the bounded peak search (:func:`peak_adhesion`) reads a tooth's tip.
+    Where a sub-grid step's cohesive zone acts at the edge
+    (:func:`femadh.runner.estimates.cohesive_edge`) the tips sit above the smooth trend by
+    about a tooth at every spacing, so the coarser members, each on its own tip, differ by
+    the smooth part alone: measured on the stiction map's sigma = 0.489 nm, p/psat 0.15
+    point, 4.04-nm band (1772 nodes), the peak's pinned piece rises from +1.04e-3 to
+    +1.42e-3 of the sigma-edge branch's limit within 0.0009 nm, the next trough +6.6e-4
+    (release period 0.0036 nm); this function: 8.2e-4 of the force.
+
+    ``fresh``: [(d, F or None, state or None)] the peak search solved (those within a
+    period count as samples); TOOTH_SAMPLES more on each side are solved as the peak
+    search's fresh states (:func:`state_between`, warm-started from them)."""
     from ..contact.forces import state_forces
 
-    if problem.sigma is None or problem.contact_model == "hertz-closure" or \
-            state.active is None or not np.any(state.active):
+    if problem.sigma is None or problem.contact_model == "hertz-closure":
         return 0.0
-    m = int(np.flatnonzero(state.active)[-1])
-    for k in LATTICE_TRIALS:
-        end = m + 1 + k
-        if not 0 < end < problem.grid.n:
-            continue
-        act = np.zeros_like(state.active)
-        act[:end] = True
-        st = solve_state(problem, state.d, state.w, tol=scene.tolerance,
-                         max_iter=scene.max_iter, active0=act)
-        if st.converged and st.stable and not np.array_equal(st.active, state.active):
-            return float(abs(f_peak - state_forces(problem, st)[2]))
-    return 0.0
+    period = release_period(prev, nxt)
+    if period is None:
+        return 0.0
+    lo, hi = sorted((prev.d, nxt.d))
+    smooth = _grid_parabola(problem, prev, best, nxt)
+    near = [st for _, _, st in fresh if st is not None]
+    samples = [f - smooth(x) for x, f, _ in fresh
+               if f is not None and abs(x - d_peak) <= period]
+    for frac in TOOTH_SAMPLES:
+        for side in (-1.0, 1.0):
+            x = d_peak + side * frac * period
+            if not lo < x < hi:
+                continue
+            a, b = (prev, best) if nxt.d == best.d or (x - best.d) * (prev.d - best.d) > 0 \
+                else (best, nxt)
+            if a.d == b.d:
+                continue
+            st = state_between(problem, a, b, x, scene, False, _warm(near, a, b, x))
+            if st is not None:
+                near.append(st)
+                samples.append(state_forces(problem, st)[2] - smooth(x))
+    return float(max(f_peak - smooth(d_peak) - min(samples), 0.0)) if samples else 0.0
+
+
+def _grid_parabola(problem, prev, best, nxt):
+    """F_ex(d) of the parabola through the three grid states around a peak (N; a function of
+    d in m): the curve's own fall over a release period, taken off the samples so that the
+    tooth is the lattice's alone. At a fold (two distinct states) nothing is taken off."""
+    from ..contact.forces import state_forces
+
+    ds = [float(s.d - best.d) for s in (prev, best, nxt)]      # (centred: d ~ 1e-9 m)
+    if len(set(ds)) < 3:
+        return lambda x: 0.0
+    fs = [float(s.f_ex if hasattr(s, "f_ex") else state_forces(problem, s)[2])
+          for s in (prev, best, nxt)]
+    c = np.polyfit(ds, fs, 2)
+    return lambda x: float(np.polyval(c, x - best.d))
