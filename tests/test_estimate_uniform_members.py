@@ -49,3 +49,28 @@ def test_members_follow_the_quarter_members_softening(path, n, family):
         assert r2 == pytest.approx(h[1] / h[0], rel=1e-12, abs=0)
         # and the coarsest member is no coarser than N/2: at most twice the run's spacing
         assert h[1] / h0 < 2.01
+
+
+def test_the_estimate_divides_by_the_members_uneven_ratios(monkeypatch):
+    """A uniform run whose members are N/sqrt2 and N/2 (the Fig 4 scene at N = 100, its own
+    trapping ratio 0.48: N/4 at 1.9) takes its grid part from Richardson over the ratios its
+    members' spacings have (observed_order_uneven): 99.5/70.5 and 70.5/49.5, recorded in the
+    result."""
+    from femadh.runner import estimates
+
+    seen = []
+    real = estimates.discretisation
+
+    def spy(*a, **kw):
+        seen.append(kw)
+        return real(*a, **kw)
+    monkeypatch.setattr(estimates, "discretisation", spy)
+    sc = variant(femadh.load_scene(FIG4), nodes=100).replace(
+        {"sweep.start": "1.2 nm", "sweep.stop": "0.6 nm"})
+    res = femadh.run(sc, progress=False, figures=False)
+    assert res.status == "converged"
+    assert res.grid["members"] == ["N = 71", "N = 50"]
+    assert res.grid["member_ratio"] == pytest.approx(99.5 / 70.5, rel=1e-12, abs=0)
+    assert res.grid["member_ratio2"] == pytest.approx(70.5 / 49.5, rel=1e-12, abs=0)
+    assert seen and seen[0]["ratio"] == res.grid["member_ratio"] \
+        and seen[0]["ratio2"] == res.grid["member_ratio2"]
