@@ -37,12 +37,42 @@ def _point(rel=0.15, **solver):
 
 
 @pytest.fixture(scope="module")
-def run():
+def traced():
+    """(result, the peak search's problem and sink) of the run with its estimate."""
+    from femadh.runner import estimates
+
     sc = _point(grid={"spacing": "4.04 nm", "band": "2.2 um", "grading": "0.2942626780203085 um"},
                 analysis_radius="28.28427124746190 um")
-    with warnings.catch_warnings():
+    got, real = {}, estimates.refine_peak
+
+    def spy(scene, res, problem, sink):
+        got.update(problem=problem, sink=sink)
+        return real(scene, res, problem, sink)
+    with pytest.MonkeyPatch.context() as mp, warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshResolutionWarning)
-        return femadh.run(sc, progress=False, figures=False)
+        mp.setattr(estimates, "refine_peak", spy)
+        return femadh.run(sc, progress=False, figures=False), got
+
+
+@pytest.fixture(scope="module")
+def run(traced):
+    return traced[0]
+
+
+def test_release_period_is_one_spacing_of_the_edge(traced):
+    """The window the lattice part samples is one release of the contact edge: the
+    separation over which the node count of the peak's grid states changes by one
+    (release_period: 0.2 nm, 391 -> 343 contact nodes) equals the separation over which their
+    contact radius (the outermost contact node) moves by one band spacing, h |d_next - d_prev|
+    / |r_c,prev - r_c,next| (1.578 -> 1.384 um): the edge's path lies in the band's uniform
+    part. Measured equal to 2e-14; 1e-12 allowed."""
+    from femadh.runner.peak import release_period
+
+    _, got = traced
+    _, _, prev, _, nxt = got["sink"].peak
+    h = float(got["problem"].grid.nodes[1])
+    by_radius = h * abs(nxt.d - prev.d) / abs(prev.r_c - nxt.r_c)
+    assert release_period(prev, nxt) == pytest.approx(by_radius, rel=1e-12, abs=0)
 
 
 def test_stated_error_covers_the_edge_branch_limit(run):
