@@ -10,12 +10,47 @@ dependency is missing; 6 the run reached its time limit (``[solver] time_limit``
 SIGINT / SIGTERM (completed states kept, ``--resume`` continues); 1 an internal error (a bug:
 set FEMADH_DEBUG=1 for its traceback).
 """
-import argparse
 import os
+import signal
 import sys
 
-from ._version import __version__
-from .errors import (DependencyError, FemadhError, Interrupted, OutputError,
+
+def _as_program():
+    """Whether this process is the ``femadh`` program (its script or ``python -m femadh``),
+    not a script that calls :func:`main`; a coverage run keeps its teardown (its data is
+    written at exit)."""
+    prog = os.path.normpath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    return (not os.environ.get("COVERAGE_PROCESS_START")
+            and (os.path.basename(prog).removesuffix(".exe") == "femadh"
+                 or prog.endswith(os.path.join("femadh", "__main__.py"))))
+
+
+#: the line a Ctrl-C prints while the program starts (see :func:`_stop_at_once`)
+_STOP_LINE = [b"femadh: error: interrupted by SIGINT while starting; nothing was written\n"]
+
+
+def _stop_at_once(signum, frame):
+    """SIGINT to the program outside :func:`main`'s guard - while it imports itself (before
+    :func:`main` runs) or after the command has ended: one line, exit 130, at once. Nothing
+    is being written then (the line says what stands), and a KeyboardInterrupt raised in the
+    middle of an import would end in a traceback of the import machinery instead."""
+    try:
+        os.write(2, _STOP_LINE[0])
+    except OSError:
+        pass                        # (no stderr: the exit code still says it)
+    os._exit(130)
+
+
+# First thing, before the imports below: the program's Ctrl-C is one line from here on. Not
+# when imported by a script or a test (their Ctrl-C is theirs), nor when the parent set
+# SIGINT to be ignored (nohup, a background job: it stays ignored).
+if _as_program() and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+    signal.signal(signal.SIGINT, _stop_at_once)
+
+import argparse  # noqa: E402  (after the handler: a Ctrl-C during these imports is one line)
+
+from ._version import __version__  # noqa: E402
+from .errors import (DependencyError, FemadhError, Interrupted, OutputError,  # noqa: E402
                      SceneError)
 
 EXIT_SCENE, EXIT_SOLVE, EXIT_OUTPUT, EXIT_DEPENDENCY, EXIT_BUG = 2, 3, 4, 5, 1
@@ -111,6 +146,9 @@ def _parser():
     g2.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
     g2.add_argument("--scheduler", help="a dask.distributed scheduler address "
                     "(tcp://host:8786) or local:N for a LocalCluster of N workers")
+    sw.add_argument("--no-estimate", action="store_true",
+                    help="skip each point's error estimates (as `femadh run --no-estimate`); "
+                         "a later run with estimates runs such points again")
     sw.add_argument("--quantity", default="max_adhesion_N",
                     help="the number the figure shows (default max_adhesion_N)")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -166,19 +204,14 @@ def main(argv=None):
     flushed. Called with ``argv`` (a script, a test) it forks nothing and returns."""
     program = argv is None and _as_program()
     code = _main(argv, program)
+    if program and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        # the command has ended: a Ctrl-C now (the interpreter's teardown) is one line too
+        _STOP_LINE[0] = (f"femadh: error: interrupted by SIGINT while exiting; the command "
+                         f"had ended (exit code {code})\n").encode()
+        signal.signal(signal.SIGINT, _stop_at_once)
     if program and sys.argv[1:2] == ["run"]:
         _exit_now(code)
     return code
-
-
-def _as_program():
-    """Whether this process is the ``femadh`` program (its script or ``python -m femadh``),
-    not a script that calls :func:`main`; a coverage run keeps its teardown (its data is
-    written at exit)."""
-    prog = os.path.normpath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
-    return (not os.environ.get("COVERAGE_PROCESS_START")
-            and (os.path.basename(prog).removesuffix(".exe") == "femadh"
-                 or prog.endswith(os.path.join("femadh", "__main__.py"))))
 
 
 def _exit_now(code):
@@ -194,9 +227,13 @@ def _exit_now(code):
 
 
 def _main(argv, program=False):
-    args = _parser().parse_args(argv)
-    args.program = program
     try:
+        if signal.getsignal(signal.SIGINT) is _stop_at_once:
+            # from here a Ctrl-C is a KeyboardInterrupt, taken below (or, in a run, deferred
+            # to its next safe point by femadh.interrupt)
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        args = _parser().parse_args(argv)
+        args.program = program
         from ._threads import blas_threads
 
         with blas_threads():
@@ -214,7 +251,8 @@ def _main(argv, program=False):
         _error(f"{exc}; nothing was being written")
         return exc.exit_code
     except KeyboardInterrupt:
-        _error("interrupted")
+        # (outside a run's safe points: its imports, the scene's checks, another command)
+        _error("interrupted by SIGINT")
         return 130
     except FemadhError as exc:
         _error(exc)
@@ -401,7 +439,8 @@ def _sweep(scene, args):
         study = run_study(scene, vary, out, zip_=zip_, workers=args.workers,
                           scheduler=args.scheduler,
                           progress=not args.quiet and sys.stderr.isatty(),
-                          quantity=args.quantity)
+                          quantity=args.quantity,
+                          estimate="peak" if args.no_estimate else True)
     except Interrupted as exc:
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())

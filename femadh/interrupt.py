@@ -11,7 +11,10 @@ atomically: the operator build, the figures) the handler raises at once.
 
 A second signal while the first is pending stops at once (the user insists); the output files
 are still consistent (see femadh.io.atomic). Outside the main thread (e.g. a Dask worker) the
-handlers cannot be installed and the guard is a no-op.
+handlers cannot be installed and the guard is a no-op. A signal the parent process set to
+be ignored (``nohup``, a background job started with SIGINT ignored, a pool worker that
+leaves Ctrl-C to its driver) stays ignored: its SIG_IGN is left in place, not replaced by the
+run's handler, so the run goes on as its parent asked.
 
 The blocks nest: a run inside a run (an estimate's coarser members) shares the outer run's
 flag, so a signal that arrives during a member stops the whole run (it is never consumed by
@@ -59,7 +62,9 @@ def interruptible(time_limit=None):
         finally:
             _depth[0] -= 1
         return
-    old = {s: signal.signal(s, _handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    # (a signal the parent set to SIG_IGN stays ignored: that was its parent's request)
+    old = {s: signal.signal(s, _handler) for s in (signal.SIGINT, signal.SIGTERM)
+           if signal.getsignal(s) is not signal.SIG_IGN}
     _pending.clear()
     _depth[0] = 1
     _deadline[0] = (time.monotonic() + time_limit, time_limit) if time_limit else None

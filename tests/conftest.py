@@ -251,7 +251,7 @@ def corner_approach():
     Traced once for test_landing_relax and test_landing_scan (each traced it, the same
     path, ~2 CPU-s): the spies record and call through, so the path is the one each traced."""
     import femadh
-    from femadh.contact import landing, linalg, stepping, trace
+    from femadh.contact import complementarity, landing, linalg, stepping, trace
     from femadh.discretisation import plan_grid
     from femadh.elastic import GreenOperator
     from femadh.scene import build_problem
@@ -275,12 +275,18 @@ def corner_approach():
         fallbacks.append((d, starts[-1], descent))
         return real_relaxed(problem, d, st, descent, **kw)
     dtype = linalg.PRECONDITIONER_DTYPE
+    # (and every Newton step's GMRES to GMRES_RTOL: with the first step at a set solved to
+    # complementarity.GMRES_RTOL_NEW_SET the polish from this landing's descent converges
+    # and no fallback is needed - the case is one corrector path's)
+    first_step = complementarity.GMRES_RTOL_NEW_SET
     try:
         stepping.land, landing._relaxed = land_spy, relaxed_spy
         linalg.PRECONDITIONER_DTYPE = np.float64
+        complementarity.GMRES_RTOL_NEW_SET = complementarity.GMRES_RTOL
         sweep = trace(p, CORNER_D_VALUES, branch="approach", tol=scene.tolerance,
                       max_iter=scene.max_iter)
     finally:
         stepping.land, landing._relaxed = real_land, real_relaxed
         linalg.PRECONDITIONER_DTYPE = dtype
+        complementarity.GMRES_RTOL_NEW_SET = first_step
     return scene, p, sweep, fallbacks

@@ -109,7 +109,7 @@ def test_killed_study_loses_no_completed_point(tmp_path):
     out = tmp_path / "study"
     cmd = [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary",
            "effects.asperity_gap.sigma=0.8 nm..2 nm:6", "--out", str(out), "--workers", "1",
-           "--quiet"]
+           "--quiet", "--no-estimate"]
     p = subprocess.Popen(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE)
     t0 = time.time()
@@ -216,8 +216,9 @@ def study_scene(tmp_path_factory):
 
 
 def _cmd(scene, out, *extra):
+    # (no error estimates: what is kept and redone is the point, not its accuracy)
     return [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary", SIGMAS,
-            "--out", str(out), "--quiet", *extra]
+            "--out", str(out), "--quiet", "--no-estimate", *extra]
 
 
 def _table(out):
@@ -312,7 +313,7 @@ def test_unfinished_records_are_redone_and_failed_points_exit_3(tmp_path, capsys
     out = tmp_path / "st"
     # sigma = 0.4 nm on 60 nodes is lattice trapping (a physical failure, final); 1 nm runs
     args = ["study", "sweep", str(scene), "--vary", "effects.asperity_gap.sigma=0.4 nm,1 nm",
-            "--out", str(out), "--workers", "1"]
+            "--out", str(out), "--workers", "1", "--no-estimate"]
     assert main(args) == 3
     cap = capsys.readouterr()
     assert "1 of 2 points failed:" in cap.err and "1 point (0): " in cap.err
@@ -329,7 +330,7 @@ def test_unfinished_records_are_redone_and_failed_points_exit_3(tmp_path, capsys
     allbad = tmp_path / "bad"
     assert main(["study", "sweep", str(scene), "--vary",
                  "effects.asperity_gap.sigma=0.3 nm,0.4 nm", "--out", str(allbad),
-                 "--workers", "1"]) == 3
+                 "--workers", "1", "--no-estimate"]) == 3
     err = capsys.readouterr().err
     assert "2 of 2 points failed" in err and "no figure: every point failed" in err
     assert len([ln for ln in err.splitlines() if ln.startswith("femadh: error:   ")]) == 1
@@ -390,3 +391,44 @@ def test_points_differing_in_the_modulus_do_not_share_an_operator(tmp_path):
     assert [r["operator_reused"] for r in recs] == [False, False, False]
     assert recs[2]["F_ex_deepest_N"] == recs[0]["F_ex_deepest_N"]
     assert recs[1]["F_ex_deepest_N"] != pytest.approx(recs[0]["F_ex_deepest_N"], rel=1e-2, abs=0)
+
+
+def test_points_without_estimates_are_not_reused_by_a_study_that_asks_for_them(tmp_path,
+                                                                              capsys):
+    """--no-estimate: each point's record says what its run estimated ("peak": the peak
+    located, no error estimates; study.json says it of the run). A later study with
+    estimates runs such a point again (never reuses it as if estimated) and says so; a
+    study without estimates reuses a point that has them (its errors are real). A record of
+    an earlier femadh (no "estimate") is taken for what it shows."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(study_text())
+    out = tmp_path / "st"
+    args = ["study", "sweep", str(scene), "--vary", "effects.asperity_gap.sigma=1 nm",
+            "--out", str(out), "--workers", "1"]
+    rec_file = out / "points" / study_points(femadh.load_scene(scene), {
+        "effects.asperity_gap.sigma": "1 nm"})[0].id / "record.json"
+    assert main(args + ["--no-estimate"]) == 0
+    assert "reused 0, redone 0, new 1" in capsys.readouterr().out
+    rec = json.loads(rec_file.read_text())
+    assert rec["estimate"] == "peak" and not [k for k in rec if k.endswith("_error")]
+    assert json.loads((out / "study.json").read_text())["estimate"] == "peak"
+    assert "max_adhesion_N_error" not in _table(out)[0]
+    assert main(args) == 0
+    cap = capsys.readouterr()
+    assert "reused 0, redone 1, new 0" in cap.out
+    assert "1 finished point computed without error estimates (--no-estimate) run again" \
+        in cap.err
+    rec = json.loads(rec_file.read_text())
+    assert rec["estimate"] == "errors" and rec["max_adhesion_N_error"] > 0
+    assert "max_adhesion_N_error" in _table(out)[0]
+    # the other way round, from an earlier femadh's record: with an estimated error it
+    # serves a study that asks for no estimate
+    rec_file.write_text(json.dumps({k: v for k, v in rec.items() if k != "estimate"}))
+    assert main(args + ["--no-estimate"]) == 0
+    cap = capsys.readouterr()
+    assert "reused 1, redone 0, new 0" in cap.out and "run again" not in cap.err
+    # without one it is not taken for estimated
+    rec_file.write_text(json.dumps({k: v for k, v in rec.items()
+                                    if k != "estimate" and not k.endswith("_error")}))
+    assert main(args) == 0
+    assert "reused 0, redone 1, new 0" in capsys.readouterr().out

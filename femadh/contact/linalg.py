@@ -204,24 +204,30 @@ class TrailingCholesky:
     def _factor_block(self, k):
         """The leading k x k block of U, contiguous (one copy per block size)."""
         if self._block[0] != k:
+            from scipy.linalg import blas
+
             kept = self.kept
             blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])
-            self._block = (k, blk)
+            self._block = (k, blk, blas.strsv if blk.dtype == np.float32 else blas.dtrsv)
         return self._block[1]
 
     def solve(self, m, rhs):
         """x with H[m:, m:] x = rhs (natural node order m..n-1): U^T U x' = rhs' in reversed
         order (x' = x reversed), two triangular solves."""
-        from scipy.linalg import blas
-
         k = self.n - m
-        if k <= 0:
-            return np.zeros(0)
-        if not self.covers(m):
-            raise ValueError(f"trailing block from node {m} is not covered (m0 = {self.m0}, "
-                             f"positive definite leading size {self.k_valid})")
-        u = self._factor_block(k)
-        trsv = blas.strsv if u.dtype == np.float32 else blas.dtrsv
+        blk = self._block
+        if blk[0] != k or k <= 0:
+            # a new block size: checked once (a block is cut only from a factor that covers
+            # it, and what a factor covers never changes once its block is cut: the
+            # corrector's iterations and GMRES products then skip the checks)
+            if k <= 0:
+                return np.zeros(0)
+            if not self.covers(m):
+                raise ValueError(f"trailing block from node {m} is not covered (m0 = "
+                                 f"{self.m0}, positive definite leading size {self.k_valid})")
+            self._factor_block(k)
+            blk = self._block
+        u, trsv = blk[1], blk[2]
         # (a double vector would be converted by the wrapper anyway; reversed, contiguous)
         r = np.array(rhs[::-1], dtype=u.dtype)
         y = trsv(u, r, trans=1, overwrite_x=1)          # U^T y = r
@@ -258,8 +264,11 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
     V = np.empty((maxiter + 1, n))
     Z = np.empty((maxiter, n))
     R = np.zeros((maxiter + 1, maxiter))
-    cs, sn = np.zeros(maxiter), np.zeros(maxiter)
-    g = np.zeros(maxiter + 1)
+    # the rotations and the rotated right-hand side as Python floats: the same IEEE double
+    # arithmetic as numpy scalars, bit for bit, without their per-operation overhead (the
+    # loop's own Python was a third of a Krylov iteration at ~400 free nodes)
+    cs, sn = [0.0] * maxiter, [0.0] * maxiter
+    g = [0.0] * (maxiter + 1)
     g[0] = beta
     V[0] = b / beta
     j = 0
@@ -267,11 +276,13 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
         Z[j] = apply_m(V[j])
         w = apply_a(Z[j])
         # classical Gram-Schmidt, twice (as stable as modified, in two BLAS calls each)
-        h = V[:j + 1] @ w
-        w = w - h @ V[:j + 1]
-        h2 = V[:j + 1] @ w
-        w = w - h2 @ V[:j + 1]
-        col = np.append(h + h2, np.linalg.norm(w))
+        Vj = V[:j + 1]
+        h = Vj @ w
+        w = w - h @ Vj
+        h2 = Vj @ w
+        w = w - h2 @ Vj
+        col = (h + h2).tolist()
+        col.append(math.sqrt(w @ w))        # np.linalg.norm's own sqrt(w . w)
         for i in range(j):      # the earlier rotations on the new column
             a, c = col[i], col[i + 1]
             col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c
@@ -279,14 +290,14 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
         cs[j], sn[j] = (1.0, 0.0) if r == 0 else (col[j] / r, col[j + 1] / r)
         breakdown = col[j + 1] <= 1e-14 * beta
         V[j + 1] = w / col[j + 1] if not breakdown else 0.0
-        col[j], col[j + 1] = r, 0.0
+        col[j] = r
         R[:j + 1, j] = col[:j + 1]
         g[j + 1] = -sn[j] * g[j]
         g[j] = cs[j] * g[j]
         if abs(g[j + 1]) <= rtol * beta or breakdown:
             break
     k = j + 1
-    y = _back_substitute(R[:k, :k], g[:k])
+    y = _back_substitute(R[:k, :k], np.array(g[:k]))
     return y @ Z[:k], k, bool(abs(g[k]) <= rtol * beta)
 
 

@@ -4,9 +4,11 @@ Drawing them costs a run about as much as a small solve: importing matplotlib (~
 one core) and rendering (~0.2 s for ``force_curve.png``, ~0.5 s for the paper's panels,
 validation/results/benchmark.md). The ``femadh`` program (``femadh run``, in a process of
 its own; not :func:`femadh.cli.main` called from a script) therefore forks a **figure
-worker** before it solves (:func:`figure_worker`; Linux, two cores or more): the worker imports matplotlib and
-warms its fonts on the other core while the run solves, then draws the figures of the
-result handed to it (pickled over a pipe), each in a process of its own, side by side. The
+worker** before it solves (:func:`figure_worker`; Linux, two cores or more): the worker
+imports matplotlib, warms its fonts and lays out the six-panel figure
+(:func:`femadh.io.plots.prepare`) on the other core while the run solves, then draws the
+figures of the result handed to it (pickled over a pipe), each in a process of its own,
+side by side. The
 run waits for them: ``femadh run`` never returns before its figures are on disk, exactly as
 when it draws them itself.
 
@@ -218,6 +220,7 @@ def _serve(job_r, ans_w):
     from ..io import plots
 
     plots.warm_up()
+    plots.prepare()         # (the six panels' axes and ticks: ~0.1 s less for the run to wait)
     try:
         res, folder = _recv(job_r)
     except EOFError:

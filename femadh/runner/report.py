@@ -1,15 +1,11 @@
 """The lines a run prints: per branch its states and largest adhesion, the headline numbers
 with their estimated errors, the jumps. Forces in the unit that fits their size."""
-import numpy as np
 
 
 def _force(x, err=None):
-    from ..io.plots import force_unit
+    from ..io.plots import force_text     # (one formatting for the terminal and the figures)
 
-    s, unit = force_unit([x])
-    if err is not None and np.isfinite(err):
-        return f"{x * s:.5g} ± {err * s:.1g} {unit}"
-    return f"{x * s:.5g} {unit}"
+    return force_text(x, err)
 
 
 def _nm(x):

@@ -86,6 +86,12 @@ def worker_operator(sc):
     return OPERATOR_CACHE[key], False
 
 
+#: what a point's run estimated, as its record says it (``estimate`` of femadh.run): the
+#: error estimates of the headline numbers ("errors"), only the located peak ("peak", the
+#: command line's --no-estimate), neither ("none"); in increasing order of what it holds
+ESTIMATE_NAMES = {True: "errors", "peak": "peak", False: "none"}
+
+
 def finished(rec):
     """Whether a point's record is final: converged, or failed for a physical reason."""
     if "finished" in rec:
@@ -118,7 +124,7 @@ def run_point(point, root, estimate=True):
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
            "status": "running", "finished": False, "error": None, "operator_reused": False,
-           "pid": os.getpid()}
+           "estimate": ESTIMATE_NAMES[estimate], "pid": os.getpid()}
     write_record(folder, rec)       # a dead worker's point is known by this record's pid
     signum = None
     try:
@@ -192,9 +198,15 @@ def _pool_init():
     """Set-up of a local pool worker: a Ctrl-C in the terminal reaches every process of the
     group; an idle worker ignores it (the driver stops it with SIGTERM, without a
     KeyboardInterrupt traceback), while a run in progress takes it at its next safe point
-    (the run installs its own handlers and restores this one)."""
+    (the run installs its own handlers and restores this one: a handler that does nothing,
+    not SIG_IGN, which a run leaves in place as its parent's wish)."""
     _worker_init()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:   # (a nohup'ed study's stays)
+        signal.signal(signal.SIGINT, _idle_sigint)
+
+
+def _idle_sigint(signum, frame):
+    """An idle pool worker's SIGINT: nothing (the driver decides, see :func:`_pool_init`)."""
 
 
 _MALLOC_TUNED = False
@@ -242,7 +254,9 @@ def driver_signals():
             raise Interrupted(flag[0])
         flag.append(signum)
 
-    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    # (a signal the parent set to SIG_IGN stays ignored, as in femadh.interrupt)
+    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)
+           if signal.getsignal(s) is not signal.SIG_IGN}
     try:
         yield flag
     finally:

@@ -34,7 +34,7 @@ from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
 from ..io.progress import StudyProgress
 from ..io.study_table import study_figure, write_table
-from .executors import (HEADLINE, OPERATOR_CACHE, _jsonable,  # noqa: F401
+from .executors import (ESTIMATE_NAMES, HEADLINE, OPERATOR_CACHE, _jsonable,  # noqa: F401
                         tune_malloc, _worker_init, driver_signals, execute, finished,
                         run_point, write_record)
 from ..scene.values import mask_numbers, parse_values  # noqa: F401  (public here since 1.0)
@@ -128,6 +128,27 @@ def _indices(idx):
     return ", ".join(out)
 
 
+#: the estimate modes in increasing order of what a point's record holds
+_ORDER = ("none", "peak", "errors")
+
+
+def point_estimate(rec):
+    """What a finished point's run estimated: its record's ``estimate`` ("errors", "peak" or
+    "none", :data:`~femadh.studies.executors.ESTIMATE_NAMES`). A record of an earlier femadh
+    (no such field) counts as "errors" when it holds an estimated error, else as "none": not
+    knowing, it is never taken for more than it shows."""
+    if rec.get("estimate") in _ORDER:
+        return rec["estimate"]
+    return "errors" if any(k.endswith("_error") for k in rec) else "none"
+
+
+def serves(rec, estimate):
+    """Whether a finished point's record serves a study run with ``estimate`` (True, "peak",
+    False): it estimated at least as much (a point with error estimates serves a run that
+    asks for none, its errors then shown in the table as computed; never the other way)."""
+    return _ORDER.index(point_estimate(rec)) >= _ORDER.index(ESTIMATE_NAMES[estimate])
+
+
 def _label(changes):
     return ", ".join(f"{k} = {v}" for k, v in changes.items())
 
@@ -151,6 +172,10 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         workers.
     progress : bool, optional
         A bar with the points done / failed / reused (the CLI: only in a terminal).
+    estimate : bool or "peak"
+        What each point's run estimates (``femadh.run``'s ``estimate``; "peak" is the command
+        line's --no-estimate). Each point's record says it; a finished point is reused only
+        when it estimated at least as much (:func:`serves`), else it is run again.
 
     Returns
     -------
@@ -175,12 +200,21 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         old = _load_records(out)
         ids = {p.id for p in points}
         done = {k: r for k, r in old.items() if finished(r) and k in ids}
+        # a point finished without the estimates this run asks for is run again with them
+        short = {k for k, r in done.items() if not serves(r, estimate)}
+        done = {k: r for k, r in done.items() if k not in short}
         todo = [p for p in points if p.id not in done]
         result = StudyRun(points, dict(done), reused=len(done),
                           redone=sum(p.id in old for p in todo),
                           new=sum(p.id not in old for p in todo))
+        if short:
+            what = ("without error estimates (--no-estimate) run again with them"
+                    if estimate is True else "without their peak located run again with it")
+            result.notes.append(f"{len(short)} finished point{'s' * (len(short) > 1)} "
+                                f"computed {what}")
         write_atomic(out / "study.json", json.dumps(
             {"scene_file": scene.path, "scene": scene.name, "vary": vary, "zip": zip_,
+             "estimate": ESTIMATE_NAMES[estimate],
              "points": [{"index": p.index, "id": p.id, "changes": p.changes}
                         for p in points]}, indent=1, default=_jsonable) + "\n")
         bar = StudyProgress(len(points), result.reused, scene.name) if progress else None

@@ -1,0 +1,165 @@
+"""A Ctrl-C at any moment of ``femadh run`` is one line and exit 130; a SIGINT its parent set
+to be ignored stays ignored.
+
+The program's start (importing femadh, parsing, the scene's checks, the lazy import of scipy)
+comes before a run's own handlers (femadh.interrupt) are in place; a SIGINT there used to end
+in a KeyboardInterrupt traceback of the import machinery (~40-100 lines). These tests send a
+real SIGINT to a real ``python -m femadh run`` at chosen moments: deterministically, when a
+given module starts to be imported (an audit hook in the child), and after a few delays from
+femadh's first import (the child says when femadh starts; Python's own start-up before that,
+its site module, is no code of femadh's and is not tested: measured ~15-30 ms here).
+"""
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import fig3_uniform_text
+from femadh import interrupt
+from femadh.errors import Interrupted
+
+ROOT = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+
+#: the child: ``python -m femadh`` (runpy, as the program runs), or with FEMADH_TEST_SCRIPT
+#: what the ``femadh`` script pip writes does (``from femadh.cli import main``: no __main__
+#: module), with an audit hook that sends this process SIGINT when the module named in
+#: FEMADH_TEST_SIGINT_AT starts to be imported, or writes one byte to the fd in
+#: FEMADH_TEST_READY_FD when femadh.cli starts to be imported
+CHILD = r"""
+import os, signal, sys
+at, ready = os.environ.get("FEMADH_TEST_SIGINT_AT"), os.environ.get("FEMADH_TEST_READY_FD")
+fired = []
+def hook(event, args):
+    if event != "import" or fired:
+        return
+    if args[0] == at:
+        fired.append(1)
+        os.kill(os.getpid(), signal.SIGINT)
+    elif ready and args[0] == "femadh.cli":
+        fired.append(1)
+        os.write(int(ready), b"!")
+sys.addaudithook(hook)
+if os.environ.get("FEMADH_TEST_SCRIPT"):
+    sys.argv[0] = os.path.join(os.path.dirname(sys.executable), "femadh")
+    from femadh.cli import main
+    sys.exit(main())
+import runpy
+runpy.run_module("femadh", run_name="__main__", alter_sys=True)
+"""
+
+
+def _scene(tmp_path, step="0.5 nm"):
+    """The Fig 3 scene on 60 uniform nodes (the tests need a run, not accuracy): in 0.5-nm
+    steps a process of ~0.5 s, in the file's 0.2-nm steps ~0.65 s (its run ~0.1 s)."""
+    p = tmp_path / "s.toml"
+    p.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60").replace(
+        'step = "0.2 nm"', f'step = "{step}"'))
+    return p
+
+
+def _run_args(scene, out):
+    return ["run", str(scene), "--out", str(out), "--no-figures", "--no-estimate"]
+
+
+def _one_line(err):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("femadh: error: interrupted by SIGINT"), err
+    assert "Traceback" not in err
+    return lines[0]
+
+
+# the moments: femadh.cli being imported (before its handler: python -m femadh's __main__
+# takes it), argparse (cli's first import after its handler: the script has no __main__ to
+# take it), shutil (argparse's, while the parser is built), femadh.scene (the scene is
+# read), scipy (the runner's lazy import: the reviewer's case)
+@pytest.mark.parametrize("launcher, module", [
+    ("-m", "femadh.cli"), ("script", "argparse"), ("script", "shutil"), ("-m", "shutil"),
+    ("-m", "femadh.scene"), ("-m", "scipy")])
+def test_sigint_while_starting_is_one_line_and_exit_130(tmp_path, launcher, module):
+    out = tmp_path / "out"
+    env = dict(ENV, FEMADH_TEST_SIGINT_AT=module)
+    if launcher == "script":
+        env["FEMADH_TEST_SCRIPT"] = "1"
+    p = subprocess.run([sys.executable, "-c", CHILD, *_run_args(_scene(tmp_path), out)],
+                       cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 130, p.stderr
+    _one_line(p.stderr)
+    assert p.stdout == ""
+    assert not out.exists()           # nothing was written: nothing to lose or to clean
+
+
+def test_sigint_after_a_few_delays_is_one_line_and_exit_130(tmp_path):
+    """SIGINT to the process group (as a terminal's Ctrl-C) 0, 0.1, 0.3 and 0.55 s after
+    femadh began to import: its start, the scene's checks, scipy's import, the run (on a
+    quiet machine; on a loaded one the same moments fall earlier in the run's life)."""
+    scene = _scene(tmp_path, step="0.2 nm")
+    for i, delay in enumerate((0.0, 0.1, 0.3, 0.55)):
+        out = tmp_path / f"out{i}"
+        r, w = os.pipe()
+        p = subprocess.Popen([sys.executable, "-c", CHILD, *_run_args(scene, out)], cwd=ROOT,
+                             env=dict(ENV, FEMADH_TEST_READY_FD=str(w)), pass_fds=(w,),
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             start_new_session=True)
+        os.close(w)
+        try:
+            assert os.read(r, 1) == b"!"
+        finally:
+            os.close(r)
+        time.sleep(delay)
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+        if p.returncode == 0:
+            continue                  # (a loaded machine: the run had ended: nothing to test)
+        assert p.returncode == 130, (delay, err)
+        line = _one_line(err)
+        # a run stopped under way says what it kept and how to continue; before it, nothing
+        assert ("--resume" in line) == out.exists(), (delay, line)
+
+
+def test_an_ignored_sigint_stays_ignored_by_a_run(tmp_path):
+    """A run started with SIGINT ignored (nohup, a background job) runs to its end through
+    SIGINTs sent every 20 ms: femadh's handlers leave SIG_IGN in place."""
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "femadh", *_run_args(_scene(tmp_path), out)],
+                         cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    sent, t0 = 0, time.time()
+    while p.poll() is None and time.time() - t0 < 120:
+        p.send_signal(signal.SIGINT)
+        sent += 1
+        time.sleep(0.02)
+    _, err = p.communicate(timeout=120)
+    assert sent >= 5                  # (the run takes ~0.5 s or more: signals it ignored)
+    assert p.returncode == 0, err
+    assert '"status": "converged"' in (out / "summary.json").read_text()
+
+
+def test_interruptible_leaves_an_ignored_sigint_alone():
+    """In-process: inside interruptible() an ignored SIGINT stays SIG_IGN (no flag, no stop)
+    while SIGTERM still stops the run at its next check; both are as before afterwards."""
+    old_int = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    old_term = signal.getsignal(signal.SIGTERM)
+    try:
+        with interrupt.interruptible():
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+            interrupt.check()             # no Interrupted: the signal was ignored
+            assert interrupt.pending() is None
+            assert signal.getsignal(signal.SIGTERM) is not old_term
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.01)
+            with pytest.raises(Interrupted):
+                interrupt.check()
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        assert signal.getsignal(signal.SIGTERM) is old_term
+    finally:
+        signal.signal(signal.SIGINT, old_int)
+        signal.signal(signal.SIGTERM, old_term)

@@ -1,0 +1,89 @@
+"""The figures say what the terminal says: the force curve's inset states the max adhesion
+with the very digits, unit and error of the terminal's line, and every figure calls the force
+it shows the force on the sphere (no "slider" in one figure and "sphere" in another)."""
+import matplotlib
+import numpy as np
+import pytest
+
+import femadh
+from conftest import fig3_uniform_text
+from femadh.io import plots
+from femadh.io.plots import force_text
+from femadh.runner.report import headline_lines
+
+
+def test_force_text_picks_the_unit_of_the_force_and_one_digit_of_its_error():
+    assert force_text(3.1152e-5, 2.56e-8) == "31.152 ± 0.03 µN"
+    # (the unit is the force's own, not the error's: 2.6e-8 N would be nN alone)
+    assert force_text(1.6029e-3, 4.4e-7) == "1.6029 ± 0.0004 mN"
+    assert force_text(1.5e-3) == "1.5 mN" == force_text(1.5e-3, float("nan"))
+    assert force_text(-2.5e-10, 1e-12) == "-250 ± 1 pN"
+
+
+@pytest.fixture(scope="module")
+def fig3_small(tmp_path_factory):
+    """The Fig 3 scene on 60 uniform nodes in 0.5-nm steps, with its error estimates (the
+    inset's ±), and the text of each figure it draws: {figure: [every text on it]}."""
+    path = tmp_path_factory.mktemp("fig3") / "s.toml"
+    path.write_text(fig3_uniform_text().replace("nodes = 200", "nodes = 60").replace(
+        'step = "0.2 nm"', 'step = "0.5 nm"'))
+    res = femadh.run(femadh.load_scene(path), progress=False)
+    texts = {}
+    real = plots._save
+
+    def keep_text(fig, p, dpi=100):
+        texts[p.name] = [t.get_text() for t in fig.findobj(matplotlib.text.Text)]
+        real(fig, p, dpi)
+    plots._save = keep_text
+    try:
+        plots.contact_figures(res, tmp_path_factory.mktemp("figures"))
+    finally:
+        plots._save = real
+    return res, texts
+
+
+def test_the_inset_states_the_terminal_s_max_adhesion(fig3_small):
+    res, texts = fig3_small
+    assert np.isfinite(res.headline["max_adhesion_N_error"])
+    line = next(ln for ln in headline_lines(res) if ln.startswith("max adhesion "))
+    inset = [t for t in texts["force_curve.png"] if t.startswith("max adhesion ")]
+    # the terminal's line goes on with the DMT and JKR values: the inset is its beginning
+    assert len(inset) == 1 and "±" in inset[0] and line.startswith(inset[0] + " ("), (
+        inset, line)
+
+
+def test_every_figure_calls_the_force_the_force_on_the_sphere(fig3_small):
+    _, texts = fig3_small
+    assert set(texts) == {"force_curve.png", "profiles_and_forces.png"}
+    for name, words in texts.items():
+        assert not [t for t in words if "slider" in t], name
+        assert [t for t in words if "force on the sphere" in t], name
+    # panels (d) and (e) both: the force axis of each
+    assert len([t for t in texts["profiles_and_forces.png"]
+                if "force on the sphere" in t]) == 2
+
+
+def test_a_prepared_six_panel_figure_is_the_same_picture(fig3_small, tmp_path, monkeypatch):
+    """The figure worker lays the six panels out before the result arrives
+    (plots.prepare): the PNG is the same, byte for byte, as one drawn from nothing, and
+    the draw then makes none of the ~120 Tick objects of its 12 axes (measured: 121 made
+    from nothing on this run; validation/figure_pace.py times both)."""
+    import matplotlib.axis as maxis
+
+    res, _ = fig3_small
+    made, real = [0], maxis.Tick.__init__
+
+    def count(self, *a, **k):
+        made[0] += 1
+        real(self, *a, **k)
+    monkeypatch.setattr(maxis.Tick, "__init__", count)
+    plots.paper1_panels(res, tmp_path / "new.png")
+    from_nothing, made[0] = made[0], 0
+    plots.prepare()
+    # (prepare makes 12 a major axis, and a first minor tick: 156; a draw from nothing
+    # makes what its axes show: 121 on this run)
+    assert made[0] >= from_nothing >= 60
+    made[0] = 0
+    plots.paper1_panels(res, tmp_path / "prepared.png")
+    assert made[0] == 0
+    assert (tmp_path / "prepared.png").read_bytes() == (tmp_path / "new.png").read_bytes()
