@@ -357,7 +357,7 @@ def cohesive_edge(problem):
     no step acts at the edge the tips are the lattice's faithful states: the Fig 4 scene's
     uniform N = 200, 400, 800 lie +2.17e-3, +5.0e-4, +9.1e-5 above the same branch's limit
     on their disk (1.0921001e-4 N; orders 2.1 and 2.5) while its teeth at the peak are
-    2.5e-3 to 3.8e-3 of the force."""
+    9.5e-4 to 3.8e-3 of the force (accuracy.md's Fig 4 rows)."""
     from ..laws.step import SmoothStepLaw
 
     if problem.sigma is None:
