@@ -1775,6 +1775,38 @@ DEFECTS = [
       "femadh/runner/edge_route.py",
       (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
         '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
+    # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
+    D("lattice_part_off", "estimate: no lattice part where a step's cohesive zone acts at "
+      "the contact edge", "femadh/runner/estimates.py",
+      (("LATTICE_PART = True", "LATTICE_PART = False"),)),
+    D("lattice_tooth_max", "lattice part: the peak's fall to the highest sample, not the "
+      "lowest", "femadh/runner/peak.py",
+      (("    return float(max(f_peak - smooth(d_peak) - min(samples), 0.0)) if samples else 0.0",
+        "    return float(max(f_peak - smooth(d_peak) - max(samples), 0.0)) if samples else 0.0"),)),
+    D("lattice_period_quarter", "lattice part: the release period quartered (the window misses the "
+      "tooth's trough)", "femadh/runner/peak.py",
+      (("    return abs(nxt.d - prev.d) / dn if dn else None",
+        "    return abs(nxt.d - prev.d) / (4 * dn) if dn else None"),)),
+    D("cohesive_edge_any_step", "lattice part taken wherever a sub-grid step is reachable",
+      "femadh/runner/estimates.py",
+      (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
+        "    return secant > 0"),)),
+    D("cohesive_edge_scaled", "lattice part only where the step's secant exceeds 4x LJ's",
+      "femadh/runner/estimates.py",
+      (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
+        "    return secant > 0 and secant > 4 * problem.surface_force_stiffness()[2]"),)),
+    D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
+      "femadh/runner/estimates.py",
+      (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
+        "    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 2 - 0.5)"),)),
+    D("uniform_sqrt2_nominal_ratio", "uniform sqrt2 members: Richardson at sqrt 2, not their "
+      "spacings' ratio", "femadh/runner/estimates.py",
+      (("        return (n - 0.5) / (n1 - 0.5), out, (n1 - 0.5) / (n2 - 0.5)",
+        "        return 2**0.5, out, (n1 - 0.5) / (n2 - 0.5)"),)),
+    D("uniform_ratio2_dropped", "uniform sqrt2 members: the estimate ignores the second ratio",
+      "femadh/runner/estimates.py",
+      (("                                   ratio=ratio, ratio2=ratio2).items():",
+        "                                   ratio=ratio).items():"),)),
     # -- the corrector made cheaper (branch corrector): releases carry h, P, K w; the first
     #    step at a set solved to GMRES_RTOL_NEW_SET; GMRES's rotations in Python floats; the
     #    preconditioner's block size checked once

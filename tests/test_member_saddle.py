@@ -56,7 +56,7 @@ def case():
     sc = _scene()
     _, sink = _traced(sc)
     fine = build_problem(sc)
-    _, mem = estimates.coarser_members(sc, fine)
+    _, mem, _ = estimates.coarser_members(sc, fine)
     label, member = mem[0]
     assert label == "spacing 19.06 nm"
     return sc, fine, sink, member

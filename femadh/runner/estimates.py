@@ -45,7 +45,7 @@ from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # fresh states between grid states and the peak search: their own home (members and the
 # instrument use them too)
-from .peak import peak_adhesion
+from .peak import lattice_tooth, peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
@@ -112,7 +112,10 @@ def refine_peak(scene, res, problem, sink):
     if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
         return 0.0
     branch, f_grid, prev, best, nxt = sink.peak
-    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)
+    fresh = []
+    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,
+                               record=fresh)
+    sink.peak_fresh = fresh          # (the estimate's lattice part samples around the peak)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
@@ -198,6 +201,17 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
+    # the lattice: where a sub-grid step's cohesive zone acts at the contact edge, the peak
+    # search reads a tooth's tip of the sawtooth the edge's node releases make, which the
+    # members cannot see (femadh.runner.peak.lattice_tooth)
+    peak_problem = getattr(sink, "peak_problem", problem)
+    if LATTICE_PART and "max_adhesion_N" in hl and getattr(sink, "peak_fresh", None) \
+            is not None and cohesive_edge(peak_problem):
+        _, _, prev, best, nxt = sink.peak
+        tooth = lattice_tooth(peak_problem, prev, best, nxt, scene, hl["max_adhesion_N"],
+                              hl["d_at_max_adhesion_m"], sink.peak_fresh)
+        if tooth > 0:
+            parts.setdefault("max_adhesion_N", {})["lattice"] = tooth
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
     # a layered body has none: its mesh part is the difference to the next coarser mesh,
     # Richardson with the P2 body's observed order 3 - validation/results/layered_fe.md)
@@ -232,7 +246,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
                                 f"({_short(g.error)}); the FE mesh part of the error is not "
                                 "estimated: the stated errors lack it")
     levels = []
-    ratio, members = coarser_members(scene, problem, green)
+    ratio, members, ratio2 = coarser_members(scene, problem, green)
     # the forces at the deepest separation: members placed by its contact edge (the same
     # fraction of a spacing as the fine grid's), where they can be; the family's reduced
     # members then skip that state (its grid part would be replaced)
@@ -261,12 +275,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         levels.append(dict(r.headline))
     res.grid["member_solves"] = solved
     res.grid["member_ratio"] = ratio
+    if ratio2 is not None:
+        res.grid["member_ratio2"] = ratio2
     res.grid["members"] = [lb for lb, _ in members][:len(levels)]
     if scene.grid is not None:
         res.grid["member_spacings_m"] = [m.grid["spacing"] for _, m in members][:len(levels)]
     if levels:
         for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
-                                   ratio=ratio).items():
+                                   ratio=ratio, ratio2=ratio2).items():
             parts.setdefault(k, {})["grid"] = v
     if locked is not None and levels:
         (h1, h2), (lv1, lv2) = locked
@@ -313,6 +329,45 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     # search, which locates the headline's largest adhesion itself
     res.timings["error_estimate_s"] = time.perf_counter() - t0
     return parts
+
+
+#: the largest adhesion gets a lattice part (:func:`femadh.runner.peak.lattice_tooth`) where
+#: a sub-grid step's cohesive zone acts at the contact edge (:func:`cohesive_edge`). False:
+#: no such part (as before)
+LATTICE_PART = True
+
+
+def cohesive_edge(problem):
+    """True where a sub-grid step law (the capillary condensate, :mod:`femadh.contact.subgrid`)
+    has its edge just above the sigma floor and softens, by its secant across that edge
+    (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`: a Dugdale cohesive zone at the
+    contact edge), more than every collocated law does at its steepest
+    (:meth:`~femadh.contact.problem.ContactProblem.surface_force_stiffness`).
+
+    There the sawtooth of the contact edge's node releases that the peak search reads
+    (femadh.runner.peak.lattice_tooth) puts its tips above the smooth trend by about a tooth
+    at every spacing. Measured on the stiction map's sigma = 0.489 nm, p/psat 0.15 point
+    (secant 9.8e17 Pa/m against LJ's 2.77e17), against the sigma-edge branch's order-2
+    family (1.564850e-4 N, 6.3e-5; validation/results/sigma_edge.md): the static 5.885-um
+    band's largest adhesion at 13.48, 8.09, 5.72 and 4.04 nm lies +6.04e-3, +3.01e-3,
+    +2.01e-3 and +1.42e-3 above it (the 8.09- and 5.72-nm values the 4.04-nm run's reduced
+    members), each of the finer three ~6-8e-4 above the edge family's own h^2 errors (the
+    members' differences see only those); the estimate said 8.6e-4 of the force and the run
+    was converged at 1e-3 (effectivity 0.61); the tooth there 8.2e-4 (with it 1.19). Where
+    no step acts at the edge the tips are the lattice's faithful states: the Fig 4 scene's
+    uniform N = 200, 400, 800 lie +2.17e-3, +5.0e-4, +9.1e-5 above the same branch's limit
+    on their disk (1.0921001e-4 N; orders 2.1 and 2.5) while its teeth at the peak are
+    9.5e-4 to 3.8e-3 of the force (accuracy.md's Fig 4 rows)."""
+    from ..laws.step import SmoothStepLaw
+
+    if problem.sigma is None:
+        return False
+    steps = [law for law in problem.effects.values()
+             if isinstance(law, SmoothStepLaw) and getattr(law, "SUBGRID", False)]
+    if not steps:
+        return False
+    secant = max(law.edge_softening(problem.sigma) for law in steps)
+    return secant > 0 and secant > problem.surface_force_stiffness()[2]
 
 
 def fe_against_green(fe, green):
@@ -401,19 +456,52 @@ def guard_bounds(res, problem):
             "accuracy)")
 
 
-def coarser_members(scene, problem, green=None):
-    """(ratio r, [(label, scene)]) of the two coarser members of the scene's grid family.
+#: a uniform grid whose N/4 member would soften beyond the plan's TRAP_SAFE (its softening
+#: ratio 4x the run's own) takes members at N/sqrt2 and N/2 instead of N/2 and N/4
+#: (:func:`uniform_member_nodes`). False: N/2 and N/4 always (as before)
+UNIFORM_SQRT2_MEMBERS = True
 
-    Uniform grids: N/2 and N/4 (r = 2). Banded grids: spacings r h and r^2 h of the same
-    family (same band, grading and radius), r = sqrt 2
+
+def uniform_member_nodes(problem, n):
+    """(N1, N2) of a uniform grid's two coarser members: N/2 and N/4, or round(N/sqrt2) and
+    N/2 where the N/4 member would soften beyond TRAP_SAFE.
+
+    A member's trapping ratio (:func:`femadh.discretisation.plan.trapping_ratio`) grows like
+    its spacing, a / (N - 1/2): the Fig 4 scene's N = 200 run (0.24) has its N = 100 and
+    N = 50 members at 0.48 and 0.96 of a node's own stiffness; they land micro-jump after
+    micro-jump and made the largest adhesion's grid part 3.2x its error and the pull-off's 6
+    lattice steps (validation/results/effectivity.md, sec 3-4). The plan keeps a banded
+    family's coarsest member below TRAP_SAFE (:func:`~femadh.discretisation.plan.safe_spacing`);
+    an explicit N gets the finer pair where its N/4 would not be."""
+    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
+
+    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5) if n // 4 >= 1 else math.inf
+    if UNIFORM_SQRT2_MEMBERS and quarter > TRAP_SAFE:
+        return int(round(n / 2**0.5)), n // 2
+    return n // 2, n // 4
+
+
+def coarser_members(scene, problem, green=None):
+    """(ratio r, [(label, scene)], ratio2) of the two coarser members of the scene's grid
+    family; ratio2 is the second member's spacing over the first's where it differs from r
+    (else None).
+
+    Uniform grids: N/2 and N/4 (r = 2), or N/sqrt2 and N/2 where N/4 would be near-trapped
+    (:func:`uniform_member_nodes`; r and ratio2 the spacings' actual ratios,
+    (N - 1/2) / (N1 - 1/2) and (N1 - 1/2) / (N2 - 1/2)). Banded grids: spacings r h and r^2 h
+    of the same family (same band, grading and radius), r = sqrt 2
     (:func:`femadh.discretisation.plan.member_ratio`): members that stay asymptotic and,
     with the adaptive plan's spacing cap, below the trapping limit (a lattice-trapped member
     lands fold after fold and makes the estimate pessimistic: the Fig 4 scene's uniform
     N = 50 and 100 members, effectivity 9.8)."""
     green = green or {}
     if scene.grid is None:
-        return 2.0, [(f"N = {n}", variant(scene, nodes=n, **green))
-                     for n in (scene.nodes // 2, scene.nodes // 4) if n >= 8]
+        n = scene.nodes
+        n1, n2 = uniform_member_nodes(problem, n)
+        out = [(f"N = {k}", variant(scene, nodes=k, **green)) for k in (n1, n2) if k >= 8]
+        if n1 == n // 2:
+            return 2.0, out, None
+        return (n - 0.5) / (n1 - 0.5), out, (n1 - 0.5) / (n2 - 0.5)
     from ..discretisation.plan import member_ratio
 
     r = member_ratio(problem)
@@ -424,7 +512,7 @@ def coarser_members(scene, problem, green=None):
         if h > g["band"] / 8:
             break
         out.append((f"spacing {h * 1e9:.4g} nm", variant(scene, grid={**g, "spacing": h})))
-    return r, out
+    return r, out, None
 
 
 QUANTITIES = ("max_adhesion_N", "F_LJ_deepest_N", "F_ex_deepest_N", "jump_in_d_m",

@@ -396,3 +396,83 @@ def _vertex_proposal(ds, fs, i, a, c):
     # F = f0 + s01 (x - x0) + curv (x - x0)(x - x1): dF/dx = 0
     x = 0.5 * (x0 + x1) - s01 / (2 * curv)
     return x if a < x < c else None
+
+
+#: fresh states :func:`lattice_tooth` adds on each side of the peak, at these fractions of
+#: the release period (the peak search's own states within a period count too)
+TOOTH_SAMPLES = (0.5, 1.0)
+
+
+def release_period(prev, nxt):
+    """Separation (m) over which the contact edge releases (or joins) one node between the
+    grid states ``prev`` and ``nxt`` around a peak: |d_next - d_prev| over the difference
+    of their contact node counts; None where the counts are equal (no node released in the
+    bracket) or a state has no contact set."""
+    if prev.active is None or nxt.active is None:
+        return None
+    dn = abs(int(np.count_nonzero(prev.active)) - int(np.count_nonzero(nxt.active)))
+    return abs(nxt.d - prev.d) / dn if dn else None
+
+
+def lattice_tooth(problem, prev, best, nxt, scene, f_peak, d_peak, fresh=()):
+    """How far (N, >= 0) F_ex falls from the refined peak (``f_peak`` at ``d_peak``) within one
+    release period of the contact edge on either side of it (:func:`release_period`), the
+    curve's own fall over that distance (the parabola through the grid states ``prev``,
+    ``best``, ``nxt``) taken off; 0.0 without a sigma-gap contact or a release in the
+    bracket.
+
+    On a fixed lattice the contact edge of a sigma-gap contact moves a node at a time: a
+    contact node is held until its multiplier vanishes and is then released, so F_ex(d) is
+    a sawtooth, and the bounded peak search (:func:`peak_adhesion`) reads a tooth's tip.
+    Where a sub-grid step's cohesive zone acts at the edge
+    (:func:`femadh.runner.estimates.cohesive_edge`) the tips sit above the smooth trend by
+    about a tooth at every spacing, so the coarser members, each on its own tip, differ by
+    the smooth part alone: measured on the stiction map's sigma = 0.489 nm, p/psat 0.15
+    point, 4.04-nm band (1772 nodes), the peak's pinned piece rises from +1.04e-3 to
+    +1.42e-3 of the sigma-edge branch's limit within 0.0009 nm, the next trough +6.6e-4
+    (release period 0.0036 nm); this function: 8.2e-4 of the force.
+
+    ``fresh``: [(d, F or None, state or None)] the peak search solved (those within a
+    period count as samples); TOOTH_SAMPLES more on each side are solved as the peak
+    search's fresh states (:func:`state_between`, warm-started from them)."""
+    from ..contact.forces import state_forces
+
+    if problem.sigma is None or problem.contact_model == "hertz-closure":
+        return 0.0
+    period = release_period(prev, nxt)
+    if period is None:
+        return 0.0
+    lo, hi = sorted((prev.d, nxt.d))
+    smooth = _grid_parabola(problem, prev, best, nxt)
+    near = [st for _, _, st in fresh if st is not None]
+    samples = [f - smooth(x) for x, f, _ in fresh
+               if f is not None and abs(x - d_peak) <= period]
+    for frac in TOOTH_SAMPLES:
+        for side in (-1.0, 1.0):
+            x = d_peak + side * frac * period
+            if not lo < x < hi:
+                continue
+            a, b = (prev, best) if nxt.d == best.d or (x - best.d) * (prev.d - best.d) > 0 \
+                else (best, nxt)
+            if a.d == b.d:
+                continue
+            st = state_between(problem, a, b, x, scene, False, _warm(near, a, b, x))
+            if st is not None:
+                near.append(st)
+                samples.append(state_forces(problem, st)[2] - smooth(x))
+    return float(max(f_peak - smooth(d_peak) - min(samples), 0.0)) if samples else 0.0
+
+
+def _grid_parabola(problem, prev, best, nxt):
+    """F_ex(d) of the parabola through the three grid states around a peak (N; a function of
+    d in m): the curve's own fall over a release period, taken off the samples so that the
+    tooth is the lattice's alone. At a fold (two distinct states) nothing is taken off."""
+    from ..contact.forces import state_forces
+
+    ds = [float(s.d - best.d) for s in (prev, best, nxt)]      # (centred: d ~ 1e-9 m)
+    if len(set(ds)) < 3:
+        return lambda x: 0.0
+    fs = [float(s.f_ex if hasattr(s, "f_ex") else state_forces(problem, s)[2])
+          for s in (prev, best, nxt)]
+    c = np.polyfit(ds, fs, 2)
+    return lambda x: float(np.polyval(c, x - best.d))
