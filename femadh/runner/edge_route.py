@@ -316,46 +316,14 @@ def _nodes_of(a0, c, h, h0):
     return g.n
 
 
-#: the curve's name for the branch's own states (each on its own scaled grid; not the
-#: sweep's separations)
-CURVE = "retract_edge_branch"
-#: what the route does not give, said in the result's warnings
-MISSING = ("edge route: the curve is the retract's branch traced in its edge radius (its "
-           "own states, each on its own scaled grid, from deep contact to the pull-off "
-           "fold); the approach, the jump-in, the jump-out's landing and the separated "
-           "retract beyond it, and the surface fields are not computed on this route: the "
-           "headline numbers read from them (jump_in_d_m, hysteresis_J, the deepest forces) "
-           "are absent")
-
-
-def _curve(br, r, a_run):
-    """(curve columns, the first state the runner's stability test rejects or None): the
-    retract's states on the stable part in its order (c decreasing from deep contact, d
-    increasing), up to the fold or to the last state before one that is not an energy
-    minimum with its contact set held (:meth:`SigmaEdgeBranch.stable`: under displacement
-    control the retract leaves the branch there, before its fold)."""
-    states = [r.fold] + [s for s in r.states if s.c > r.fold.c]
-    if r.best is not r.fold and all(s is not r.best for s in states):
-        states.append(r.best)
-    states.sort(key=lambda s: -s.c)
-    force = runner_force(br, a_run)
-    cols = {"d_m": [], "h0_m": [], "F_ex_N": [], "r_c_m": [], "n_iter": [],
-            "residual_m": [], "converged": [], "stable": []}
-    lost = None
-    for s in states:
-        if not br.stable(s):
-            lost = s
-            break
-        cols["d_m"].append(s.d)
-        cols["h0_m"].append(float(s.h[0]))
-        cols["F_ex_N"].append(force(s))
-        cols["r_c_m"].append(s.c)
-        cols["n_iter"].append(s.n_iter)
-        cols["residual_m"].append(s.residual)
-        cols["converged"].append(True)
-        cols["stable"].append(True)
-    return {k: np.asarray(v, bool if k in ("converged", "stable") else
-                          int if k == "n_iter" else float) for k, v in cols.items()}, lost
+#: the prefix that makes a result's warning a note (printed "note: ..."; the report's NOTE):
+#: what the route computes and judges is normal output, not a warning
+NOTE = "error estimate: "
+#: what the route judges, said in the result's notes
+JUDGED = (NOTE + "edge route: the max adhesion and the pull-off separation (jump_out_d_m) are "
+          "judged by the family of edge grids; the approach (jump_in_d_m, the deepest "
+          "forces) is the sweep's on the adaptive grid's first member and the hysteresis "
+          "is read off both jumps: computed, not estimated")
 
 
 def _tolerance_part(br, scene):
@@ -365,22 +333,29 @@ def _tolerance_part(br, scene):
     return float(math.pi * scene.analysis_radius ** 2 * scene.tolerance * P1.max())
 
 
-def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume=False,
-                   folder_id=None):
+def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=False,
+                   resume=False, folder_id=None, progress=False):
     """Run ``scene`` by the edge route (see the module docstring) from its pilot ``pil``:
-    the family to the scene's target accuracy (``scene.target_accuracy``), the headline
-    numbers with their errors, the branch's curve; written to ``out_dir`` (summary.json,
-    curve.csv) where given. Returns a ContactResult: "converged" where the estimate meets
-    the target, else "failed" with one line saying what the family reached (failure kind
-    "accuracy"). A failed trace ends the run "failed" naming the step."""
+    the approach on the adaptive grid's member ``trial`` (:mod:`femadh.runner.edge_sweep`),
+    the family to the scene's target accuracy (``scene.target_accuracy``), the retract at
+    the sweep's separations on the finest member's scaled grids with its jump-out landed,
+    the headline numbers with their errors; written to ``out_dir`` (summary.json,
+    curve.csv, fields.csv, jumps.csv, figures) as they are computed. Returns a
+    ContactResult: "converged" where the estimate meets the target, else "failed" with one
+    line saying what the family reached (failure kind "accuracy"). A failed trace ends the
+    run "failed" naming the step; a stopped one keeps the states it committed."""
     from ..scene import scene_id
+    from .edge_sweep import approach_problem, trace_approach
     from .lifecycle import lifecycle
     from .result import ContactResult, contact_summary
+    from .sink import Sink
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
     short = None
     res = ContactResult(scene.name, scene)
+    # the route is recorded from the start (a run stopped in it says which it took)
+    res.grid = {"kind": "edge-branch", "route": "edge-branch"}
     folder = None
     if out_dir is not None:
         from ..io.run_folder import RunFolder
@@ -397,26 +372,36 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
         from .estimates import GuardError
 
         with lifecycle(res, write, failures=(ConvergenceError, GuardError, ValueError),
-                       t0=t0):
-            short = _route(scene, res, pil, target)
+                       t0=t0) as life:
+            t1 = time.perf_counter()
+            tsc, problem = approach_problem(scene, trial)
+            res.nodes = problem.grid.nodes.copy()
+            writer = None
             if folder is not None:
-                res.to_csv(folder.path / "curve.csv")
+                from ..io.writers import ContactWriter
+
+                writer = ContactWriter(folder, problem, vtk=scene.vtk, run_id=scene_id(scene))
+                life.cleanup(writer.close)
+            sink = Sink(problem, res, writer, progress)
+            trace_approach(tsc, problem, sink)
+            res.timings["approach_s"] = time.perf_counter() - t1
+            short = _route(scene, res, pil, target, sink)
+            sink.close()
         if short is not None and res.status == "converged":
             # the estimate does not support the request: one line, what was reached
             res.status, res.error, res.failure_kind = "failed", short, "accuracy"
             write()
         if res.status in ("interrupted", "time limit"):
-            # (the CLI's line says a stopped run's states are kept: not on this route)
-            res.warnings.append("resume: the edge route keeps no states of a stopped run (its "
-                                "family is not checkpointed); --resume traces its pilot and "
-                                "family again")
+            res.warnings.append("resume: the states the edge route committed before the stop "
+                                "are in the folder's files (each row whole); --resume "
+                                "starts the route over (its family is not checkpointed)")
             write()
         if (figures and folder is not None and res.status in ("converged", "failed")
-                and len(res.branches.get(CURVE, {}).get("d_m", ()))):
+                and any(len(b.get("d_m", ())) for b in res.branches.values())):
             from .figures import draw_figures
 
-            # every run comes with its figure (the branch's curve), as on the sweep path
-            # (runner/adaptive.py: a signal stops them at once)
+            # every run comes with its figure, as on the sweep path (runner/adaptive.py: a
+            # signal stops them at once)
             with phase("figures"):
                 draw_figures(res, folder)
             write()
@@ -426,60 +411,60 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
     return res
 
 
-def _route(scene, res, pil, target):
-    """Fill ``res`` (headline, estimates, curve, grid, accuracy) from the family; returns the
-    one-line failure where the estimate does not meet ``target`` (else None)."""
+def _route(scene, res, pil, target, sink):
+    """Fill ``res`` (retract, headline, estimates, grid, accuracy) from the family and the
+    retract's sweep into ``sink``; returns the one-line failure where the estimate does not
+    meet ``target`` (else None)."""
+    from .edge_sweep import trace_retract_sweep
+    from .headline import headline
     from .headline import work_of_adhesion as W_of
-    from ..reference import dmt_pull_off, jkr_pull_off
 
     a_run = scene.analysis_radius
-    # the route is recorded from the start (a run stopped in the family says which it took)
-    res.grid = {"kind": "edge-branch", "route": "edge-branch"}
     t1 = time.perf_counter()
     fam = family(scene, pil, target)
     res.timings["family_s"] = time.perf_counter() - t1
     res.timings["pilot_s"] = pil.seconds
     br, r = fam.finest
-    res.nodes = br.nodes0 * r.best.lam
-    res.branches[CURVE], lost = _curve(br, r, a_run)
-    hl = res.headline
     best = r.best
-    if lost is not None and lost.c >= best.c:
+    t1 = time.perf_counter()
+    info = trace_retract_sweep(scene, sink, br, r)
+    res.timings["retract_s"] = time.perf_counter() - t1
+    if info["lost"] is not None and info["lost"] <= best.d:
         raise ConvergenceError(
             f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
-            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (c = "
-            f"{lost.c:.6g} m): it is not the retract's", d=best.d, residual=math.nan,
-            n_iter=0)
-    hl["max_adhesion_N"] = fam.value
-    hl["d_at_max_adhesion_m"] = float(best.d)
-    hl["max_adhesion_branch"] = CURVE
-    hl["r_c_at_max_adhesion_m"] = best.c
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (the "
+            f"runner's test at d = {info['lost'] * 1e9:.6g} nm): it is not the retract's",
+            d=best.d, residual=math.nan, n_iter=0)
     if best.d <= min(scene.d_values):
         raise ConvergenceError(
             f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
             f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
             "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
-    if lost is None and r.fold.d > max(scene.d_values):
+    hl = res.headline = headline(res, br._ref)
+    hl["max_adhesion_N"] = fam.value
+    hl["d_at_max_adhesion_m"] = float(best.d)
+    hl["max_adhesion_branch"] = "retract"
+    hl["r_c_at_max_adhesion_m"] = best.c
+    hl.pop("jump_out_d_m", None)
+    if info["departed"] is None:
         res.warnings.append(
-            f"edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond the "
-            f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
-            "jump_out_d_m is not given")
-    elif lost is None:
+            f"{NOTE}edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond "
+            f"the sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in "
+            "contact, jump_out_d_m is not given")
+    elif info["lost"] is None and info["departed"] == r.fold.d:
         hl["jump_out_d_m"] = float(r.fold.d)
     else:
         # the retract leaves the branch before its fold: the jump-out is there, between the
-        # last stable state and the first unstable one (its landing is not computed)
+        # last stable state and the first unstable one (landed at the latter)
         res.warnings.append(
-            f"edge route: the branch stops being stable (the runner's test, contact set "
-            f"held) at c = {lost.c * 1e6:.4g} um, d = {lost.d * 1e9:.5g} nm, before its fold "
-            f"(d = {r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
-            f"{res.branches[CURVE]['d_m'][-1] * 1e9:.5g} nm and that; jump_out_d_m is not "
+            f"edge route: the branch stops being stable (the runner's test) at d = "
+            f"{(info['lost'] or info['departed']) * 1e9:.5g} nm, before its fold (d = "
+            f"{r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
+            f"{info['departed'] * 1e9:.5g} nm and that (landed there); jump_out_d_m is not "
             "given")
     W = W_of(br._ref)
     R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
-    hl["dmt_pull_off_N"] = dmt_pull_off(R, W)
-    hl["jkr_pull_off_N"] = jkr_pull_off(R, W)
     # the errors: the family's Richardson (grid), the force beyond the analysis radius on the
     # undeformed paraboloid (tail: the runner's F_ex is read on its disk, as here) and the
     # solver's tolerance - added in magnitude, as the runner's estimate adds its parts
@@ -498,6 +483,8 @@ def _route(scene, res, pil, target):
     res.grid = {"kind": "edge-branch", "route": "edge-branch", "nodes": fam.nodes[-1],
                 "analysis_radius_m": float(br.radius(best)),
                 "runner_analysis_radius_m": a_run, "edge_node": br.k,
+                "approach_nodes": int(res.nodes.size),
+                "retract_branch_states": info["states"],
                 "family_spacings_m": fam.h, "family_nodes": fam.nodes,
                 "family_seconds": fam.seconds, "observed_order": fam.order,
                 "extrapolation_N": fam.extrapolation, "fold_order": fam.fold_order,
@@ -508,8 +495,9 @@ def _route(scene, res, pil, target):
                 "worst_complementarity": list(r.worst_complementarity)}
     res.accuracy = {"target": target, "met": bool(rel <= target), "adaptive": True,
                     "route": "edge-branch", "nodes": fam.nodes[-1], "members": len(fam.h),
-                    "estimated_rel_error": rel, "stop": fam.stop}
-    res.warnings.append(MISSING)
+                    "estimated_rel_error": rel, "stop": fam.stop,
+                    "judged": sorted(parts)}
+    res.warnings.append(JUDGED)
     # the largest adhesion within the smooth laws' bounds, as every run's (a GuardError)
     from .estimates import guard_bounds
 
