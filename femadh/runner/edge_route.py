@@ -224,6 +224,7 @@ def route_for(scene, follows):
         return None
     if route == "auto" and not follows:
         return None
+    # ("edge" and "peak" pilot wherever the route can carry the scene)
     try:
         with phase("edge route: pilot"):
             pil = pilot(scene)
@@ -326,11 +327,150 @@ JUDGED = (NOTE + "edge route: the max adhesion and the pull-off separation (jump
           "is read off both jumps: computed, not estimated")
 
 
+#: the curve's name for the branch's own states (each on its own scaled grid; not the
+#: sweep's separations): the curve of a run that asks for the max adhesion alone
+#: ([solver] route = "peak") or whose accuracy the family does not reach
+CURVE = "retract_edge_branch"
+#: what such a run does not give, said in the result's notes
+MISSING = (NOTE + "edge route, max adhesion alone ([solver] route = 'peak', or an accuracy "
+           "the family does not reach): the curve is "
+           "the retract's branch traced in its edge radius (its own states, each on its own "
+           "scaled grid, from deep contact to the pull-off fold); the approach, the jump-in, "
+           "the jump-out's landing and the separated retract beyond it, and the surface "
+           "fields are not computed: the headline numbers read from them (jump_in_d_m, "
+           "hysteresis_J, the deepest forces) are absent")
+
+
+def _curve(br, r, a_run):
+    """(curve columns, the first state the runner's stability test rejects or None): the
+    retract's states on the stable part in its order (c decreasing from deep contact, d
+    increasing), up to the fold or to the last state before one that is not an energy
+    minimum with its contact set held (:meth:`SigmaEdgeBranch.stable`: under displacement
+    control the retract leaves the branch there, before its fold)."""
+    states = [r.fold] + [s for s in r.states if s.c > r.fold.c]
+    if r.best is not r.fold and all(s is not r.best for s in states):
+        states.append(r.best)
+    states.sort(key=lambda s: -s.c)
+    force = runner_force(br, a_run)
+    cols = {"d_m": [], "h0_m": [], "F_ex_N": [], "r_c_m": [], "n_iter": [],
+            "residual_m": [], "converged": [], "stable": []}
+    lost = None
+    for s in states:
+        if not br.stable(s):
+            lost = s
+            break
+        cols["d_m"].append(s.d)
+        cols["h0_m"].append(float(s.h[0]))
+        cols["F_ex_N"].append(force(s))
+        cols["r_c_m"].append(s.c)
+        cols["n_iter"].append(s.n_iter)
+        cols["residual_m"].append(s.residual)
+        cols["converged"].append(True)
+        cols["stable"].append(True)
+    return {k: np.asarray(v, bool if k in ("converged", "stable") else
+                          int if k == "n_iter" else float) for k, v in cols.items()}, lost
+
+
 def _tolerance_part(br, scene):
     """The solver tolerance's share of a force error (N), as the runner's estimate has it:
     the analysis disk's area x tolerance x the largest law stiffness at the gap sigma."""
     P1 = np.abs(br._ref.dpressure(np.full(br.n, scene.gap.sigma)))
     return float(math.pi * scene.analysis_radius ** 2 * scene.tolerance * P1.max())
+
+
+def _peak_only(scene, res, br, r, value):
+    """The headline and curve of a run of the max adhesion alone ([solver] route = "peak"):
+    the branch's own states to the fold or to the last one the runner's stability test
+    keeps (:func:`_curve`), the jump-out at the fold where the sweep reaches it."""
+    from .headline import headline
+
+    best = r.best
+    res.nodes = br.nodes0 * best.lam
+    res.branches[CURVE], lost = _curve(br, r, scene.analysis_radius)
+    if lost is not None and lost.c >= best.c:
+        raise ConvergenceError(
+            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (c = "
+            f"{lost.c:.6g} m): it is not the retract's", d=best.d, residual=math.nan,
+            n_iter=0)
+    _below_sweep(scene, best)
+    hl = res.headline = headline(res, br._ref)
+    for k in [k for k in hl if k.startswith("r_c_at_zero_force")]:
+        del hl[k]
+    _max_adhesion(hl, value, best, CURVE)
+    if lost is None and r.fold.d > max(scene.d_values):
+        _fold_beyond(scene, res, r)
+    elif lost is None:
+        hl["jump_out_d_m"] = float(r.fold.d)
+    else:
+        res.warnings.append(
+            f"edge route: the branch stops being stable (the runner's test, contact set "
+            f"held) at c = {lost.c * 1e6:.4g} um, d = {lost.d * 1e9:.5g} nm, before its fold "
+            f"(d = {r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
+            f"{res.branches[CURVE]['d_m'][-1] * 1e9:.5g} nm and that; jump_out_d_m is not "
+            "given")
+    res.warnings.append(MISSING)
+
+
+def _full_sweep(scene, res, br, r, sink, value):
+    """The headline of a routed run with the sweep's outputs: the retract at the sweep's
+    separations into ``sink`` (:func:`femadh.runner.edge_sweep.trace_retract_sweep`, after
+    the approach), the headline read off both branches and their jumps, the max adhesion
+    and the jump-out the family's."""
+    from .edge_sweep import trace_retract_sweep
+    from .headline import headline
+
+    best = r.best
+    t1 = time.perf_counter()
+    info = trace_retract_sweep(scene, sink, br, r)
+    res.timings["retract_s"] = time.perf_counter() - t1
+    if info["lost"] is not None and info["lost"] <= best.d:
+        raise ConvergenceError(
+            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (the "
+            f"runner's test at d = {info['lost'] * 1e9:.6g} nm): it is not the retract's",
+            d=best.d, residual=math.nan, n_iter=0)
+    _below_sweep(scene, best)
+    hl = res.headline = headline(res, br._ref)
+    _max_adhesion(hl, value, best, "retract")
+    hl.pop("jump_out_d_m", None)
+    if info["lost"] is not None:
+        raise ConvergenceError(
+            f"edge route: the branch stops being stable (the runner's test) at d = "
+            f"{info['lost'] * 1e9:.6g} nm, before its fold (d = {r.fold.d * 1e9:.6g} nm): the "
+            "retract leaves the branch there and unzips on a fixed grid, which the route "
+            "does not follow; [solver] route = 'grid' sweeps it (the family's max adhesion, "
+            f"on the stable side: {value:.6g} N at d = {best.d * 1e9:.6g} nm)",
+            d=info["lost"], residual=math.nan, n_iter=0)
+    if info["departed"] is None:
+        _fold_beyond(scene, res, r)
+    else:
+        hl["jump_out_d_m"] = float(r.fold.d)
+    res.warnings.append(JUDGED)
+    return info["states"]
+
+
+def _below_sweep(scene, best):
+    if best.d <= min(scene.d_values):
+        raise ConvergenceError(
+            f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
+            f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
+            "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
+
+
+def _max_adhesion(hl, value, best, branch):
+    """The family's max adhesion ``value`` (N) and where it is into the headline ``hl``."""
+    hl["max_adhesion_N"] = value
+    hl["d_at_max_adhesion_m"] = float(best.d)
+    hl["max_adhesion_branch"] = branch
+    hl["r_c_at_max_adhesion_m"] = best.c
+
+
+def _fold_beyond(scene, res, r):
+    res.warnings.append(
+        f"{NOTE}edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond the "
+        f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
+        "jump_out_d_m is not given")
 
 
 def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=False,
@@ -374,27 +514,43 @@ def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=F
         with lifecycle(res, write, failures=(ConvergenceError, GuardError, ValueError),
                        t0=t0) as life:
             t1 = time.perf_counter()
-            tsc, problem = approach_problem(scene, trial)
-            res.nodes = problem.grid.nodes.copy()
-            writer = None
-            if folder is not None:
-                from ..io.writers import ContactWriter
+            fam = family(scene, pil, target)
+            res.timings["family_s"] = time.perf_counter() - t1
+            res.timings["pilot_s"] = pil.seconds
+            if getattr(scene, "route", "auto") == "peak" or not _met(scene, fam, target):
+                # the max adhesion alone (asked so, or the accuracy asked is out of the
+                # family's reach: the run fails in one line before the sweep's outputs)
+                short = _route(scene, res, pil, target, None, fam)
+                if folder is not None:
+                    res.to_csv(folder.path / "curve.csv")
+            else:
+                t1 = time.perf_counter()
+                tsc, problem = approach_problem(scene, trial)
+                res.nodes = problem.grid.nodes.copy()
+                writer = None
+                if folder is not None:
+                    from ..io.writers import ContactWriter
 
-                writer = ContactWriter(folder, problem, vtk=scene.vtk, run_id=scene_id(scene))
-                life.cleanup(writer.close)
-            sink = Sink(problem, res, writer, progress)
-            trace_approach(tsc, problem, sink)
-            res.timings["approach_s"] = time.perf_counter() - t1
-            short = _route(scene, res, pil, target, sink)
-            sink.close()
+                    writer = ContactWriter(folder, problem, vtk=scene.vtk,
+                                           run_id=scene_id(scene))
+                    life.cleanup(writer.close)
+                sink = Sink(problem, res, writer, progress)
+                trace_approach(tsc, problem, sink)
+                res.timings["approach_s"] = time.perf_counter() - t1
+                short = _route(scene, res, pil, target, sink, fam)
+                sink.close()
         if short is not None and res.status == "converged":
             # the estimate does not support the request: one line, what was reached
             res.status, res.error, res.failure_kind = "failed", short, "accuracy"
             write()
         if res.status in ("interrupted", "time limit"):
-            res.warnings.append("resume: the states the edge route committed before the stop "
-                                "are in the folder's files (each row whole); --resume "
-                                "starts the route over (its family is not checkpointed)")
+            res.warnings.append(
+                "resume: the edge route keeps no states of a stopped run of the max adhesion "
+                "alone (route 'peak'); --resume traces its pilot and family again"
+                if getattr(scene, "route", "auto") == "peak" else
+                "resume: the states the edge route committed before the stop are in the "
+                "folder's files (each row whole); --resume starts the route over (its "
+                "family is not checkpointed)")
             write()
         if (figures and folder is not None and res.status in ("converged", "failed")
                 and any(len(b.get("d_m", ())) for b in res.branches.values())):
@@ -411,68 +567,46 @@ def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=F
     return res
 
 
-def _route(scene, res, pil, target, sink):
-    """Fill ``res`` (retract, headline, estimates, grid, accuracy) from the family and the
-    retract's sweep into ``sink``; returns the one-line failure where the estimate does not
-    meet ``target`` (else None)."""
-    from .edge_sweep import trace_retract_sweep
-    from .headline import headline
+def _error_parts(scene, fam):
+    """The max adhesion's error parts (N): the family's Richardson (grid), the force beyond
+    the analysis radius on the undeformed paraboloid at the largest force's d (tail: the
+    runner's F_ex is read on its disk, as here) and the solver's tolerance."""
+    br, r = fam.finest
+    R, a_run = scene.sphere.radius, scene.analysis_radius
+    h_a = np.array([r.best.d + scene.sphere.shape(a_run)])
+    tail = float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
+                                        for e in scene.effects.values()))
+    return {"grid": fam.error, "tail": tail, "tolerance": _tolerance_part(br, scene)}
+
+
+def _met(scene, fam, target):
+    """Whether the max adhesion's estimated relative error (its parts added in magnitude)
+    is within ``target``."""
+    return sum(abs(v) for v in _error_parts(scene, fam).values()) <= target * abs(fam.value)
+
+
+def _route(scene, res, pil, target, sink, fam):
+    """Fill ``res`` (retract, headline, estimates, grid, accuracy) from the family ``fam``
+    and the retract's sweep into ``sink`` (None: the branch's own curve, the max adhesion
+    alone); returns the one-line failure where the estimate does not meet ``target`` (else
+    None)."""
     from .headline import work_of_adhesion as W_of
 
     a_run = scene.analysis_radius
-    t1 = time.perf_counter()
-    fam = family(scene, pil, target)
-    res.timings["family_s"] = time.perf_counter() - t1
-    res.timings["pilot_s"] = pil.seconds
     br, r = fam.finest
     best = r.best
-    t1 = time.perf_counter()
-    info = trace_retract_sweep(scene, sink, br, r)
-    res.timings["retract_s"] = time.perf_counter() - t1
-    if info["lost"] is not None and info["lost"] <= best.d:
-        raise ConvergenceError(
-            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
-            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (the "
-            f"runner's test at d = {info['lost'] * 1e9:.6g} nm): it is not the retract's",
-            d=best.d, residual=math.nan, n_iter=0)
-    if best.d <= min(scene.d_values):
-        raise ConvergenceError(
-            f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
-            f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
-            "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
-    hl = res.headline = headline(res, br._ref)
-    hl["max_adhesion_N"] = fam.value
-    hl["d_at_max_adhesion_m"] = float(best.d)
-    hl["max_adhesion_branch"] = "retract"
-    hl["r_c_at_max_adhesion_m"] = best.c
-    hl.pop("jump_out_d_m", None)
-    if info["departed"] is None:
-        res.warnings.append(
-            f"{NOTE}edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond "
-            f"the sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in "
-            "contact, jump_out_d_m is not given")
-    elif info["lost"] is None and info["departed"] == r.fold.d:
-        hl["jump_out_d_m"] = float(r.fold.d)
+    if sink is None:
+        _peak_only(scene, res, br, r, fam.value)
+        committed = None
     else:
-        # the retract leaves the branch before its fold: the jump-out is there, between the
-        # last stable state and the first unstable one (landed at the latter)
-        res.warnings.append(
-            f"edge route: the branch stops being stable (the runner's test) at d = "
-            f"{(info['lost'] or info['departed']) * 1e9:.5g} nm, before its fold (d = "
-            f"{r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
-            f"{info['departed'] * 1e9:.5g} nm and that (landed there); jump_out_d_m is not "
-            "given")
+        committed = _full_sweep(scene, res, br, r, sink, fam.value)
+    hl = res.headline
     W = W_of(br._ref)
     R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
-    # the errors: the family's Richardson (grid), the force beyond the analysis radius on the
-    # undeformed paraboloid (tail: the runner's F_ex is read on its disk, as here) and the
-    # solver's tolerance - added in magnitude, as the runner's estimate adds its parts
-    h_a = np.array([best.d + scene.sphere.shape(a_run)])
-    tail = float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
-                                        for e in scene.effects.values()))
-    parts = {"max_adhesion_N": {"grid": fam.error, "tail": tail,
-                                "tolerance": _tolerance_part(br, scene)},
+    # the errors (:func:`_error_parts`) added in magnitude, as the runner's estimate adds
+    # its parts
+    parts = {"max_adhesion_N": _error_parts(scene, fam),
              "jump_out_d_m": {"grid": float(fam.fold_error)}}
     parts = {k: v for k, v in parts.items() if k in hl}
     for k, comp in parts.items():
@@ -483,8 +617,8 @@ def _route(scene, res, pil, target, sink):
     res.grid = {"kind": "edge-branch", "route": "edge-branch", "nodes": fam.nodes[-1],
                 "analysis_radius_m": float(br.radius(best)),
                 "runner_analysis_radius_m": a_run, "edge_node": br.k,
-                "approach_nodes": int(res.nodes.size),
-                "retract_branch_states": info["states"],
+                "approach_nodes": None if committed is None else int(res.nodes.size),
+                "retract_branch_states": committed,
                 "family_spacings_m": fam.h, "family_nodes": fam.nodes,
                 "family_seconds": fam.seconds, "observed_order": fam.order,
                 "extrapolation_N": fam.extrapolation, "fold_order": fam.fold_order,
@@ -497,7 +631,6 @@ def _route(scene, res, pil, target, sink):
                     "route": "edge-branch", "nodes": fam.nodes[-1], "members": len(fam.h),
                     "estimated_rel_error": rel, "stop": fam.stop,
                     "judged": sorted(parts)}
-    res.warnings.append(JUDGED)
     # the largest adhesion within the smooth laws' bounds, as every run's (a GuardError)
     from .estimates import guard_bounds
 

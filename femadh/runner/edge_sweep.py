@@ -21,10 +21,10 @@ jump-out and landing, curve.csv, fields.csv, jumps.csv - written through the run
   solver (its own folds located and landed as on any run).
 
 Where the runner's stability test rejects the branch's state at a sweep separation before
-the fold (the retract leaves the branch there, displacement-controlled), the jump-out is
-landed from the last stable state at that separation instead (resolved to the sweep's step,
-as a fixed grid's fold bracket is before bisection; the jump-out separation is then not a
-headline number).
+the fold (the retract would leave the branch there, displacement-controlled; never seen on
+the stiction map's points, validation/results/sigma_edge.md), the route stops: off its
+branch the retract unzips node by node on a fixed grid, the cost the route exists to avoid,
+and the run fails saying so ([solver] route = "grid" sweeps it).
 
 A stopped routed run keeps the states it committed (every file row is whole: the writer
 appends curve.csv last); its summary says that --resume starts the route over.
@@ -110,31 +110,26 @@ def trace_retract_sweep(scene, sink, br, retract):
             sink.state("retract", st)
             last = (pb, st)
             out["states"] += 1
-    if out["lost"] is None and not beyond:
+    if out["lost"] is not None:
+        # the retract leaves the branch before its fold: off the branch the surface unzips
+        # node by node on a fixed grid (hundreds of micro-folds, the cost the route avoids;
+        # measured 388 s on a 681-node scaled grid of the small test scene): not followed
+        return out
+    if not beyond:
         return out                    # the sweep ends in contact: no jump-out
-    if out["lost"] is None:
-        # the fold itself: the runner's state at its separation, on its scaled grid
-        # (taken as it is: the runner's Jacobian at fixed d is singular at the fold, its
-        # Newton does not converge there, measured; and its stability is marginal - the
-        # branch's smallest stiffness vanishes there, the test reads it either way by
-        # round-off; the branch's states up to it passed the runner's test)
-        pb, before = as_runner_state(fold, tol)
-        if not before.converged:
-            raise ConvergenceError(f"edge route: the fold's state (d = {fold.d * 1e9:.6g} nm) "
-                                   f"does not meet the runner's tolerance on its grid",
-                                   d=fold.d, residual=before.residual, n_iter=before.n_iter)
-        d_fold = fold.d
-        resolution = MIN_STEP_FRACTION * step
-        d_land = d_fold + resolution
-    else:
-        if last is None:
-            raise ConvergenceError(
-                f"edge route: the retract's deepest state (d = {out['lost'] * 1e9:.6g} nm) "
-                "is not stable by the runner's test", d=out["lost"], residual=math.nan,
-                n_iter=0)
-        pb, before = last
-        d_fold, d_land = before.d, out["lost"]
-        resolution = d_land - d_fold
+    # the fold itself: the runner's state at its separation on its scaled grid, taken as
+    # it is (the runner's Jacobian at fixed d is singular at the fold, its Newton does not
+    # converge there, measured; and its stability is marginal - the branch's smallest
+    # stiffness vanishes there, the test reads it either way by round-off; the branch's
+    # states up to it passed the runner's test)
+    pb, before = as_runner_state(fold, tol)
+    if not before.converged:
+        raise ConvergenceError(f"edge route: the fold's state (d = {fold.d * 1e9:.6g} nm) "
+                               f"does not meet the runner's tolerance on its grid",
+                               d=fold.d, residual=before.residual, n_iter=before.n_iter)
+    d_fold = fold.d
+    resolution = MIN_STEP_FRACTION * step
+    d_land = d_fold + resolution
     with phase("retract (landing)"):
         after = land(pb, d_land, before.w, tol=tol, max_iter=max_iter)
     if not (after.converged and after.stable):
@@ -144,9 +139,6 @@ def trace_retract_sweep(scene, sink, br, retract):
     _on_grid(sink, pb)
     sink.jump(Jump("retract", d_fold, d_land, resolution, before, after))
     out["departed"], out["landing"] = d_fold, after
-    if out["lost"] is not None:
-        # landed at a sweep separation (the one the branch's state failed at): its state
-        sink.state("retract", after)
     rest = [d for d in d_all if d > d_land]
     if rest:
         first = [True]
