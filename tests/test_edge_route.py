@@ -28,16 +28,18 @@ def small():
 
 @pytest.fixture(scope="module")
 def routed(small, tmp_path_factory):
+    """The small scene swept from 4 nm (its retract's fold, 2.67 nm, inside the sweep)."""
     out = tmp_path_factory.mktemp("edge") / "run"
-    return femadh.run(small, out, figures=True, progress=False), out
-
-
-@pytest.fixture(scope="module")
-def routed_far(small, tmp_path_factory):
-    """The small scene swept from 4 nm: its retract's fold inside the sweep."""
-    out = tmp_path_factory.mktemp("edge") / "far"
-    return femadh.run(small.replace({"sweep.start": "4 nm"}), out, figures=False,
+    return femadh.run(small.replace({"sweep.start": "4 nm"}), out, figures=True,
                       progress=False), out
+
+
+def _no_approach(monkeypatch):
+    """The route's approach left out (tests of its retract alone: the approach is the
+    sweep's own, tested with it)."""
+    from femadh.runner import edge_sweep
+
+    monkeypatch.setattr(edge_sweep, "trace_approach", lambda tsc, problem, sink: problem)
 
 
 def test_small_scene_takes_the_route(routed):
@@ -66,14 +68,13 @@ def test_small_scene_takes_the_route(routed):
     for c in (ap, re_):
         assert c["converged"].all() and c["stable"].all()
         assert (c["residual_m"] <= res.scene.tolerance).all()
-    # the retract's contact states: edge radius shrinking as d grows; the fold (2.67 nm)
-    # lies beyond the sweep's 2-nm end, so the sweep ends in contact: no jump-out, a note
-    # says why; the approach jumps in once
-    assert all(a >= b for a, b in zip(re_["r_c_m"], re_["r_c_m"][1:]))
-    assert re_["r_c_m"][-1] > 0 and "jump_out_d_m" not in res.headline
-    assert [j["branch"] for j in res.jumps] == ["approach"]
+    # the retract's contact states: edge radius shrinking as d grows to the fold; the
+    # approach jumps in once, the retract jumps out once
+    inside = re_["d_m"] <= res.headline["jump_out_d_m"]
+    r_in = re_["r_c_m"][inside]
+    assert all(a >= b for a, b in zip(r_in, r_in[1:])) and r_in[-1] > 0
+    assert [j["branch"] for j in res.jumps] == ["approach", "retract"]
     assert "jump_in_d_m" in res.headline and "hysteresis_J" in res.headline
-    assert any("beyond the sweep's end" in w for w in res.warnings)
     assert (out / "force_curve.png").stat().st_size > 0
     # the headline (the branch's largest force, found between separations, on the runner's
     # disk) against the largest committed retract state's F_ex (on its own, wider disk: the
@@ -82,10 +83,25 @@ def test_small_scene_takes_the_route(routed):
     assert F * (1 - 1e-3) <= re_["F_ex_N"].max() <= F * (1 + 1e-3)
     # the route's notes are notes, not warnings (printed "note: ...")
     assert all(w.startswith(edge_route.NOTE) for w in res.warnings)
+    assert sorted(res.accuracy["judged"]) == ["jump_out_d_m", "max_adhesion_N"]
+
+
+def test_a_sweep_that_ends_in_contact_has_no_jump_out(small, monkeypatch):
+    """The sweep's 2-nm end short of the fold (2.67 nm): the retract's states all on the
+    branch, no jump-out, a note says why (the approach left out, a 1-nm step)."""
+    _no_approach(monkeypatch)
+    res = femadh.run(small.replace({"sweep.step": "1 nm"}), None, figures=False,
+                     progress=False)
+    assert res.status == "converged", res.error
+    re_ = res.branches["retract"]
+    assert (re_["r_c_m"] > 0).all() and "jump_out_d_m" not in res.headline
+    assert not res.jumps
+    assert any("beyond the sweep's end" in w and w.startswith(edge_route.NOTE)
+               for w in res.warnings)
     assert sorted(res.accuracy["judged"]) == ["max_adhesion_N"]
 
 
-def test_jump_out_landed_and_the_separated_retract(routed_far):
+def test_jump_out_landed_and_the_separated_retract(routed):
     """Sweep from 4 nm: the fold (d = 2.67 nm) inside it. The jump-out is the fold's d with
     its family error; its landing (energy descent on the fold's scaled grid) lowers the total
     energy (measured 1.09e-15 J released), reaches a stable state with no node at sigma, and
@@ -94,7 +110,7 @@ def test_jump_out_landed_and_the_separated_retract(routed_far):
     of different members, asserted 1e-4); the deepest states of approach (the adaptive grid's
     first member, accuracy 1e-2) and retract (the finest edge grid) agree to that member's
     accuracy (measured 4.6e-4 of the max adhesion, asserted 1e-3)."""
-    res, out = routed_far
+    res, out = routed
     hl = res.headline
     assert res.status == "converged", res.error
     assert hl["jump_out_d_m"] == pytest.approx(2.6708e-9, rel=1e-3, abs=0)
@@ -132,6 +148,7 @@ def test_a_branch_that_stops_being_stable_stops_the_route(small, monkeypatch):
     reason. (A 0.5-nm sweep: the route's family does not depend on the step.)"""
     from femadh.runner import edge_sweep
 
+    _no_approach(monkeypatch)
     sc = small.replace({"sweep.step": "0.5 nm"})
     orig = edge_sweep.runner_state
     cut = {}
@@ -308,3 +325,57 @@ def test_a_tail_beyond_the_request_is_named(small):
     assert "force beyond the analysis radius" in res.error and "stopped: met" not in res.error
     comp = res.estimates["max_adhesion_N"]
     assert abs(comp["tail"]) > max(abs(comp["grid"]), abs(comp["tolerance"]))
+
+
+def test_a_stopped_routed_run_keeps_its_states(small, tmp_path, monkeypatch):
+    """A signal during the retract stops the run after the state being committed: status
+    "interrupted", curve.csv and fields.csv hold exactly the states committed (each row
+    whole), the summary says so and that --resume starts the route over; --resume then
+    completes it. (The approach left out, a 1-nm step.)"""
+    import json
+    import signal
+
+    from femadh import interrupt
+    from femadh.runner.run import run
+    from femadh.runner.sink import Sink
+
+    _no_approach(monkeypatch)
+    sc = small.replace({"sweep.step": "1 nm"})
+    orig = Sink.state
+    seen = []
+
+    def state(self, branch, st):
+        seen.append(branch)
+        if len(seen) == 3:
+            interrupt._pending.append(signal.SIGINT)
+        return orig(self, branch, st)
+    monkeypatch.setattr(Sink, "state", state)
+    out = tmp_path / "run"
+    res = run(sc, out, figures=False, progress=False)
+    assert res.status == "interrupted"
+    rows = (out / "curve.csv").read_text().splitlines()[1:]
+    assert len(rows) == 3 and all(r.split(",")[1] == "retract" for r in rows)
+    states = {int(line.split(",", 1)[0]) for line in
+              (out / "fields.csv").read_text().splitlines()[1:]}
+    assert states == {0, 1, 2}
+    summ = json.loads((out / "summary.json").read_text())
+    assert summ["status"] == "interrupted" and summ["grid"]["route"] == "edge-branch"
+    assert any("starts the route over" in w for w in summ["warnings"])
+    monkeypatch.setattr(Sink, "state", orig)
+    again = run(sc, out, figures=False, progress=False, resume=True)
+    assert again.status == "converged", again.error
+    assert len((out / "curve.csv").read_text().splitlines()) - 1 == len(sc.d_values)
+
+
+def test_peak_route_is_the_max_adhesion_alone(small):
+    """[solver] route = "peak": the family's max adhesion (the same number as the full
+    route's: one family) and the branch's own curve, no approach; a note says what is not
+    computed."""
+    res = femadh.run(small.replace({"solver.route": "peak"}), None, figures=False,
+                     progress=False)
+    assert res.status == "converged", res.error
+    assert list(res.branches) == [edge_route.CURVE] and not res.jumps
+    assert "jump_in_d_m" not in res.headline
+    assert any(w.startswith(edge_route.NOTE + "edge route, max adhesion alone")
+               for w in res.warnings)
+    assert edge_route.route_for(small.replace({"solver.route": "peak"}), False) is not None
