@@ -73,6 +73,9 @@ def test_small_scene_takes_the_route(routed):
     inside = re_["d_m"] <= res.headline["jump_out_d_m"]
     r_in = re_["r_c_m"][inside]
     assert all(a >= b for a, b in zip(r_in, r_in[1:])) and r_in[-1] > 0
+    # each placed on the branch at its separation: the runner's corrector from it converges
+    # in one iteration (measured 1 at every one), its contact set the branch's
+    assert (re_["n_iter"][inside] <= 1).all()
     assert [j["branch"] for j in res.jumps] == ["approach", "retract"]
     assert "jump_in_d_m" in res.headline and "hysteresis_J" in res.headline
     assert (out / "force_curve.png").stat().st_size > 0
@@ -314,12 +317,23 @@ def test_a_resumed_sweep_folder_keeps_the_sweep(tmp_path):
     assert not holds_sweep_run(tmp_path)
 
 
-def test_a_tail_beyond_the_request_is_named(small):
+def test_a_tail_beyond_the_request_grows_the_disk(small, monkeypatch):
     """A disk too small for the request (analysis radius from delta = 3 nm, 0.35 um, at 1e-3):
     the family's grid part meets it (measured 1.0e-9 N), the force beyond the disk does not
-    (1.7e-8 N, 2.9e-3 of the max adhesion): the run fails in one line naming that part and the
-    radius, not "stopped: met"."""
-    sc = small.replace({"solver.analysis_radius": {"delta": "3 nm"}, "solver.accuracy": 1e-3})
+    (1.7e-8 N, 2.9e-3 of the max adhesion): the route doubles the disk, as the sweep's loop
+    does, and meets the request there; the grown radius is recorded. Where it may not grow
+    (MAX_DISK_DOUBLINGS = 0) the run fails in one line naming that part and the radius, not
+    "stopped: met". (The max adhesion alone, route = "peak": the disk is the family's.)"""
+    sc = small.replace({"solver.analysis_radius": {"delta": "3 nm"}, "solver.accuracy": 1e-3,
+                        "solver.route": "peak"})
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "converged", res.error
+    a0 = sc.analysis_radius
+    grown = res.grid["analysis_radius_grown_m"]
+    assert grown and grown[0] == pytest.approx(2 * a0, rel=1e-12, abs=0)
+    comp = res.estimates["max_adhesion_N"]
+    assert abs(comp["tail"]) <= 0.6e-3 * res.headline["max_adhesion_N"]
+    monkeypatch.setattr(edge_route, "MAX_DISK_DOUBLINGS", 0)
     res = femadh.run(sc, None, figures=False, progress=False)
     assert res.status == "failed" and res.failure_kind == "accuracy"
     assert "force beyond the analysis radius" in res.error and "stopped: met" not in res.error

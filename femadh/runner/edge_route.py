@@ -34,11 +34,21 @@ What the route gives (:func:`run_edge_route`): the max adhesion (the finest memb
 F_ex on the runner's analysis disk, where on the branch it is, its edge radius) and the
 displacement-controlled pull-off (the fold's d, ``jump_out_d_m``), each with its estimated
 error (Richardson of the family, the force beyond the analysis radius, the solver's
-tolerance, as the runner's estimate has them); the finest member's branch states as the
-curve "retract_edge_branch" (each state on its own scaled grid; d decreasing from deep
-contact to the fold). Not given (yet): the approach, the jump-in, the jump-out's landing and
-the separated retract beyond it, the surface fields - the headline numbers read from those
-(jump_in_d_m, hysteresis_J, the deepest forces) are absent, and the summary says so.
+tolerance, as the runner's estimate has them); and the sweep's outputs
+(:mod:`femadh.runner.edge_sweep`): the approach by the sweep on the adaptive grid's first
+member with its jump-in, the retract's states at the sweep's separations on the finest
+member's scaled grids (each polished by the runner's corrector), the jump-out landed from
+the fold and the separated retract stepped - curve.csv, fields.csv, jumps.csv and the
+figures as any run writes them. The numbers read off the approach and the jumps
+(jump_in_d_m, hysteresis_J, the deepest forces) are computed, not estimated: the accuracy
+record lists what is judged (``judged``), a note says so. ``[solver] route = "peak"`` asks
+for the max adhesion and the pull-off alone (a study that reads only these: the stiction
+map): no approach, the branch's own states as the curve "retract_edge_branch" (each on its
+own scaled grid, from deep contact to the fold); so does a run whose accuracy the family
+does not reach (it fails in one line before the sweep's outputs).
+
+A stopped routed run keeps the states it committed (each row of the files whole) and says
+so; --resume starts the route over (its family is not checkpointed).
 """
 from dataclasses import dataclass, field
 import math
@@ -514,18 +524,19 @@ def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=F
         with lifecycle(res, write, failures=(ConvergenceError, GuardError, ValueError),
                        t0=t0) as life:
             t1 = time.perf_counter()
-            fam = family(scene, pil, target)
+            user = scene
+            scene, fam, grown = _grown_family(scene, pil, target)
             res.timings["family_s"] = time.perf_counter() - t1
             res.timings["pilot_s"] = pil.seconds
             if getattr(scene, "route", "auto") == "peak" or not _met(scene, fam, target):
                 # the max adhesion alone (asked so, or the accuracy asked is out of the
                 # family's reach: the run fails in one line before the sweep's outputs)
-                short = _route(scene, res, pil, target, None, fam)
+                short = _route(scene, res, pil, target, None, fam, grown)
                 if folder is not None:
                     res.to_csv(folder.path / "curve.csv")
             else:
                 t1 = time.perf_counter()
-                tsc, problem = approach_problem(scene, trial)
+                tsc, problem = approach_problem(user, trial)
                 res.nodes = problem.grid.nodes.copy()
                 writer = None
                 if folder is not None:
@@ -537,7 +548,7 @@ def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=F
                 sink = Sink(problem, res, writer, progress)
                 trace_approach(tsc, problem, sink)
                 res.timings["approach_s"] = time.perf_counter() - t1
-                short = _route(scene, res, pil, target, sink, fam)
+                short = _route(scene, res, pil, target, sink, fam, grown)
                 sink.close()
         if short is not None and res.status == "converged":
             # the estimate does not support the request: one line, what was reached
@@ -579,17 +590,47 @@ def _error_parts(scene, fam):
     return {"grid": fam.error, "tail": tail, "tolerance": _tolerance_part(br, scene)}
 
 
+#: doublings of the analysis radius the route may make where the force beyond it is what
+#: falls short (the sweep's adaptive loop doubles it likewise, runner/adaptive.py _decide)
+MAX_DISK_DOUBLINGS = 3
+
+
+def _grown_family(scene, pil, target):
+    """(scene, family, radii grown through): the family on the scene's analysis radius, and
+    where the force beyond it exceeds the share of the target the adaptive loop allows it
+    (its SAFETY), on twice that radius - as the sweep's loop grows its disk - while it stays
+    below half the sphere's radius (eq 4's paraboloid is a sphere only for r << R; the
+    whole radius for a paraboloid profile) and at most MAX_DISK_DOUBLINGS times."""
+    from .adaptive import SAFETY
+    from .estimates import variant
+
+    fam = family(scene, pil, target)
+    grown = []
+    cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
+    while len(grown) < MAX_DISK_DOUBLINGS:
+        tail = abs(_error_parts(scene, fam)["tail"])
+        a = scene.analysis_radius
+        if tail <= SAFETY * target * abs(fam.value) or not 2 * a < cap:
+            break
+        scene = variant(scene, radius=2 * a)
+        grown.append(2 * a)
+        with phase(f"edge route: analysis radius {2 * a * 1e6:.3g} um"):
+            fam = family(scene, pil, target)
+    return scene, fam, grown
+
+
 def _met(scene, fam, target):
     """Whether the max adhesion's estimated relative error (its parts added in magnitude)
     is within ``target``."""
     return sum(abs(v) for v in _error_parts(scene, fam).values()) <= target * abs(fam.value)
 
 
-def _route(scene, res, pil, target, sink, fam):
+def _route(scene, res, pil, target, sink, fam, grown=()):
     """Fill ``res`` (retract, headline, estimates, grid, accuracy) from the family ``fam``
     and the retract's sweep into ``sink`` (None: the branch's own curve, the max adhesion
-    alone); returns the one-line failure where the estimate does not meet ``target`` (else
-    None)."""
+    alone); ``scene`` with the analysis radius the family was read on (``grown``: the radii
+    it grew through, :func:`_grown_family`). Returns the one-line failure where the
+    estimate does not meet ``target`` (else None)."""
     from .headline import work_of_adhesion as W_of
 
     a_run = scene.analysis_radius
@@ -617,6 +658,7 @@ def _route(scene, res, pil, target, sink, fam):
     res.grid = {"kind": "edge-branch", "route": "edge-branch", "nodes": fam.nodes[-1],
                 "analysis_radius_m": float(br.radius(best)),
                 "runner_analysis_radius_m": a_run, "edge_node": br.k,
+                "analysis_radius_grown_m": list(grown),
                 "approach_nodes": None if committed is None else int(res.nodes.size),
                 "retract_branch_states": committed,
                 "family_spacings_m": fam.h, "family_nodes": fam.nodes,
@@ -641,8 +683,11 @@ def _route(scene, res, pil, target, sink, fam):
         # the family grows only the grid part's resolution: say which part is too large
         why = {"grid": f"stopped: {fam.stop}",
                "tail": (f"the largest part is the force beyond the analysis radius "
-                        f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N): a wider "
-                        f"[solver] analysis_radius (now {a_run:.3g} m) would reduce it"),
+                        f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N) of "
+                        f"{a_run:.3g} m" + (f" (grown {len(grown)} times)" if grown else "")
+                        + f": the route grows the disk at most {MAX_DISK_DOUBLINGS} times "
+                        "and below half the sphere's radius; a wider [solver] "
+                        "analysis_radius would reduce it"),
                "tolerance": (f"the largest part is the solver tolerance's "
                              f"({abs(comp['tolerance']):.3g} N): a tighter [solver] tolerance "
                              "would reduce it")}[big]
