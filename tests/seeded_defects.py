@@ -1795,10 +1795,11 @@ DEFECTS = [
       "at its separation", "femadh/contact/sigma_edge.py",
       (("    for s in (hi, lo):\n        if s.d == d:\n            return s\n",
         "    for s in (hi, lo):\n        return s\n"),)),
-    D("rfull_polish_no_contact_set", "routed sweep: the runner's corrector started without "
-      "the branch's contact set", "femadh/contact/sigma_edge.py",
+    D("rfull_polish_at_branch_d", "routed sweep: a state polished at the branch state's "
+      "separation, not the sweep's", "femadh/contact/sigma_edge.py",
       (("    new = solve_complementarity(pb, d, st.w, tol=tol, max_iter=max_iter, active0=active)",
-        "    new = solve_complementarity(pb, d, st.w, tol=tol, max_iter=max_iter)"),)),
+        "    new = solve_complementarity(pb, st.d, st.w, tol=tol, max_iter=max_iter,\n"
+        "                                active0=active)"),)),
     D("rfull_fold_state_sign", "routed sweep: the fold's runner state with the contact "
       "pressure added to the laws'", "femadh/contact/sigma_edge.py",
       (("    p_net = sum(p_eff.values()) - st.p_c\n", "    p_net = sum(p_eff.values()) + st.p_c\n"),)),
