@@ -183,8 +183,13 @@ def test_bundled_scenes_keep_their_path(small):
     assert edge_route.static_reasons(slider) == []
     assert edge_route.route_for(slider, True) is None
     assert edge_route.route_for(slider, False) is None          # a static band: no pilot
-    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot)
+    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot):
+    # the bundled Fig 4 scene's pilot finds a fold, its default path is the sweep (its
+    # headline numbers, all estimated, stay as they were)
     assert edge_route.route_for(small, False) is None
+    fig4 = femadh.load_scene("validation/scenes/paper1_fig4.toml")
+    assert edge_route.static_reasons(fig4) == []
+    assert edge_route.route_for(fig4, False) is None
     fig6 = femadh.load_scene("validation/scenes/paper1_fig6_sigma0.20.toml")
     assert any("grid is set" in r for r in edge_route.static_reasons(fig6))
     fig8 = femadh.load_scene("validation/scenes/paper1_fig8_rho179.toml")
