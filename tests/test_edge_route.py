@@ -90,21 +90,6 @@ def test_small_scene_takes_the_route(routed):
     assert sorted(res.accuracy["judged"]) == ["jump_out_d_m", "max_adhesion_N"]
 
 
-def test_a_sweep_that_ends_in_contact_has_no_jump_out(small, monkeypatch):
-    """The sweep's 2-nm end short of the fold (2.67 nm): the retract's states all on the
-    branch, no jump-out, a note says why (the approach left out, a 1-nm step)."""
-    _no_approach(monkeypatch)
-    res = femadh.run(small.replace({"sweep.step": "1 nm"}), None, figures=False,
-                     progress=False)
-    assert res.status == "converged", res.error
-    re_ = res.branches["retract"]
-    assert (re_["r_c_m"] > 0).all() and "jump_out_d_m" not in res.headline
-    assert not res.jumps
-    assert any("beyond the sweep's end" in w and w.startswith(edge_route.NOTE)
-               for w in res.warnings)
-    assert sorted(res.accuracy["judged"]) == ["max_adhesion_N"]
-
-
 def test_jump_out_landed_and_the_separated_retract(routed):
     """Sweep from 4 nm: the fold (d = 2.67 nm) inside it. The jump-out is the fold's d with
     its family error; its landing (energy descent on the fold's scaled grid) lowers the total
@@ -234,8 +219,10 @@ def test_headline_agrees_with_the_present_runner(routed):
 
 def test_accuracy_out_of_reach_is_one_line(small, monkeypatch):
     """An accuracy the family's budget cannot reach ends "failed", kind "accuracy", in one
-    line naming what it reached, the members and nodes."""
+    line naming what it reached, the members and nodes (the disk kept: its growth is
+    tested below)."""
     monkeypatch.setattr(edge_route, "MAX_LEVELS", 3)
+    monkeypatch.setattr(edge_route, "MAX_DISK_DOUBLINGS", 0)
     res = femadh.run(small.replace({"solver.accuracy": 1e-7}), None, figures=False,
                      progress=False)
     assert res.status == "failed" and res.failure_kind == "accuracy"
@@ -351,7 +338,9 @@ def test_a_stopped_routed_run_keeps_its_states(small, tmp_path, monkeypatch):
     """A signal during the retract stops the run after the state being committed: status
     "interrupted", curve.csv and fields.csv hold exactly the states committed (each row
     whole), the summary says so and that --resume starts the route over; --resume then
-    completes it. (The approach left out, a 1-nm step.)"""
+    completes it. The sweep's 2-nm end lies short of the fold (2.67 nm): the retract's
+    states all on the branch, no jump-out, a note says why. (The approach left out, a 1-nm
+    step.)"""
     import json
     import signal
 
@@ -385,6 +374,12 @@ def test_a_stopped_routed_run_keeps_its_states(small, tmp_path, monkeypatch):
     again = run(sc, out, figures=False, progress=False, resume=True)
     assert again.status == "converged", again.error
     assert len((out / "curve.csv").read_text().splitlines()) - 1 == len(sc.d_values)
+    re_ = again.branches["retract"]
+    assert (re_["r_c_m"] > 0).all() and "jump_out_d_m" not in again.headline
+    assert not again.jumps
+    assert any("beyond the sweep's end" in w and w.startswith(edge_route.NOTE)
+               for w in again.warnings)
+    assert sorted(again.accuracy["judged"]) == ["max_adhesion_N"]
 
 
 def test_peak_route_is_the_max_adhesion_alone(small):
