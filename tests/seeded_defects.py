@@ -1822,7 +1822,6 @@ DEFECTS = [
       "femadh/runner/edge_route.py",
       (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
         '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
-
 ]
 
 

@@ -469,8 +469,8 @@ def _below_sweep(scene, best):
 
 
 def _max_adhesion(hl, value, best, branch):
-    """The family's max adhesion ``value`` (N) and where it is into the headline ``hl``."""
-    hl["max_adhesion_N"] = value
+    """Where the family's max adhesion ``value`` (N) is, into the headline ``hl`` (the value
+    itself: :func:`_route`, once the branch's part is done)."""
     hl["d_at_max_adhesion_m"] = float(best.d)
     hl["max_adhesion_branch"] = branch
     hl["r_c_at_max_adhesion_m"] = best.c
@@ -642,6 +642,7 @@ def _route(scene, res, pil, target, sink, fam, grown=()):
     else:
         committed = _full_sweep(scene, res, br, r, sink, fam.value)
     hl = res.headline
+    hl["max_adhesion_N"] = fam.value
     W = W_of(br._ref)
     R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
