@@ -394,3 +394,39 @@ def test_peak_route_is_the_max_adhesion_alone(small):
     assert any(w.startswith(edge_route.NOTE + "edge route, max adhesion alone")
                for w in res.warnings)
     assert edge_route.route_for(small.replace({"solver.route": "peak"}), False) is not None
+    # the curve: the branch's states from deep contact to the fold (2.67 nm, beyond the
+    # sweep's 2-nm end: no jump-out, a note), the largest F_ex the headline's own state
+    c = res.branches[edge_route.CURVE]
+    assert all(a > b for a, b in zip(c["r_c_m"], c["r_c_m"][1:]))
+    assert all(a < b for a, b in zip(c["d_m"], c["d_m"][1:]))
+    assert c["stable"].all() and c["d_m"][-1] > 2e-9
+    assert "jump_out_d_m" not in res.headline
+    assert any("beyond the sweep's end" in w for w in res.warnings)
+    assert max(c["F_ex_N"]) == pytest.approx(res.headline["max_adhesion_N"], rel=1e-12,
+                                             abs=0)
+
+
+def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, monkeypatch):
+    """Route "peak": where the runner's stability test rejects a branch state between the
+    largest force and the fold (made so: every state below the midpoint of c* and the
+    fold's c), the curve ends at the last stable state, jump_out_d_m is not given and a
+    warning says where; the max adhesion is the same number. A loss of stability above c*
+    (the largest force not on the retract) fails the run with that reason."""
+    from femadh.contact.sigma_edge import SigmaEdgeBranch
+
+    sc = small.replace({"solver.route": "peak"})
+    ref = femadh.run(sc, None, figures=False, progress=False)
+    c = ref.branches[edge_route.CURVE]["r_c_m"]
+    c_star = ref.headline["r_c_at_max_adhesion_m"]
+    cut = 0.5 * (c_star + c[-1])
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c >= cut)
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "converged", res.error
+    kept = res.branches[edge_route.CURVE]["r_c_m"]
+    assert kept.min() >= cut and len(kept) < len(c)
+    assert "jump_out_d_m" not in res.headline
+    assert any("stops being stable" in w for w in res.warnings)
+    assert res.headline["max_adhesion_N"] == ref.headline["max_adhesion_N"]
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c > 1.01 * c_star)
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "failed" and "not the retract's" in res.error
