@@ -382,12 +382,18 @@ def test_a_stopped_routed_run_keeps_its_states(small, tmp_path, monkeypatch):
     assert sorted(again.accuracy["judged"]) == ["max_adhesion_N"]
 
 
-def test_peak_route_is_the_max_adhesion_alone(small):
+@pytest.fixture(scope="module")
+def peaked(small):
+    """The small scene by route "peak"."""
+    return femadh.run(small.replace({"solver.route": "peak"}), None, figures=False,
+                      progress=False)
+
+
+def test_peak_route_is_the_max_adhesion_alone(small, peaked):
     """[solver] route = "peak": the family's max adhesion (the same number as the full
     route's: one family) and the branch's own curve, no approach; a note says what is not
     computed."""
-    res = femadh.run(small.replace({"solver.route": "peak"}), None, figures=False,
-                     progress=False)
+    res = peaked
     assert res.status == "converged", res.error
     assert list(res.branches) == [edge_route.CURVE] and not res.jumps
     assert "jump_in_d_m" not in res.headline
@@ -406,7 +412,8 @@ def test_peak_route_is_the_max_adhesion_alone(small):
                                              abs=0)
 
 
-def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, monkeypatch):
+def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, peaked,
+                                                                      monkeypatch):
     """Route "peak": where the runner's stability test rejects a branch state between the
     largest force and the fold (made so: every state below the midpoint of c* and the
     fold's c), the curve ends at the last stable state, jump_out_d_m is not given and a
@@ -415,7 +422,7 @@ def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, mo
     from femadh.contact.sigma_edge import SigmaEdgeBranch
 
     sc = small.replace({"solver.route": "peak"})
-    ref = femadh.run(sc, None, figures=False, progress=False)
+    ref = peaked
     c = ref.branches[edge_route.CURVE]["r_c_m"]
     c_star = ref.headline["r_c_at_max_adhesion_m"]
     cut = 0.5 * (c_star + c[-1])
