@@ -1718,6 +1718,54 @@ DEFECTS = [
     D("eroute_low_fold", "edge route: a pilot's fold at its lowest edge radius taken",
       "femadh/runner/edge_route.py",
       (("    if r.fold.c < c_ref / PILOT_SPAN / LOW:", "    if False:"),)),
+    # -- the routed run's sweep outputs (branch routefull: femadh/runner/edge_sweep.py,
+    #    femadh/contact/sigma_edge.py's placing and polishing, edge_route's modes)
+    D("rfull_land_at_fold", "routed sweep: the jump-out landed at the fold's own separation",
+      "femadh/runner/edge_sweep.py",
+      (("    resolution = MIN_STEP_FRACTION * step\n    d_land = d_fold + resolution\n",
+        "    resolution = MIN_STEP_FRACTION * step\n    d_land = d_fold\n"),)),
+    D("rfull_landing_committed", "routed sweep: the landing committed as a sweep state",
+      "femadh/runner/edge_sweep.py",
+      (("            if first[0]:              # the landing: a jump's record, not a sweep state\n"
+        "                first[0] = False\n                return\n",
+        "            if first[0]:              # the landing: a jump's record, not a sweep state\n"
+        "                first[0] = False\n"),)),
+    D("rfull_unstable_committed", "routed sweep: a branch state the runner's test rejects "
+      "committed", "femadh/runner/edge_sweep.py",
+      (("            if not st.stable:\n                out[\"lost\"] = d\n",
+        "            if False:\n                out[\"lost\"] = d\n"),)),
+    D("rfull_place_at_bracket_end", "routed sweep: a state placed at its bracket's end, not "
+      "at its separation", "femadh/contact/sigma_edge.py",
+      (("    for s in (hi, lo):\n        if s.d == d:\n            return s\n",
+        "    for s in (hi, lo):\n        return s\n"),)),
+    D("rfull_polish_at_branch_d", "routed sweep: a state polished at the branch state's "
+      "separation, not the sweep's", "femadh/contact/sigma_edge.py",
+      (("    new = solve_complementarity(pb, d, st.w, tol=tol, max_iter=max_iter, active0=active)",
+        "    new = solve_complementarity(pb, st.d, st.w, tol=tol, max_iter=max_iter,\n"
+        "                                active0=active)"),)),
+    D("rfull_fold_state_sign", "routed sweep: the fold's runner state with the contact "
+      "pressure added to the laws'", "femadh/contact/sigma_edge.py",
+      (("    p_net = sum(p_eff.values()) - st.p_c\n", "    p_net = sum(p_eff.values()) + st.p_c\n"),)),
+    D("rfull_deep_not_extended", "routed sweep: the branch not traced on to the sweep's "
+      "deepest separation", "femadh/contact/sigma_edge.py",
+      (("    if top.d > d_deep:\n        run = tr.march(", "    if False:\n        run = tr.march("),)),
+    D("rfull_met_absolute", "edge route: the outputs' accuracy gate on an absolute error (N)",
+      "femadh/runner/edge_route.py",
+      (("    return sum(abs(v) for v in _error_parts(scene, fam).values()) <= target * abs(fam.value)",
+        "    return sum(abs(v) for v in _error_parts(scene, fam).values()) <= target"),)),
+    D("rfull_peak_full", "edge route: route = 'peak' computes the sweep's outputs",
+      "femadh/runner/edge_route.py",
+      (("            if getattr(scene, \"route\", \"auto\") == \"peak\" or not _met(",
+        "            if getattr(scene, \"route\", \"auto\") == \"speak\" or not _met("),)),
+    D("rfull_judged_warning", "edge route: what it judges printed as a warning",
+      "femadh/runner/edge_route.py",
+      (("JUDGED = (NOTE + \"edge route: the max adhesion", "JUDGED = (\"edge route: the max adhesion"),)),
+    D("rfull_lost_continues", "edge route: a branch the runner's test rejects before its "
+      "fold reported converged", "femadh/runner/edge_route.py",
+      (("    if info[\"lost\"] is not None:\n        raise ConvergenceError(\n"
+        "            f\"edge route: the branch stops being stable",
+        "    if False:\n        raise ConvergenceError(\n"
+        "            f\"edge route: the branch stops being stable"),)),
 
     # -- the solve made cheaper (branch fig4solve): the descent's round-off rejections, the
     #    first refinement's order

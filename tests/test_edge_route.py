@@ -8,6 +8,7 @@ band would need more than FOLLOW_NODES nodes, so its adaptive grid would follow 
 ~4 CPU-s in all."""
 import math
 
+import numpy as np
 import pytest
 
 import femadh
@@ -27,13 +28,27 @@ def small():
 
 @pytest.fixture(scope="module")
 def routed(small, tmp_path_factory):
+    """The small scene swept from 4 nm in 0.5-nm steps (its retract's fold, 2.67 nm, inside
+    the sweep)."""
     out = tmp_path_factory.mktemp("edge") / "run"
-    return femadh.run(small, out, figures=True, progress=False), out
+    return femadh.run(small.replace({"sweep.start": "4 nm", "sweep.step": "0.5 nm"}), out,
+                      figures=True, progress=False), out
+
+
+def _no_approach(monkeypatch):
+    """The route's approach left out (tests of its retract alone: the approach is the
+    sweep's own, tested with it)."""
+    from femadh.runner import edge_sweep
+
+    monkeypatch.setattr(edge_sweep, "trace_approach", lambda tsc, problem, sink: problem)
 
 
 def test_small_scene_takes_the_route(routed):
     """A run of the qualifying scene goes down the edge route (its adaptive grid would follow
-    the edge, its pilot finds a fold) and writes its summary and the branch's curve."""
+    the edge, its pilot finds a fold) and writes what every run writes: the approach (with
+    its jump-in) and the retract at the sweep's separations in curve.csv and fields.csv
+    (every state a converged, stable state of the runner's equations on its grid), jumps.csv,
+    the summary and the figure."""
     import json
 
     res, out = routed
@@ -44,50 +59,105 @@ def test_small_scene_takes_the_route(routed):
     assert summ["status"] == "converged" and summ["grid"]["route"] == "edge-branch"
     assert summ["headline"]["max_adhesion_N"] == res.headline["max_adhesion_N"]
     rows = (out / "curve.csv").read_text().splitlines()
-    assert rows[0].startswith("branch,d_m")
-    assert len(rows) - 1 == len(res.branches[edge_route.CURVE]["d_m"]) >= 5
-    c = res.branches[edge_route.CURVE]
-    # the retract's states: edge radius shrinking, separation growing to the fold (the
-    # jump-out), the largest F_ex the headline's
-    assert all(a > b for a, b in zip(c["r_c_m"], c["r_c_m"][1:]))
-    assert all(a < b for a, b in zip(c["d_m"], c["d_m"][1:]))
-    # every state stable to the fold (the runner's test on each state's scaled grid, its
-    # sub-grid step built there); the fold (2.67 nm) lies beyond the sweep's 2-nm end, so
-    # the sweep ends in contact: no jump-out, and a warning says why; the figure is drawn
-    assert not any("stops being stable" in w for w in res.warnings)
-    assert c["d_m"][-1] > 2e-9 and "jump_out_d_m" not in res.headline
-    assert any("beyond the sweep's end" in w for w in res.warnings)
+    ap, re_ = res.branches["approach"], res.branches["retract"]
+    assert len(rows) - 1 == len(ap["d_m"]) + len(re_["d_m"])
+    d = np.asarray(res.scene.d_values)
+    assert np.array_equal(ap["d_m"], d) and np.array_equal(re_["d_m"], d[::-1])
+    states = {int(line.split(",", 1)[0]) for line in
+              (out / "fields.csv").read_text().splitlines()[1:]}
+    assert states == set(range(len(rows) - 1))
+    for c in (ap, re_):
+        assert c["converged"].all() and c["stable"].all()
+        assert (c["residual_m"] <= res.scene.tolerance).all()
+    # the retract's contact states: edge radius shrinking as d grows to the fold; the
+    # approach jumps in once, the retract jumps out once
+    inside = re_["d_m"] <= res.headline["jump_out_d_m"]
+    r_in = re_["r_c_m"][inside]
+    assert all(a >= b for a, b in zip(r_in, r_in[1:])) and r_in[-1] > 0
+    # each placed on the branch at its separation: the runner's corrector from it converges
+    # in one iteration (measured 1 at every one), its contact set the branch's
+    assert (re_["n_iter"][inside] <= 1).all()
+    assert [j["branch"] for j in res.jumps] == ["approach", "retract"]
+    assert "jump_in_d_m" in res.headline and "hysteresis_J" in res.headline
     assert (out / "force_curve.png").stat().st_size > 0
-    assert max(c["F_ex_N"]) == pytest.approx(res.headline["max_adhesion_N"], rel=1e-12,
-                                             abs=0)
-    assert c["stable"].all()
-    assert any("edge route" in w for w in res.warnings)     # what it does not compute
+    # the headline (the branch's largest force, found between separations, on the runner's
+    # disk) against the largest committed retract state's F_ex (on its own, wider disk, at a
+    # sweep separation 0.05 nm from d*: measured 3.1e-4 below it)
+    F = res.headline["max_adhesion_N"]
+    assert F * (1 - 1e-3) <= re_["F_ex_N"].max() <= F * (1 + 1e-3)
+    # the route's notes are notes, not warnings (printed "note: ...")
+    assert all(w.startswith(edge_route.NOTE) for w in res.warnings)
+    assert sorted(res.accuracy["judged"]) == ["jump_out_d_m", "max_adhesion_N"]
 
 
-def test_a_branch_that_stops_being_stable_ends_the_curve_there(small, routed, monkeypatch):
-    """Where the runner's stability test rejects a branch state between the largest force and
-    the fold (here made so: every state of edge radius below the midpoint of c* and the fold's
-    c reads unstable), the curve ends at the last stable state, the jump-out is not given
-    (it lies between that state and the first unstable one) and a warning says where; the
-    max adhesion, on the stable side, is the same number. A loss of stability above c* (the
-    largest force not on the retract) fails the run with that reason."""
-    from femadh.contact.sigma_edge import SigmaEdgeBranch
-
-    ref, _ = routed
-    c = ref.branches[edge_route.CURVE]["r_c_m"]
-    c_star = ref.headline["r_c_at_max_adhesion_m"]
-    cut = 0.5 * (c_star + c[-1])
-    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c >= cut)
-    res = femadh.run(small, None, figures=False, progress=False)
+def test_jump_out_landed_and_the_separated_retract(routed):
+    """Sweep from 4 nm: the fold (d = 2.67 nm) inside it. The jump-out is the fold's d with
+    its family error; its landing (energy descent on the fold's scaled grid) lowers the total
+    energy (measured 1.09e-15 J released), reaches a stable state with no node at sigma, and
+    the retract is stepped on from it; the separated states match the approach's at the same
+    separations (one equilibrium there: measured |dF| <= 4.5e-5 of the max adhesion on grids
+    of different members, asserted 1e-4); the deepest states of approach (the adaptive grid's
+    first member, accuracy 1e-2) and retract (the finest edge grid) agree to that member's
+    accuracy (measured 4.8e-4 of the max adhesion, asserted 1e-3)."""
+    res, out = routed
+    hl = res.headline
     assert res.status == "converged", res.error
-    kept = res.branches[edge_route.CURVE]["r_c_m"]
-    assert kept.min() >= cut and len(kept) < len(c)
-    assert "jump_out_d_m" not in res.headline
-    assert any("stops being stable" in w for w in res.warnings)
-    assert res.headline["max_adhesion_N"] == ref.headline["max_adhesion_N"]
-    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c > 1.01 * c_star)
-    res = femadh.run(small, None, figures=False, progress=False)
-    assert res.status == "failed" and "not the retract's" in res.error
+    assert hl["jump_out_d_m"] == pytest.approx(2.6708e-9, rel=1e-3, abs=0)
+    assert 0 < hl["jump_out_d_m_error"] < 1e-3 * hl["jump_out_d_m"]
+    jo = [j for j in res.jumps if j["branch"] == "retract"]
+    assert len(jo) == 1 and jo[0]["d_fold_m"] == hl["jump_out_d_m"]
+    assert 0 < jo[0]["d_land_m"] - jo[0]["d_fold_m"] == pytest.approx(jo[0]["resolution_m"],
+                                                                      rel=1e-6, abs=0)
+    assert jo[0]["energy_released_J"] > 0
+    assert jo[0]["F_ex_after_N"] < 0.1 * jo[0]["F_ex_before_N"]
+    sigma = res.scene.gap.sigma
+    assert jo[0]["h0_before_m"] == pytest.approx(sigma, rel=1e-9, abs=0)
+    assert jo[0]["h0_after_m"] > 5 * sigma
+    ap, re_ = res.branches["approach"], res.branches["retract"]
+    after = re_["d_m"] > hl["jump_out_d_m"]
+    assert after.sum() == 3 and (re_["r_c_m"][after] == 0).all()
+    assert re_["stable"].all() and re_["converged"].all()
+    F = hl["max_adhesion_N"]
+    tot_a = dict(zip(ap["d_m"], ap["F_ex_N"] + ap["F_tail_N"]))
+    for d, f in zip(re_["d_m"][after], (re_["F_ex_N"] + re_["F_tail_N"])[after]):
+        if d in tot_a and tot_a[d] > 0 and ap["r_c_m"][list(ap["d_m"]).index(d)] == 0:
+            assert abs(f - tot_a[d]) <= 1e-4 * F
+    assert abs((ap["F_ex_N"] + ap["F_tail_N"])[-1] - (re_["F_ex_N"] + re_["F_tail_N"])[0]) \
+        <= 1e-3 * F
+    assert sorted(res.accuracy["judged"]) == ["jump_out_d_m", "max_adhesion_N"]
+    assert "hysteresis_J" in hl and hl["hysteresis_J"] > jo[0]["energy_released_J"]
+
+
+def test_a_branch_that_stops_being_stable_stops_the_route(small, monkeypatch):
+    """Where the runner's stability test rejects the branch's state at a sweep separation
+    between the largest force and the fold (here made so: every state above d = 1.7 nm reads
+    unstable), the retract would leave the branch and unzip node by node on a fixed grid
+    (measured 388 s on this scene): the run fails naming the separation, the states before
+    it committed; below d* (the largest force not on the retract) it fails with that
+    reason. (A 0.5-nm sweep: the route's family does not depend on the step.)"""
+    from femadh.runner import edge_sweep
+
+    _no_approach(monkeypatch)
+    sc = small.replace({"sweep.step": "0.5 nm"})
+    orig = edge_sweep.runner_state
+    cut = {}
+
+    def patched(st, d, tol, max_iter):
+        pb, new = orig(st, d, tol, max_iter)
+        if d > cut["d"]:
+            new.stable = False
+        return pb, new
+    monkeypatch.setattr(edge_sweep, "runner_state", patched)
+    cut["d"] = 1.7e-9
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "failed" and "stops being stable" in res.error
+    assert "2 nm" in res.error and "route = 'grid'" in res.error
+    re_ = res.branches["retract"]
+    assert re_["d_m"].max() <= cut["d"] and re_["stable"].all()
+    assert not [j for j in res.jumps if j["branch"] == "retract"]
+    cut["d"] = 0.9e-9
+    bad = femadh.run(sc, None, figures=False, progress=False)
+    assert bad.status == "failed" and "not the retract's" in bad.error
 
 
 def test_bundled_scenes_keep_their_path(small):
@@ -98,8 +168,13 @@ def test_bundled_scenes_keep_their_path(small):
     assert edge_route.static_reasons(slider) == []
     assert edge_route.route_for(slider, True) is None
     assert edge_route.route_for(slider, False) is None          # a static band: no pilot
-    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot)
+    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot):
+    # the bundled Fig 4 scene's pilot finds a fold, its default path is the sweep (its
+    # headline numbers, all estimated, stay as they were)
     assert edge_route.route_for(small, False) is None
+    fig4 = femadh.load_scene("validation/scenes/paper1_fig4.toml")
+    assert edge_route.static_reasons(fig4) == []
+    assert edge_route.route_for(fig4, False) is None
     fig6 = femadh.load_scene("validation/scenes/paper1_fig6_sigma0.20.toml")
     assert any("grid is set" in r for r in edge_route.static_reasons(fig6))
     fig8 = femadh.load_scene("validation/scenes/paper1_fig8_rho179.toml")
@@ -144,8 +219,10 @@ def test_headline_agrees_with_the_present_runner(routed):
 
 def test_accuracy_out_of_reach_is_one_line(small, monkeypatch):
     """An accuracy the family's budget cannot reach ends "failed", kind "accuracy", in one
-    line naming what it reached, the members and nodes."""
+    line naming what it reached, the members and nodes (the disk kept: its growth is
+    tested below)."""
     monkeypatch.setattr(edge_route, "MAX_LEVELS", 3)
+    monkeypatch.setattr(edge_route, "MAX_DISK_DOUBLINGS", 0)
     res = femadh.run(small.replace({"solver.accuracy": 1e-7}), None, figures=False,
                      progress=False)
     assert res.status == "failed" and res.failure_kind == "accuracy"
@@ -233,14 +310,130 @@ def test_a_resumed_sweep_folder_keeps_the_sweep(tmp_path):
     assert not holds_sweep_run(tmp_path)
 
 
-def test_a_tail_beyond_the_request_is_named(small):
+def test_a_tail_beyond_the_request_grows_the_disk(small, monkeypatch):
     """A disk too small for the request (analysis radius from delta = 3 nm, 0.35 um, at 1e-3):
     the family's grid part meets it (measured 1.0e-9 N), the force beyond the disk does not
-    (1.7e-8 N, 2.9e-3 of the max adhesion): the run fails in one line naming that part and the
-    radius, not "stopped: met"."""
-    sc = small.replace({"solver.analysis_radius": {"delta": "3 nm"}, "solver.accuracy": 1e-3})
+    (1.7e-8 N, 2.9e-3 of the max adhesion): the route doubles the disk, as the sweep's loop
+    does, and meets the request there; the grown radius is recorded. Where it may not grow
+    (MAX_DISK_DOUBLINGS = 0) the run fails in one line naming that part and the radius, not
+    "stopped: met". (The max adhesion alone, route = "peak": the disk is the family's.)"""
+    sc = small.replace({"solver.analysis_radius": {"delta": "3 nm"}, "solver.accuracy": 1e-3,
+                        "solver.route": "peak"})
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "converged", res.error
+    a0 = sc.analysis_radius
+    grown = res.grid["analysis_radius_grown_m"]
+    assert grown and grown[0] == pytest.approx(2 * a0, rel=1e-12, abs=0)
+    comp = res.estimates["max_adhesion_N"]
+    assert abs(comp["tail"]) <= 0.6e-3 * res.headline["max_adhesion_N"]
+    monkeypatch.setattr(edge_route, "MAX_DISK_DOUBLINGS", 0)
     res = femadh.run(sc, None, figures=False, progress=False)
     assert res.status == "failed" and res.failure_kind == "accuracy"
     assert "force beyond the analysis radius" in res.error and "stopped: met" not in res.error
     comp = res.estimates["max_adhesion_N"]
     assert abs(comp["tail"]) > max(abs(comp["grid"]), abs(comp["tolerance"]))
+
+
+def test_a_stopped_routed_run_keeps_its_states(small, tmp_path, monkeypatch):
+    """A signal during the retract stops the run after the state being committed: status
+    "interrupted", curve.csv and fields.csv hold exactly the states committed (each row
+    whole), the summary says so and that --resume starts the route over; --resume then
+    completes it. The sweep's 2-nm end lies short of the fold (2.67 nm): the retract's
+    states all on the branch, no jump-out, a note says why. (The approach left out, a 1-nm
+    step.)"""
+    import json
+    import signal
+
+    from femadh import interrupt
+    from femadh.runner.run import run
+    from femadh.runner.sink import Sink
+
+    _no_approach(monkeypatch)
+    sc = small.replace({"sweep.step": "1 nm"})
+    orig = Sink.state
+    seen = []
+
+    def state(self, branch, st):
+        seen.append(branch)
+        if len(seen) == 3:
+            interrupt._pending.append(signal.SIGINT)
+        return orig(self, branch, st)
+    monkeypatch.setattr(Sink, "state", state)
+    out = tmp_path / "run"
+    res = run(sc, out, figures=False, progress=False)
+    assert res.status == "interrupted"
+    rows = (out / "curve.csv").read_text().splitlines()[1:]
+    assert len(rows) == 3 and all(r.split(",")[1] == "retract" for r in rows)
+    states = {int(line.split(",", 1)[0]) for line in
+              (out / "fields.csv").read_text().splitlines()[1:]}
+    assert states == {0, 1, 2}
+    summ = json.loads((out / "summary.json").read_text())
+    assert summ["status"] == "interrupted" and summ["grid"]["route"] == "edge-branch"
+    assert any("starts the route over" in w for w in summ["warnings"])
+    monkeypatch.setattr(Sink, "state", orig)
+    again = run(sc, out, figures=False, progress=False, resume=True)
+    assert again.status == "converged", again.error
+    assert len((out / "curve.csv").read_text().splitlines()) - 1 == len(sc.d_values)
+    re_ = again.branches["retract"]
+    assert (re_["r_c_m"] > 0).all() and "jump_out_d_m" not in again.headline
+    assert not again.jumps
+    assert any("beyond the sweep's end" in w and w.startswith(edge_route.NOTE)
+               for w in again.warnings)
+    assert sorted(again.accuracy["judged"]) == ["max_adhesion_N"]
+
+
+@pytest.fixture(scope="module")
+def peaked(small):
+    """The small scene by route "peak"."""
+    return femadh.run(small.replace({"solver.route": "peak"}), None, figures=False,
+                      progress=False)
+
+
+def test_peak_route_is_the_max_adhesion_alone(small, peaked):
+    """[solver] route = "peak": the family's max adhesion (the same number as the full
+    route's: one family) and the branch's own curve, no approach; a note says what is not
+    computed."""
+    res = peaked
+    assert res.status == "converged", res.error
+    assert list(res.branches) == [edge_route.CURVE] and not res.jumps
+    assert "jump_in_d_m" not in res.headline
+    assert any(w.startswith(edge_route.NOTE + "edge route, max adhesion alone")
+               for w in res.warnings)
+    assert edge_route.route_for(small.replace({"solver.route": "peak"}), False) is not None
+    # the curve: the branch's states from deep contact to the fold (2.67 nm, beyond the
+    # sweep's 2-nm end: no jump-out, a note), the largest F_ex the headline's own state
+    c = res.branches[edge_route.CURVE]
+    assert all(a > b for a, b in zip(c["r_c_m"], c["r_c_m"][1:]))
+    assert all(a < b for a, b in zip(c["d_m"], c["d_m"][1:]))
+    assert c["stable"].all() and c["d_m"][-1] > 2e-9
+    assert "jump_out_d_m" not in res.headline
+    assert any("beyond the sweep's end" in w for w in res.warnings)
+    assert max(c["F_ex_N"]) == pytest.approx(res.headline["max_adhesion_N"], rel=1e-12,
+                                             abs=0)
+
+
+def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, peaked,
+                                                                      monkeypatch):
+    """Route "peak": where the runner's stability test rejects a branch state between the
+    largest force and the fold (made so: every state below the midpoint of c* and the
+    fold's c), the curve ends at the last stable state, jump_out_d_m is not given and a
+    warning says where; the max adhesion is the same number. A loss of stability above c*
+    (the largest force not on the retract) fails the run with that reason."""
+    from femadh.contact.sigma_edge import SigmaEdgeBranch
+
+    sc = small.replace({"solver.route": "peak"})
+    ref = peaked
+    c = ref.branches[edge_route.CURVE]["r_c_m"]
+    c_star = ref.headline["r_c_at_max_adhesion_m"]
+    cut = 0.5 * (c_star + c[-1])
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c >= cut)
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "converged", res.error
+    kept = res.branches[edge_route.CURVE]["r_c_m"]
+    assert kept.min() >= cut and len(kept) < len(c)
+    assert "jump_out_d_m" not in res.headline
+    assert any("stops being stable" in w for w in res.warnings)
+    assert res.headline["max_adhesion_N"] == ref.headline["max_adhesion_N"]
+    monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c > 1.01 * c_star)
+    res = femadh.run(sc, None, figures=False, progress=False)
+    assert res.status == "failed" and "not the retract's" in res.error

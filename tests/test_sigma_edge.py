@@ -219,3 +219,38 @@ def test_start_by_homotopy_keeps_complementarity():
     assert out[2e-9][0] is None                       # the case the homotopy is for
     assert out[4e-9][0] is not None and out[4e-9][0].d == out[4e-9][1].d
     assert out[2e-9][1].d == pytest.approx(out[4e-9][1].d, rel=3e-4, abs=0)
+
+
+def test_states_at_the_sweeps_separations(point):
+    """The routed run's retract (femadh/runner/edge_sweep.py) reads the branch at the
+    sweep's separations: traced on up to d = -2 nm (extend_deep: d falls monotonically with
+    c on the stable part, complementarity on every new state), a state placed at each
+    separation by secant in c (its d within 1e-6 of its bracket's width), polished there
+    by the runner's corrector in at most one iteration to a converged, stable state at
+    exactly that d with the branch's contact set (nodes 0..k-1, the edge node either way);
+    the fold's state as the runner's (as_runner_state: its residual within the tolerance,
+    nodes 0..k held). A separation outside the stable part has no state."""
+    from femadh.contact.sigma_edge import (as_runner_state, extend_deep, runner_state,
+                                           state_at_separation)
+
+    scene, br, r = point
+    stable = extend_deep(br, r, -2e-9)
+    assert stable[0] is r.fold and stable[-1].d <= -2e-9
+    assert all(a.d > b.d and a.c < b.c for a, b in zip(stable, stable[1:]))
+    for s in stable:
+        p, g = br.complementarity(s)
+        assert p >= 0 and g > 0
+    width = max(a.d - b.d for a, b in zip(stable, stable[1:]))
+    for d in (-2e-9, -0.4e-9, 0.92e-9, 1.2e-9, r.fold.d - 1e-11):
+        bst = state_at_separation(br, stable, d)
+        assert abs(bst.d - d) <= 1e-6 * width
+        pb, st = runner_state(bst, d, scene.tolerance, scene.max_iter)
+        assert st.converged and st.stable and st.n_iter <= 1 and st.d == d
+        assert st.active[:br.k].all() and not st.active[br.k + 1:].any()
+        assert pb.grid.n == br.n and pb.grid.nodes[br.k] == pytest.approx(bst.c, rel=1e-12,
+                                                                          abs=0)
+    pb, st = as_runner_state(r.fold, scene.tolerance)
+    assert st.converged and st.residual <= scene.tolerance
+    assert st.active.sum() == br.k + 1 and st.d == r.fold.d
+    assert state_at_separation(br, stable, r.fold.d + 1e-10) is None
+    assert state_at_separation(br, stable, stable[-1].d - 1e-10) is None

@@ -44,9 +44,14 @@ POINT_LIMIT = "90 s"
 
 
 #: the map asks for the max adhesion alone: a point whose pilot finds the retract's pull-off
-#: fold takes the edge route (femadh/runner/edge_route.py; [solver] route = "edge"), the
-#: others the adaptive sweep
-ROUTE = "edge"
+#: fold takes the edge route for it alone (femadh/runner/edge_route.py; [solver] route =
+#: "peak": the family's max adhesion and pull-off, no approach or states at the sweep's
+#: separations), the others the adaptive sweep. Not the scene's default "auto": with the
+#: sweep's outputs a routed point costs 20-68 s on the sigma = 0.3 nm column (the approach
+#: by the sweep 4-43 s, the retract's states 12-22 s; load ~5, validation/results/
+#: edge_route.md), and "auto" pilots only where the adaptive grid would follow the edge
+#: (the four low-humidity static-band points stay on the sweep and reach POINT_LIMIT)
+ROUTE = "peak"
 
 
 def stiction_map(out, sigma=None):

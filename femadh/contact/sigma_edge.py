@@ -432,3 +432,119 @@ def start_state(branch, c):
                                residual=math.nan, n_iter=MAX_ITER)
     # its force and multipliers at full strength (the last solve ran at t = 1)
     return st
+
+
+def extend_deep(branch, retract, d_deep, max_states=None):
+    """The retract's branch traced on up in c (deeper contact) until its separation is at
+    most ``d_deep`` (m): the sweep's retract starts at its deepest separation, below the
+    largest force's state where :func:`trace_retract` stops. The new states join
+    ``retract.states`` (kept in increasing c), each checked for complementarity as
+    :func:`trace_retract` checks them (ValueError naming the state). Returns the states of
+    the stable part (c >= the fold's, the fold included) in increasing c."""
+    from .edge_branch import MAX_STATES, BranchTrace
+
+    tr = BranchTrace(branch)
+    tr.states = list(retract.states)
+    top = tr.states[-1]
+    cap = MAX_STATES if max_states is None else max_states
+
+    def done(run):
+        if len(run) > cap:
+            from ..errors import ConvergenceError
+
+            raise ConvergenceError(f"sigma-edge branch: the retract does not reach d = "
+                                   f"{d_deep * 1e9:.6g} nm in {cap} states up from c = "
+                                   f"{top.c:.6g} m", d=run[-1].d, residual=math.nan,
+                                   n_iter=0)
+        return run[-1].d <= d_deep
+
+    if top.d > d_deep:
+        run = tr.march(top, +1, done, STEP0)
+        for s in run[1:]:
+            p, g = branch.complementarity(s)
+            if not (p >= -COMPL_SLACK and g > 0):
+                raise ValueError(f"sigma-edge branch: complementarity fails at c = "
+                                 f"{s.c:.6g} m (d = {s.d:.6g} m) on the way to the sweep's "
+                                 f"deepest separation: smallest multiplier {p:.3g} of the "
+                                 f"largest, smallest free gap above sigma {g:.3g} sigma")
+        retract.states = sorted(tr.states, key=lambda s: s.c)
+    fold = retract.fold
+    return [fold] + [s for s in retract.states if s.c > fold.c]
+
+
+#: branch solves allowed to place a state at a requested separation (secant in c)
+AT_D_SOLVES = 6
+
+
+def state_at_separation(branch, stable, d):
+    """The branch's state at separation d (m) on its stable part ``stable`` (states in
+    increasing c, d decreasing; d within their range): secant iterations in c from the
+    bracketing states (at most AT_D_SOLVES solves, to |d_state - d| <= 1e-6 of the
+    bracket's width in d). The state's d is then within a round-off of d: the runner's
+    corrector at d itself (:func:`runner_state`) removes the rest. None where d lies
+    outside the states' range."""
+    for hi, lo in zip(stable, stable[1:]):
+        # hi at the smaller c (larger d), lo at the larger c (smaller d)
+        if lo.d <= d <= hi.d:
+            break
+    else:
+        return None
+    for s in (hi, lo):
+        if s.d == d:
+            return s
+    a, b = hi, lo
+    width = hi.d - lo.d
+    best = None
+    for _ in range(AT_D_SOLVES):
+        t = (d - a.d) / (b.d - a.d)
+        c = a.c + t * (b.c - a.c)
+        w0 = a.w + t * (b.w - a.w)
+        st = branch.solve(c, w0, a.d + t * (b.d - a.d))
+        if st is None:
+            break
+        best = st
+        if abs(st.d - d) <= 1e-6 * width:
+            break
+        # keep the bracket (d(c) is monotone on the stable part)
+        if st.d > d:
+            a = st
+        else:
+            b = st
+    return best
+
+
+def runner_state(st, d, tol, max_iter):
+    """The runner's State at separation d (m) on the scaled grid of the branch state ``st``
+    (its :class:`ContactProblem`, ``st.problem``): the runner's corrector from the branch
+    state's surface with its contact set (nodes 0..k-1 held, the edge node k too), so that
+    the committed state is a solution of the runner's own equations (paper 1 eqs 6, 8) with
+    the runner's convergence and stability flags. Returns (problem, State)."""
+    from .complementarity import solve_complementarity
+
+    pb = st.problem
+    active = np.asarray(st.h <= pb.sigma * (1 + 1e-12))
+    new = solve_complementarity(pb, d, st.w, tol=tol, max_iter=max_iter, active0=active)
+    return pb, new
+
+
+def as_runner_state(st, tol):
+    """The branch state ``st`` as the runner's State on its scaled grid, as it is (no
+    corrector: at the fold the runner's Jacobian at fixed d is singular, its Newton does not
+    converge there): nodes 0..k held (the edge node at sigma with p_c,k = 0), each law's
+    pressure on the scaled problem, the runner's residual max |w - C (P - p_c)| and
+    stability test (:func:`~femadh.contact.stability.is_stable`, marginal at a fold);
+    converged where that residual is within ``tol`` (m). Returns (problem, State)."""
+    from .state import State
+    from .stability import is_stable
+
+    pb = st.problem
+    n = st.w.size
+    A = np.zeros(n, bool)
+    A[:int(np.count_nonzero(st.h <= pb.sigma))] = True
+    p_eff = pb.effect_pressures(st.h)
+    p_net = sum(p_eff.values()) - st.p_c
+    res = float(np.max(np.abs(st.w - pb.C @ p_net)))
+    r_c = math.sqrt(float(pb.areas[A].sum()) / math.pi)
+    return pb, State(st.d, st.w.copy(), st.h.copy(), p_eff, st.p_c.copy(), A, r_c,
+                     st.n_iter, res, res <= tol,
+                     bool(is_stable(pb, st.h, ~A)))

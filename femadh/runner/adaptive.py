@@ -343,8 +343,9 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         pil = (None if resume and holds_sweep_run(out_dir)
                else route_for(scene, first.follow is not None))
         if pil is not None:
-            return run_edge_route(scene, out_dir, pil, figures=figures, overwrite=overwrite,
-                                  resume=resume, folder_id=scene_id(scene))
+            return run_edge_route(scene, out_dir, pil, trial=first, figures=figures,
+                                  overwrite=overwrite, resume=resume,
+                                  folder_id=scene_id(scene), progress=progress)
     if first.operator is None:
         failure = _too_many_nodes(first)
     else:

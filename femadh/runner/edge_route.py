@@ -34,11 +34,21 @@ What the route gives (:func:`run_edge_route`): the max adhesion (the finest memb
 F_ex on the runner's analysis disk, where on the branch it is, its edge radius) and the
 displacement-controlled pull-off (the fold's d, ``jump_out_d_m``), each with its estimated
 error (Richardson of the family, the force beyond the analysis radius, the solver's
-tolerance, as the runner's estimate has them); the finest member's branch states as the
-curve "retract_edge_branch" (each state on its own scaled grid; d decreasing from deep
-contact to the fold). Not given (yet): the approach, the jump-in, the jump-out's landing and
-the separated retract beyond it, the surface fields - the headline numbers read from those
-(jump_in_d_m, hysteresis_J, the deepest forces) are absent, and the summary says so.
+tolerance, as the runner's estimate has them); and the sweep's outputs
+(:mod:`femadh.runner.edge_sweep`): the approach by the sweep on the adaptive grid's first
+member with its jump-in, the retract's states at the sweep's separations on the finest
+member's scaled grids (each polished by the runner's corrector), the jump-out landed from
+the fold and the separated retract stepped - curve.csv, fields.csv, jumps.csv and the
+figures as any run writes them. The numbers read off the approach and the jumps
+(jump_in_d_m, hysteresis_J, the deepest forces) are computed, not estimated: the accuracy
+record lists what is judged (``judged``), a note says so. ``[solver] route = "peak"`` asks
+for the max adhesion and the pull-off alone (a study that reads only these: the stiction
+map): no approach, the branch's own states as the curve "retract_edge_branch" (each on its
+own scaled grid, from deep contact to the fold); so does a run whose accuracy the family
+does not reach (it fails in one line before the sweep's outputs).
+
+A stopped routed run keeps the states it committed (each row of the files whole) and says
+so; --resume starts the route over (its family is not checkpointed).
 """
 from dataclasses import dataclass, field
 import math
@@ -224,6 +234,7 @@ def route_for(scene, follows):
         return None
     if route == "auto" and not follows:
         return None
+    # ("edge" and "peak" pilot wherever the route can carry the scene)
     try:
         with phase("edge route: pilot"):
             pil = pilot(scene)
@@ -316,16 +327,28 @@ def _nodes_of(a0, c, h, h0):
     return g.n
 
 
+#: the prefix that makes a result's warning a note (printed "note: ..."; the report's NOTE):
+#: what the route computes and judges is normal output, not a warning
+NOTE = "error estimate: "
+#: what the route judges, said in the result's notes
+JUDGED = (NOTE + "edge route: the max adhesion and the pull-off separation (jump_out_d_m) are "
+          "judged by the family of edge grids; the approach (jump_in_d_m, the deepest "
+          "forces) is the sweep's on the adaptive grid's first member and the hysteresis "
+          "is read off both jumps: computed, not estimated")
+
+
 #: the curve's name for the branch's own states (each on its own scaled grid; not the
-#: sweep's separations)
+#: sweep's separations): the curve of a run that asks for the max adhesion alone
+#: ([solver] route = "peak") or whose accuracy the family does not reach
 CURVE = "retract_edge_branch"
-#: what the route does not give, said in the result's warnings
-MISSING = ("edge route: the curve is the retract's branch traced in its edge radius (its "
-           "own states, each on its own scaled grid, from deep contact to the pull-off "
-           "fold); the approach, the jump-in, the jump-out's landing and the separated "
-           "retract beyond it, and the surface fields are not computed on this route: the "
-           "headline numbers read from them (jump_in_d_m, hysteresis_J, the deepest forces) "
-           "are absent")
+#: what such a run does not give, said in the result's notes
+MISSING = (NOTE + "edge route, max adhesion alone ([solver] route = 'peak', or an accuracy "
+           "the family does not reach): the curve is "
+           "the retract's branch traced in its edge radius (its own states, each on its own "
+           "scaled grid, from deep contact to the pull-off fold); the approach, the jump-in, "
+           "the jump-out's landing and the separated retract beyond it, and the surface "
+           "fields are not computed: the headline numbers read from them (jump_in_d_m, "
+           "hysteresis_J, the deepest forces) are absent")
 
 
 def _curve(br, r, a_run):
@@ -365,22 +388,124 @@ def _tolerance_part(br, scene):
     return float(math.pi * scene.analysis_radius ** 2 * scene.tolerance * P1.max())
 
 
-def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume=False,
-                   folder_id=None):
+def _peak_only(scene, res, br, r, value):
+    """The headline and curve of a run of the max adhesion alone ([solver] route = "peak"):
+    the branch's own states to the fold or to the last one the runner's stability test
+    keeps (:func:`_curve`), the jump-out at the fold where the sweep reaches it."""
+    from .headline import headline
+
+    best = r.best
+    res.nodes = br.nodes0 * best.lam
+    res.branches[CURVE], lost = _curve(br, r, scene.analysis_radius)
+    if lost is not None and lost.c >= best.c:
+        raise ConvergenceError(
+            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (c = "
+            f"{lost.c:.6g} m): it is not the retract's", d=best.d, residual=math.nan,
+            n_iter=0)
+    _below_sweep(scene, best)
+    hl = res.headline = headline(res, br._ref)
+    for k in [k for k in hl if k.startswith("r_c_at_zero_force")]:
+        del hl[k]
+    _max_adhesion(hl, value, best, CURVE)
+    if lost is None and r.fold.d > max(scene.d_values):
+        _fold_beyond(scene, res, r)
+    elif lost is None:
+        hl["jump_out_d_m"] = float(r.fold.d)
+    else:
+        res.warnings.append(
+            f"edge route: the branch stops being stable (the runner's test, contact set "
+            f"held) at c = {lost.c * 1e6:.4g} um, d = {lost.d * 1e9:.5g} nm, before its fold "
+            f"(d = {r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
+            f"{res.branches[CURVE]['d_m'][-1] * 1e9:.5g} nm and that; jump_out_d_m is not "
+            "given")
+    res.warnings.append(MISSING)
+
+
+def _full_sweep(scene, res, br, r, sink, value):
+    """The headline of a routed run with the sweep's outputs: the retract at the sweep's
+    separations into ``sink`` (:func:`femadh.runner.edge_sweep.trace_retract_sweep`, after
+    the approach), the headline read off both branches and their jumps, the max adhesion
+    and the jump-out the family's."""
+    from .edge_sweep import trace_retract_sweep
+    from .headline import headline
+
+    best = r.best
+    t1 = time.perf_counter()
+    info = trace_retract_sweep(scene, sink, br, r)
+    res.timings["retract_s"] = time.perf_counter() - t1
+    if info["lost"] is not None and info["lost"] <= best.d:
+        raise ConvergenceError(
+            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
+            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (the "
+            f"runner's test at d = {info['lost'] * 1e9:.6g} nm): it is not the retract's",
+            d=best.d, residual=math.nan, n_iter=0)
+    _below_sweep(scene, best)
+    hl = res.headline = headline(res, br._ref)
+    _max_adhesion(hl, value, best, "retract")
+    hl.pop("jump_out_d_m", None)
+    if info["lost"] is not None:
+        raise ConvergenceError(
+            f"edge route: the branch stops being stable (the runner's test) at d = "
+            f"{info['lost'] * 1e9:.6g} nm, before its fold (d = {r.fold.d * 1e9:.6g} nm): the "
+            "retract leaves the branch there and unzips on a fixed grid, which the route "
+            "does not follow; [solver] route = 'grid' sweeps it (the family's max adhesion, "
+            f"on the stable side: {value:.6g} N at d = {best.d * 1e9:.6g} nm)",
+            d=info["lost"], residual=math.nan, n_iter=0)
+    if info["departed"] is None:
+        _fold_beyond(scene, res, r)
+    else:
+        hl["jump_out_d_m"] = float(r.fold.d)
+    res.warnings.append(JUDGED)
+    return info["states"]
+
+
+def _below_sweep(scene, best):
+    if best.d <= min(scene.d_values):
+        raise ConvergenceError(
+            f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
+            f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
+            "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
+
+
+def _max_adhesion(hl, value, best, branch):
+    """Where the family's max adhesion ``value`` (N) is, into the headline ``hl`` (the value
+    itself: :func:`_route`, once the branch's part is done)."""
+    hl["d_at_max_adhesion_m"] = float(best.d)
+    hl["max_adhesion_branch"] = branch
+    hl["r_c_at_max_adhesion_m"] = best.c
+
+
+def _fold_beyond(scene, res, r):
+    res.warnings.append(
+        f"{NOTE}edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond the "
+        f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
+        "jump_out_d_m is not given")
+
+
+def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=False,
+                   resume=False, folder_id=None, progress=False):
     """Run ``scene`` by the edge route (see the module docstring) from its pilot ``pil``:
-    the family to the scene's target accuracy (``scene.target_accuracy``), the headline
-    numbers with their errors, the branch's curve; written to ``out_dir`` (summary.json,
-    curve.csv) where given. Returns a ContactResult: "converged" where the estimate meets
-    the target, else "failed" with one line saying what the family reached (failure kind
-    "accuracy"). A failed trace ends the run "failed" naming the step."""
+    the approach on the adaptive grid's member ``trial`` (:mod:`femadh.runner.edge_sweep`),
+    the family to the scene's target accuracy (``scene.target_accuracy``), the retract at
+    the sweep's separations on the finest member's scaled grids with its jump-out landed,
+    the headline numbers with their errors; written to ``out_dir`` (summary.json,
+    curve.csv, fields.csv, jumps.csv, figures) as they are computed. Returns a
+    ContactResult: "converged" where the estimate meets the target, else "failed" with one
+    line saying what the family reached (failure kind "accuracy"). A failed trace ends the
+    run "failed" naming the step; a stopped one keeps the states it committed."""
     from ..scene import scene_id
+    from .edge_sweep import approach_problem, trace_approach
     from .lifecycle import lifecycle
     from .result import ContactResult, contact_summary
+    from .sink import Sink
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
     short = None
     res = ContactResult(scene.name, scene)
+    # the route is recorded from the start (a run stopped in it says which it took)
+    res.grid = {"kind": "edge-branch", "route": "edge-branch"}
     folder = None
     if out_dir is not None:
         from ..io.run_folder import RunFolder
@@ -397,26 +522,53 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
         from .estimates import GuardError
 
         with lifecycle(res, write, failures=(ConvergenceError, GuardError, ValueError),
-                       t0=t0):
-            short = _route(scene, res, pil, target)
-            if folder is not None:
-                res.to_csv(folder.path / "curve.csv")
+                       t0=t0) as life:
+            t1 = time.perf_counter()
+            user = scene
+            scene, fam, grown = _grown_family(scene, pil, target)
+            res.timings["family_s"] = time.perf_counter() - t1
+            res.timings["pilot_s"] = pil.seconds
+            if getattr(scene, "route", "auto") == "peak" or not _met(scene, fam, target):
+                # the max adhesion alone (asked so, or the accuracy asked is out of the
+                # family's reach: the run fails in one line before the sweep's outputs)
+                short = _route(scene, res, pil, target, None, fam, grown)
+                if folder is not None:
+                    res.to_csv(folder.path / "curve.csv")
+            else:
+                t1 = time.perf_counter()
+                tsc, problem = approach_problem(user, trial)
+                res.nodes = problem.grid.nodes.copy()
+                writer = None
+                if folder is not None:
+                    from ..io.writers import ContactWriter
+
+                    writer = ContactWriter(folder, problem, vtk=scene.vtk,
+                                           run_id=scene_id(scene))
+                    life.cleanup(writer.close)
+                sink = Sink(problem, res, writer, progress)
+                trace_approach(tsc, problem, sink)
+                res.timings["approach_s"] = time.perf_counter() - t1
+                short = _route(scene, res, pil, target, sink, fam, grown)
+                sink.close()
         if short is not None and res.status == "converged":
             # the estimate does not support the request: one line, what was reached
             res.status, res.error, res.failure_kind = "failed", short, "accuracy"
             write()
         if res.status in ("interrupted", "time limit"):
-            # (the CLI's line says a stopped run's states are kept: not on this route)
-            res.warnings.append("resume: the edge route keeps no states of a stopped run (its "
-                                "family is not checkpointed); --resume traces its pilot and "
-                                "family again")
+            res.warnings.append(
+                "resume: the edge route keeps no states of a stopped run of the max adhesion "
+                "alone (route 'peak'); --resume traces its pilot and family again"
+                if getattr(scene, "route", "auto") == "peak" else
+                "resume: the states the edge route committed before the stop are in the "
+                "folder's files (each row whole); --resume starts the route over (its "
+                "family is not checkpointed)")
             write()
         if (figures and folder is not None and res.status in ("converged", "failed")
-                and len(res.branches.get(CURVE, {}).get("d_m", ()))):
+                and any(len(b.get("d_m", ())) for b in res.branches.values())):
             from .figures import draw_figures
 
-            # every run comes with its figure (the branch's curve), as on the sweep path
-            # (runner/adaptive.py: a signal stops them at once)
+            # every run comes with its figure, as on the sweep path (runner/adaptive.py: a
+            # signal stops them at once)
             with phase("figures"):
                 draw_figures(res, folder)
             write()
@@ -426,68 +578,77 @@ def run_edge_route(scene, out_dir, pil, *, figures=True, overwrite=False, resume
     return res
 
 
-def _route(scene, res, pil, target):
-    """Fill ``res`` (headline, estimates, curve, grid, accuracy) from the family; returns the
-    one-line failure where the estimate does not meet ``target`` (else None)."""
+def _error_parts(scene, fam):
+    """The max adhesion's error parts (N): the family's Richardson (grid), the force beyond
+    the analysis radius on the undeformed paraboloid at the largest force's d (tail: the
+    runner's F_ex is read on its disk, as here) and the solver's tolerance."""
+    br, r = fam.finest
+    R, a_run = scene.sphere.radius, scene.analysis_radius
+    h_a = np.array([r.best.d + scene.sphere.shape(a_run)])
+    tail = float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
+                                        for e in scene.effects.values()))
+    return {"grid": fam.error, "tail": tail, "tolerance": _tolerance_part(br, scene)}
+
+
+#: doublings of the analysis radius the route may make where the force beyond it is what
+#: falls short (the sweep's adaptive loop doubles it likewise, runner/adaptive.py _decide)
+MAX_DISK_DOUBLINGS = 3
+
+
+def _grown_family(scene, pil, target):
+    """(scene, family, radii grown through): the family on the scene's analysis radius, and
+    where the force beyond it exceeds the share of the target the adaptive loop allows it
+    (its SAFETY), on twice that radius - as the sweep's loop grows its disk - while it stays
+    below half the sphere's radius (eq 4's paraboloid is a sphere only for r << R; the
+    whole radius for a paraboloid profile) and at most MAX_DISK_DOUBLINGS times."""
+    from .adaptive import SAFETY
+    from .estimates import variant
+
+    fam = family(scene, pil, target)
+    grown = []
+    cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
+    while len(grown) < MAX_DISK_DOUBLINGS:
+        tail = abs(_error_parts(scene, fam)["tail"])
+        a = scene.analysis_radius
+        if tail <= SAFETY * target * abs(fam.value) or not 2 * a < cap:
+            break
+        scene = variant(scene, radius=2 * a)
+        grown.append(2 * a)
+        with phase(f"edge route: analysis radius {2 * a * 1e6:.3g} um"):
+            fam = family(scene, pil, target)
+    return scene, fam, grown
+
+
+def _met(scene, fam, target):
+    """Whether the max adhesion's estimated relative error (its parts added in magnitude)
+    is within ``target``."""
+    return sum(abs(v) for v in _error_parts(scene, fam).values()) <= target * abs(fam.value)
+
+
+def _route(scene, res, pil, target, sink, fam, grown=()):
+    """Fill ``res`` (retract, headline, estimates, grid, accuracy) from the family ``fam``
+    and the retract's sweep into ``sink`` (None: the branch's own curve, the max adhesion
+    alone); ``scene`` with the analysis radius the family was read on (``grown``: the radii
+    it grew through, :func:`_grown_family`). Returns the one-line failure where the
+    estimate does not meet ``target`` (else None)."""
     from .headline import work_of_adhesion as W_of
-    from ..reference import dmt_pull_off, jkr_pull_off
 
     a_run = scene.analysis_radius
-    # the route is recorded from the start (a run stopped in the family says which it took)
-    res.grid = {"kind": "edge-branch", "route": "edge-branch"}
-    t1 = time.perf_counter()
-    fam = family(scene, pil, target)
-    res.timings["family_s"] = time.perf_counter() - t1
-    res.timings["pilot_s"] = pil.seconds
     br, r = fam.finest
-    res.nodes = br.nodes0 * r.best.lam
-    res.branches[CURVE], lost = _curve(br, r, a_run)
-    hl = res.headline
     best = r.best
-    if lost is not None and lost.c >= best.c:
-        raise ConvergenceError(
-            f"edge route: the largest force's state (c = {best.c:.6g} m, d = "
-            f"{best.d * 1e9:.6g} nm) lies beyond where the branch stops being stable (c = "
-            f"{lost.c:.6g} m): it is not the retract's", d=best.d, residual=math.nan,
-            n_iter=0)
-    hl["max_adhesion_N"] = fam.value
-    hl["d_at_max_adhesion_m"] = float(best.d)
-    hl["max_adhesion_branch"] = CURVE
-    hl["r_c_at_max_adhesion_m"] = best.c
-    if best.d <= min(scene.d_values):
-        raise ConvergenceError(
-            f"edge route: the largest force's state (d = {best.d * 1e9:.6g} nm) lies below "
-            f"the sweep's deepest separation ({min(scene.d_values) * 1e9:.6g} nm): not a state "
-            "the sweep reaches", d=best.d, residual=math.nan, n_iter=0)
-    if lost is None and r.fold.d > max(scene.d_values):
-        res.warnings.append(
-            f"edge route: the retract's fold (d = {r.fold.d * 1e9:.4g} nm) lies beyond the "
-            f"sweep's end ({max(scene.d_values) * 1e9:.5g} nm): the sweep ends in contact, "
-            "jump_out_d_m is not given")
-    elif lost is None:
-        hl["jump_out_d_m"] = float(r.fold.d)
+    if sink is None:
+        _peak_only(scene, res, br, r, fam.value)
+        committed = None
     else:
-        # the retract leaves the branch before its fold: the jump-out is there, between the
-        # last stable state and the first unstable one (its landing is not computed)
-        res.warnings.append(
-            f"edge route: the branch stops being stable (the runner's test, contact set "
-            f"held) at c = {lost.c * 1e6:.4g} um, d = {lost.d * 1e9:.5g} nm, before its fold "
-            f"(d = {r.fold.d * 1e9:.5g} nm): the retract jumps out between d = "
-            f"{res.branches[CURVE]['d_m'][-1] * 1e9:.5g} nm and that; jump_out_d_m is not "
-            "given")
+        committed = _full_sweep(scene, res, br, r, sink, fam.value)
+    hl = res.headline
+    hl["max_adhesion_N"] = fam.value
     W = W_of(br._ref)
     R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
-    hl["dmt_pull_off_N"] = dmt_pull_off(R, W)
-    hl["jkr_pull_off_N"] = jkr_pull_off(R, W)
-    # the errors: the family's Richardson (grid), the force beyond the analysis radius on the
-    # undeformed paraboloid (tail: the runner's F_ex is read on its disk, as here) and the
-    # solver's tolerance - added in magnitude, as the runner's estimate adds its parts
-    h_a = np.array([best.d + scene.sphere.shape(a_run)])
-    tail = float(-2 * math.pi * R * sum(np.asarray(e.energy(h_a))[0]
-                                        for e in scene.effects.values()))
-    parts = {"max_adhesion_N": {"grid": fam.error, "tail": tail,
-                                "tolerance": _tolerance_part(br, scene)},
+    # the errors (:func:`_error_parts`) added in magnitude, as the runner's estimate adds
+    # its parts
+    parts = {"max_adhesion_N": _error_parts(scene, fam),
              "jump_out_d_m": {"grid": float(fam.fold_error)}}
     parts = {k: v for k, v in parts.items() if k in hl}
     for k, comp in parts.items():
@@ -498,6 +659,9 @@ def _route(scene, res, pil, target):
     res.grid = {"kind": "edge-branch", "route": "edge-branch", "nodes": fam.nodes[-1],
                 "analysis_radius_m": float(br.radius(best)),
                 "runner_analysis_radius_m": a_run, "edge_node": br.k,
+                "analysis_radius_grown_m": list(grown),
+                "approach_nodes": None if committed is None else int(res.nodes.size),
+                "retract_branch_states": committed,
                 "family_spacings_m": fam.h, "family_nodes": fam.nodes,
                 "family_seconds": fam.seconds, "observed_order": fam.order,
                 "extrapolation_N": fam.extrapolation, "fold_order": fam.fold_order,
@@ -508,8 +672,8 @@ def _route(scene, res, pil, target):
                 "worst_complementarity": list(r.worst_complementarity)}
     res.accuracy = {"target": target, "met": bool(rel <= target), "adaptive": True,
                     "route": "edge-branch", "nodes": fam.nodes[-1], "members": len(fam.h),
-                    "estimated_rel_error": rel, "stop": fam.stop}
-    res.warnings.append(MISSING)
+                    "estimated_rel_error": rel, "stop": fam.stop,
+                    "judged": sorted(parts)}
     # the largest adhesion within the smooth laws' bounds, as every run's (a GuardError)
     from .estimates import guard_bounds
 
@@ -520,8 +684,11 @@ def _route(scene, res, pil, target):
         # the family grows only the grid part's resolution: say which part is too large
         why = {"grid": f"stopped: {fam.stop}",
                "tail": (f"the largest part is the force beyond the analysis radius "
-                        f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N): a wider "
-                        f"[solver] analysis_radius (now {a_run:.3g} m) would reduce it"),
+                        f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N) of "
+                        f"{a_run:.3g} m" + (f" (grown {len(grown)} times)" if grown else "")
+                        + f": the route grows the disk at most {MAX_DISK_DOUBLINGS} times "
+                        "and below half the sphere's radius; a wider [solver] "
+                        "analysis_radius would reduce it"),
                "tolerance": (f"the largest part is the solver tolerance's "
                              f"({abs(comp['tolerance']):.3g} N): a tighter [solver] tolerance "
                              "would reduce it")}[big]

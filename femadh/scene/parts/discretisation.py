@@ -87,13 +87,16 @@ SOLVER = Table("solver", "Discretisation and solver.", (
         default=None, lo=0.0),
     Key("route", "choice", "How a sigma-gap complementarity scene's retract is solved: "
         "'auto' - traced in its edge radius (femadh/runner/edge_route.py: the max adhesion "
-        "and the pull-off with their errors from a family of edge grids, not the approach, "
-        "jump-in or surface fields) where the adaptive grid would follow the contact edge "
-        "and a pilot finds the pull-off fold, else the sweep; 'edge' - the edge route "
-        "wherever the pilot finds a fold (a request of the max adhesion only, e.g. a stiction "
-        "map); 'grid' - always the sweep. A scene the route cannot carry (eq 20 adhesion, FE "
-        "or coated body, arclength, an instrument, [solver] nodes or [solver.grid]) keeps "
-        "the sweep whatever its route.", default="auto", choices=("auto", "edge", "grid")),
+        "and the pull-off with their errors from a family of edge grids; the approach by "
+        "the sweep, the retract's states at the sweep's separations, its jump-out landed) "
+        "where the adaptive grid would follow the contact edge and a pilot finds the "
+        "pull-off fold, else the sweep; 'edge' - the edge route wherever the pilot finds a "
+        "fold; 'peak' - as 'edge' but the max adhesion and the pull-off alone (no approach, "
+        "no states at the sweep's separations: a study that reads only these, e.g. a "
+        "stiction map); 'grid' - always the sweep. A scene the route cannot carry (eq 20 "
+        "adhesion, FE or coated body, arclength, an instrument, [solver] nodes or "
+        "[solver.grid]) keeps the sweep whatever its route.", default="auto",
+        choices=("auto", "edge", "peak", "grid")),
     Key("grid", "custom", "An explicit banded grid, see [solver.grid].", default=None,
         parse=lambda r, raw, path: None if raw is None else r.read(GRID, raw, path),
         expect="a table (see [solver.grid])"),
@@ -141,7 +144,7 @@ class Discretisation:
     time_limit : float or None
         Wall time (s) after which a run stops cleanly (not in the scene's id).
     route : str
-        "auto", "edge" or "grid": how a sigma-gap retract is solved
+        "auto", "edge", "peak" or "grid": how a sigma-gap retract is solved
         (:mod:`femadh.runner.edge_route`).
     """
 
