@@ -33,6 +33,11 @@ BANDED_MAX_NODES = 4000
 #: within minutes)
 CONTINUATION_MAX_NODES = 1600
 
+#: a refinement aims at this fraction of the target where the estimate is far from it (from
+#: about 3.7x the target on; nearer it :func:`femadh.runner.adaptive._safety` aims closer),
+#: and a tail above it grows the disk (the sweep's loop and the edge route alike)
+SAFETY = 0.6
+
 
 @dataclass(frozen=True)
 class Budget:

@@ -48,15 +48,12 @@ from ..discretisation import GridFamily, plan_grid
 from ..discretisation.family import MAX_NODES
 from ..discretisation.plan import safe_spacing
 from ..elastic.grid import NodeBudgetError
-from ..estimate.refine import Budget, refine_until_met
+from ..estimate.refine import SAFETY, Budget, refine_until_met
 from .accuracy import REFINE_RADIUS
 from .result import STOPPED
 
 #: runs (refinements + 1) an adaptive run may make
 MAX_TRIALS = 5
-#: the refined spacing aims at this fraction of the target where the estimate is far from it
-#: (from about 3.7x the target on; nearer it, :func:`_safety` aims closer)
-SAFETY = 0.6
 #: assumed convergence order of the headline numbers in the band spacing (local orders
 #: 1.2-2.2 on the Fig 3 scene's family; the estimate's envelope order): the first member's
 #: plan for a request other than REFERENCE_ACCURACY, and the order where the estimate did not

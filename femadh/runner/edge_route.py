@@ -601,7 +601,7 @@ def _grown_family(scene, pil, target):
     (its SAFETY), on twice that radius - as the sweep's loop grows its disk - while it stays
     below half the sphere's radius (eq 4's paraboloid is a sphere only for r << R; the
     whole radius for a paraboloid profile) and at most MAX_DISK_DOUBLINGS times."""
-    from .adaptive import SAFETY
+    from ..estimate.refine import SAFETY
     from .estimates import variant
 
     fam = family(scene, pil, target)
@@ -644,7 +644,6 @@ def _route(scene, res, pil, target, sink, fam, grown=()):
     hl = res.headline
     hl["max_adhesion_N"] = fam.value
     W = W_of(br._ref)
-    R = scene.sphere.radius
     hl["work_of_adhesion_J_per_m2"] = W
     # the errors (:func:`_error_parts`) added in magnitude, as the runner's estimate adds
     # its parts
