@@ -3,6 +3,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy import linalg
 
 from femadh.elastic import GreenOperator, RadialGrid, disk_displacement
 from femadh.reference import hertz_displacement, uniform_disk_displacement
@@ -46,8 +47,20 @@ def test_uniform_disk_is_reproduced_exactly_by_annuli():
 
 def test_stiffness_inverts_compliance():
     op = GreenOperator(RadialGrid.uniform(1e-6, 80), E_STAR)
-    # condition number of C is O(N) ~ 1e2, times double precision: measured 2.2e-15
+    # condition number of C is O(N) ~ 1e2, times double precision: measured 1.3e-15
+    # (getri; 2.2e-15 by solving for the identity's columns)
     assert np.max(np.abs(op.stiffness @ op.compliance - np.eye(80))) <= 2e-14
+
+
+def test_stiffness_of_a_broken_compliance_is_an_error_not_nans():
+    """A NaN in C (a failed kernel) stops at K = C^-1 with the operator's size, never as a K
+    full of NaNs that a solver would iterate on."""
+    op = GreenOperator(RadialGrid.uniform(1e-6, 12), E_STAR)
+    op.compliance = op.compliance.copy()
+    op.compliance[3, 5] = np.nan
+    with pytest.raises(FloatingPointError, match="12-node"), \
+            pytest.warns(linalg.LinAlgWarning):          # LAPACK's rcond of it: 0
+        op.stiffness
 
 
 def test_hertz_displacement_converges_with_observed_order():
