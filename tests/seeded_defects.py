@@ -1875,6 +1875,18 @@ DEFECTS = [
     D("greenop_m_zero", "AGM: m = 0 divides 0 by 0 (no floor at the smallest normal)",
       "femadh/elastic/green.py",
       (("ml = np.maximum(m[low], np.finfo(float).tiny)", "ml = m[low]"),)),
+    D("greenop_block_edge_side", "block assembly: a node on its annulus' inner edge taken "
+      "outside its own disk", "femadh/elastic/green.py",
+      (('first_in = np.searchsorted(e, nodes, side="left")',
+        'first_in = np.searchsorted(e, nodes, side="right")'),)),
+    D("greenop_block_bounds_swapped", "block assembly: the block's inside/outside column "
+      "bounds taken from its last and first rows", "femadh/elastic/green.py",
+      (("lo, hi = first_in[i0], first_in[i1 - 1]", "lo, hi = first_in[i1 - 1], first_in[i0]"),)),
+    D("greenop_block_band_strict", "block assembly's ragged band: r < a inside (r = a outside)",
+      "femadh/elastic/green.py", (("inside = a >= rr", "inside = a > rr"),)),
+    D("greenop_block_band_outside_dropped", "block assembly: the ragged band's outside "
+      "pairs left at zero", "femadh/elastic/green.py",
+      (("            band[~inside] = _outside(rr[~inside], a[~inside])\n", ""),)),
     D("greenop_stiffness_unguarded", "K = C^-1 of a compliance with a NaN returned as NaNs",
       "femadh/elastic/operator.py",
       (("if not np.all(np.isfinite(self._stiffness)):", "if False:"),)),

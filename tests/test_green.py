@@ -45,6 +45,26 @@ def test_uniform_disk_is_reproduced_exactly_by_annuli():
     assert np.max(np.abs(op.displacement(p) - exact)) <= 1e-15 * exact.max()
 
 
+@pytest.mark.parametrize("grid", [
+    RadialGrid.uniform(1e-6, 2),
+    RadialGrid.uniform(1e-6, 63),
+    RadialGrid.uniform(1e-6, 129),                   # BLOCK_ROWS = 64: two blocks and one row
+    RadialGrid.banded(5e-5, 2e-8, (2e-6, 8e-6), 3e-6),
+    RadialGrid.graded(1e-5, 1e-7, 3e-6),
+    RadialGrid.from_nodes(np.concatenate([[0.0], np.sort(
+        np.random.default_rng(3).random(300)) ** 3]), 1.01),
+    # nodes on their annuli's inner edges (r_k == e_k): inside their own disk, r <= a
+    RadialGrid(np.array([0.0, 1.0, 2.0, 2.5, 4.0]), np.array([0.0, 1.0, 2.0, 2.5, 3.0, 5.0])),
+], ids=["n2", "n63", "n129", "banded", "graded", "random", "nodes_on_edges"])
+def test_block_assembly_is_the_difference_of_disks_bit_for_bit(grid):
+    """C_ij = w(r_i; e_j+1) - w(r_i; e_j): the operator's block assembly against the whole
+    matrix of disk_displacement at once (masks over every node-edge pair), identical bits."""
+    w = disk_displacement(grid.nodes[:, None], grid.edges[None, :], E_STAR)
+    c = GreenOperator(grid, E_STAR).compliance
+    assert c.shape == (grid.n, grid.n)
+    assert np.array_equal(c, np.diff(w, axis=1)) and np.all(np.isfinite(c))
+
+
 def test_stiffness_inverts_compliance():
     op = GreenOperator(RadialGrid.uniform(1e-6, 80), E_STAR)
     # condition number of C is O(N) ~ 1e2, times double precision: measured 1.3e-15
