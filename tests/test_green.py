@@ -55,7 +55,11 @@ def test_uniform_disk_is_reproduced_exactly_by_annuli():
         np.random.default_rng(3).random(300)) ** 3]), 1.01),
     # nodes on their annuli's inner edges (r_k == e_k): inside their own disk, r <= a
     RadialGrid(np.array([0.0, 1.0, 2.0, 2.5, 4.0]), np.array([0.0, 1.0, 2.0, 2.5, 3.0, 5.0])),
-], ids=["n2", "n63", "n129", "banded", "graded", "random", "nodes_on_edges"])
+    # ... and such nodes first in a block of rows (rows 64 and 128) and inside one (row 100)
+    RadialGrid(np.arange(130.0), np.concatenate([[0.0], np.where(
+        np.isin(np.arange(1, 131), (64, 100, 128)), np.arange(1, 131), np.arange(1, 131) - 0.5)])),
+], ids=["n2", "n63", "n129", "banded", "graded", "random", "nodes_on_edges",
+        "nodes_on_edges_blocks"])
 def test_block_assembly_is_the_difference_of_disks_bit_for_bit(grid):
     """C_ij = w(r_i; e_j+1) - w(r_i; e_j): the operator's block assembly against the whole
     matrix of disk_displacement at once (masks over every node-edge pair), identical bits."""
