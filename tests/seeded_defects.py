@@ -47,10 +47,10 @@ D = Defect
 DEFECTS = [
     # -- elastic operators
     D("green_inside", "disk displacement inside the load +2 %", "femadh/elastic/green.py",
-      (("w[inside] = 4.0 * a[inside] / math.pi", "w[inside] = 4.08 * a[inside] / math.pi"),)),
+      (("return 4.0 * a / math.pi * special.ellipe", "return 4.08 * a / math.pi * special.ellipe"),)),
     D("green_outside", "disk displacement outside the load: wrong hypergeometric parameter",
       "femadh/elastic/green.py",
-      (("special.hyp2f1(0.5, 0.5, 2.0, m_out)", "special.hyp2f1(0.5, 0.5, 2.5, m_out)"),)),
+      (("special.hyp2f1(0.5, 0.5, 2.0, (a / r) ** 2)", "special.hyp2f1(0.5, 0.5, 2.5, (a / r) ** 2)"),)),
     D("fe_hoop_strain", "FE weak form: hoop strain u_r/(2r)", "femadh/elastic/fe/weakform.py",
       (("return g[0, 0], g[1, 1], u[0] / r,", "return g[0, 0], g[1, 1], u[0] / (2 * r),"),)),
     D("fe_shear_term", "FE weak form: shear term counted once", "femadh/elastic/fe/weakform.py",
@@ -788,8 +788,8 @@ DEFECTS = [
       "hard gap)", "femadh/laws/asperity.py", (("return self.sigma + 5 * self.width",
                                                 "return self.sigma - 5 * self.width"),)),
     D("green_outside_parameter", "disk displacement outside the load: parameter a/r, not (a/r)^2",
-      "femadh/elastic/green.py", (("m_out = (a[outside] / r[outside]) ** 2",
-                                   "m_out = (a[outside] / r[outside])"),)),
+      "femadh/elastic/green.py", (("special.hyp2f1(0.5, 0.5, 2.0, (a / r) ** 2)",
+                                   "special.hyp2f1(0.5, 0.5, 2.0, (a / r))"),)),
     D("grid_uniform_spacing", "uniform grid: dr = a/N instead of a/(N - 1/2)",
       "femadh/elastic/grid.py", (("dr = radius / (n - 0.5)", "dr = radius / n"),)),
     D("fe_fields_shear_strain", "FE stress recovery: engineering shear strain (no 1/2)",
@@ -1939,6 +1939,23 @@ DEFECTS = [
       "femadh/cli.py",
       (('                          estimate="peak" if args.no_estimate else True)',
         '                          estimate=True)'),)),
+    # -- the Green operator assembled in blocks of rows, a non-finite stiffness refused
+    #    (branch greenop, seeded_defects_greenop.md)
+    D("greenop_block_edge_side", "block assembly: a node on its annulus' inner edge taken "
+      "outside its own disk", "femadh/elastic/green.py",
+      (('first_in = np.searchsorted(e, nodes, side="left")',
+        'first_in = np.searchsorted(e, nodes, side="right")'),)),
+    D("greenop_block_bounds_swapped", "block assembly: the block's inside/outside column "
+      "bounds taken from its last and first rows", "femadh/elastic/green.py",
+      (("lo, hi = first_in[i0], first_in[i1 - 1]", "lo, hi = first_in[i1 - 1], first_in[i0]"),)),
+    D("greenop_block_band_strict", "block assembly's ragged band: r < a inside (r = a outside)",
+      "femadh/elastic/green.py", (("inside = a >= rr", "inside = a > rr"),)),
+    D("greenop_block_band_outside_dropped", "block assembly: the ragged band's outside "
+      "pairs left at zero", "femadh/elastic/green.py",
+      (("            band[~inside] = _outside(rr[~inside], a[~inside])\n", ""),)),
+    D("greenop_stiffness_unguarded", "K = C^-1 of a compliance with a NaN returned as NaNs",
+      "femadh/elastic/operator.py",
+      (("if not np.all(np.isfinite(self._stiffness)):", "if False:"),)),
 ]
 
 
