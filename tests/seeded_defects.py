@@ -1694,8 +1694,8 @@ DEFECTS = [
         "    bound = abs(f3 - f2)"),)),
     D("eroute_met_absolute", "edge route: the family stops on an absolute error (N) against "
       "the relative target", "femadh/runner/edge_route.py",
-      (("            if fam.error <= target * abs(fam.value):",
-        "            if fam.error <= target:"),)),
+      (("            allowed = target * abs(fam.value)\n",
+        "            allowed = target\n"),)),
     D("eroute_no_stability", "edge route: the curve and the jump-out without the runner's "
       "stability test", "femadh/runner/edge_route.py",
       (("        if not br.stable(s):\n            lost = s",
@@ -1722,8 +1722,8 @@ DEFECTS = [
     #    femadh/contact/sigma_edge.py's placing and polishing, edge_route's modes)
     D("rfull_land_at_fold", "routed sweep: the jump-out landed at the fold's own separation",
       "femadh/runner/edge_sweep.py",
-      (("    resolution = MIN_STEP_FRACTION * step\n    d_land = d_fold + resolution\n",
-        "    resolution = MIN_STEP_FRACTION * step\n    d_land = d_fold\n"),)),
+      (("    d_land = min(d_fold + resolution, min(beyond))\n",
+        "    d_land = d_fold\n"),)),
     D("rfull_landing_committed", "routed sweep: the landing committed as a sweep state",
       "femadh/runner/edge_sweep.py",
       (("            if first[0]:              # the landing: a jump's record, not a sweep state\n"
@@ -1821,8 +1821,8 @@ DEFECTS = [
         "    except ValueError:\n        # a pilot that cannot be traced"),)),
     D("eroute_failure_part", "edge route: an unmet request blames the smallest error part",
       "femadh/runner/edge_route.py",
-      (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
-        '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
+      (('        big = "tail" if fam.stop == "tail" else max(("grid", "tail", "tolerance"),',
+        '        big = "tail" if fam.stop == "tail" else min(("grid", "tail", "tolerance"),'),)),
     # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
     D("lattice_part_off", "estimate: no lattice part where a step's cohesive zone acts at "
       "the contact edge", "femadh/runner/estimates.py",
@@ -1956,6 +1956,17 @@ DEFECTS = [
     D("greenop_stiffness_unguarded", "K = C^-1 of a compliance with a NaN returned as NaNs",
       "femadh/elastic/operator.py",
       (("if not np.all(np.isfinite(self._stiffness)):", "if False:"),)),
+    D("route_family_grid_alone", "edge route: the family stops once its grid part alone meets "
+      "the target (tail and tolerance left out)", "femadh/runner/edge_route.py",
+      (("                allowed -= tail + tolerance\n", ""),)),
+    D("route_family_tail_ignored", "edge route: a tail beyond SAFETY of the target does not "
+      "stop the family", "femadh/runner/edge_route.py",
+      (("                if tail > SAFETY * allowed:", "                if False:"),)),
+    D("route_landing_past_separation", "edge route: the jump-out lands past a sweep "
+      "separation that lies within the landing's resolution of the fold",
+      "femadh/runner/edge_sweep.py",
+      (("    d_land = min(d_fold + resolution, min(beyond))",
+        "    d_land = d_fold + resolution"),)),
 ]
 
 

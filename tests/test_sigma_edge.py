@@ -254,3 +254,27 @@ def test_states_at_the_sweeps_separations(point):
     assert st.active.sum() == br.k + 1 and st.d == r.fold.d
     assert state_at_separation(br, stable, r.fold.d + 1e-10) is None
     assert state_at_separation(br, stable, stable[-1].d - 1e-10) is None
+
+
+def test_a_separation_within_the_landings_resolution_of_the_fold_gets_its_state(point):
+    """The routed retract (femadh/runner/edge_sweep.py) lands the jump-out at most at the
+    sweep's first separation beyond the fold: one within 2^-10 of a step beyond the fold
+    (here 1e-13 m) gets the landing as its state (found by review: it got none, the curve
+    one row short), and every separation has exactly one retract state."""
+    from types import SimpleNamespace
+
+    from femadh.runner.edge_sweep import trace_retract_sweep
+
+    scene, br, r = point
+    d_f = r.fold.d
+    ds = [d_f - 0.5e-9, d_f + 1e-13, d_f + 0.5e-9]
+    states, jumps = [], []
+    sink = SimpleNamespace(plan=lambda branch, n: None, writer=None, problem=None,
+                           state=lambda branch, st: states.append(st.d),
+                           jump=lambda j: jumps.append(j))
+    sc = SimpleNamespace(d_values=ds[::-1], tolerance=scene.tolerance,
+                         max_iter=scene.max_iter)
+    out = trace_retract_sweep(sc, sink, br, r)
+    assert out["departed"] == d_f and len(jumps) == 1
+    assert jumps[0].d_fold == d_f and jumps[0].d_land == ds[1]
+    assert states == ds

@@ -47,9 +47,10 @@ POINT_LIMIT = "90 s"
 #: fold takes the edge route for it alone (femadh/runner/edge_route.py; [solver] route =
 #: "peak": the family's max adhesion and pull-off, no approach or states at the sweep's
 #: separations), the others the adaptive sweep. Not the scene's default "auto": with the
-#: sweep's outputs a routed point costs 20-68 s on the sigma = 0.3 nm column (the approach
-#: by the sweep 4-43 s, the retract's states 12-22 s; load ~5, validation/results/
-#: edge_route.md), and "auto" pilots only where the adaptive grid would follow the edge
+#: sweep's outputs a routed point costs 8.1 and 16.0 CPU-s on the sigma = 0.3 nm column's two
+#: points measured (36-41 s wall at load 4-9: the approach by the sweep 8.7-26 s, the
+#: retract's states 3.9-26 s; validation/results/edge_route.md) against 1.2-1.5 CPU-s for the
+#: max adhesion alone, and "auto" pilots only where the adaptive grid would follow the edge
 #: (the four low-humidity static-band points stay on the sweep and reach POINT_LIMIT)
 ROUTE = "peak"
 

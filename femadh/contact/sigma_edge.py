@@ -529,7 +529,7 @@ def runner_state(st, d, tol, max_iter):
 
 def as_runner_state(st, tol):
     """The branch state ``st`` as the runner's State on its scaled grid, as it is (no
-    corrector: at the fold the runner's Jacobian at fixed d is singular, its Newton does not
+    corrector: at the fold the runner's Jacobian at fixed d is singular, its Newton need not
     converge there): nodes 0..k held (the edge node at sigma with p_c,k = 0), each law's
     pressure on the scaled problem, the runner's residual max |w - C (P - p_c)| and
     stability test (:func:`~femadh.contact.stability.is_stable`, marginal at a fold);

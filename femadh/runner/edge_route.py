@@ -253,7 +253,8 @@ class EdgeFamily:
     """The family of edge grids at the pilot's c*: spacings (m), nodes, the members'
     retracts, and Richardson's order, extrapolation and error of the finest member for the
     max adhesion and the fold's d; ``met`` whether the max adhesion's relative error (grid
-    part) is within the target; ``stop`` why the family stopped growing."""
+    part, or with ``other`` the grid part with the tail and tolerance) is within the target;
+    ``stop`` why the family stopped growing."""
 
     h: list = field(default_factory=list)
     nodes: list = field(default_factory=list)
@@ -275,14 +276,20 @@ class EdgeFamily:
         return self.runs[-1]
 
 
-def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None):
+def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None, other=None):
     """Grow the family h0 / sqrt2^j (node k at the pilot's c*, analysis radius a_run c* /
     (LOW c_fold)) until Richardson's relative error of the max adhesion is at most
     ``target``: MIN_LEVELS members at least, ``max_levels`` (default MAX_LEVELS) at most,
     no member above
     ``max_nodes`` (default the family's node limit). ``on_member(j, branch, retract)`` after
-    each member. Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
+    each member. ``other(fam)``, where given, is the (tail, tolerance) parts (N) of the
+    finest member: the grid part then has the target less those (the run is judged on
+    their sum, as the sweep's loop refines while grid + tail exceed the target), and a tail
+    above SAFETY of the target stops the family (``stop`` "tail": the disk, not the grid,
+    falls short). Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
     where the budget ended first)."""
+    from ..estimate.refine import SAFETY
+
     from ..discretisation.family import MAX_NODES
 
     max_nodes = MAX_NODES if max_nodes is None else max_nodes
@@ -310,7 +317,14 @@ def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None):
             fam.value = F[-1]
             fam.fold_order, fam.fold_extrapolation, fam.fold_error = richardson(
                 fam.h, [x.fold.d for _, x in fam.runs])
-            if fam.error <= target * abs(fam.value):
+            allowed = target * abs(fam.value)
+            if other is not None:
+                tail, tolerance = (abs(v) for v in other(fam))
+                if tail > SAFETY * allowed:
+                    fam.stop = "tail"
+                    break
+                allowed -= tail + tolerance
+            if fam.error <= allowed:
                 fam.met = True
                 fam.stop = "met"
                 break
@@ -604,7 +618,11 @@ def _grown_family(scene, pil, target):
     from ..estimate.refine import SAFETY
     from .estimates import variant
 
-    fam = family(scene, pil, target)
+    def other(fam, scene):
+        parts = _error_parts(scene, fam)
+        return parts["tail"], parts["tolerance"]
+
+    fam = family(scene, pil, target, other=lambda fam: other(fam, scene))
     grown = []
     cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
     while len(grown) < MAX_DISK_DOUBLINGS:
@@ -615,7 +633,7 @@ def _grown_family(scene, pil, target):
         scene = variant(scene, radius=2 * a)
         grown.append(2 * a)
         with phase(f"edge route: analysis radius {2 * a * 1e6:.3g} um"):
-            fam = family(scene, pil, target)
+            fam = family(scene, pil, target, other=lambda fam, sc=scene: other(fam, sc))
     return scene, fam, grown
 
 
@@ -679,14 +697,18 @@ def _route(scene, res, pil, target, sink, fam, grown=()):
     guard_bounds(res, br._ref)
     if rel > target:
         comp = parts["max_adhesion_N"]
-        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))
+        # (a family stopped by its tail names the tail: more members could not meet it)
+        big = "tail" if fam.stop == "tail" else max(("grid", "tail", "tolerance"),
+                                                     key=lambda n: abs(comp[n]))
         # the family grows only the grid part's resolution: say which part is too large
         why = {"grid": f"stopped: {fam.stop}",
                "tail": (f"the largest part is the force beyond the analysis radius "
                         f"({abs(comp['tail']):.3g} N; the grid part {fam.error:.3g} N) of "
                         f"{a_run:.3g} m" + (f" (grown {len(grown)} times)" if grown else "")
                         + f": the route grows the disk at most {MAX_DISK_DOUBLINGS} times "
-                        "and below half the sphere's radius; a wider [solver] "
+                        + ("and below half the sphere's radius" if scene.sphere.profile ==
+                           "sphere" else "and below the sphere's radius")
+                        + "; a wider [solver] "
                         "analysis_radius would reduce it"),
                "tolerance": (f"the largest part is the solver tolerance's "
                              f"({abs(comp['tolerance']):.3g} N): a tighter [solver] tolerance "

@@ -89,7 +89,6 @@ def trace_retract_sweep(scene, sink, br, retract):
     beyond = [d for d in d_all if d > fold.d]
     sink.plan("retract", len(d_all))
     out = {"lost": None, "departed": None, "landing": None, "states": 0}
-    last = None                       # (problem, State) of the last committed state
     with phase("retract (edge branch)"):
         for d in on_branch:
             bst = state_at_separation(br, stable, d)
@@ -108,7 +107,6 @@ def trace_retract_sweep(scene, sink, br, retract):
                 break
             _on_grid(sink, pb)
             sink.state("retract", st)
-            last = (pb, st)
             out["states"] += 1
     if out["lost"] is not None:
         # the retract leaves the branch before its fold: off the branch the surface unzips
@@ -118,10 +116,11 @@ def trace_retract_sweep(scene, sink, br, retract):
     if not beyond:
         return out                    # the sweep ends in contact: no jump-out
     # the fold itself: the runner's state at its separation on its scaled grid, taken as
-    # it is (the runner's Jacobian at fixed d is singular at the fold, its Newton does not
-    # converge there, measured; and its stability is marginal - the branch's smallest
-    # stiffness vanishes there, the test reads it either way by round-off; the branch's
-    # states up to it passed the runner's test)
+    # it is (the runner's Jacobian at fixed d is singular at the fold, its Newton need not
+    # converge there: 40 iterations without, measured once, 31 to converge another time;
+    # and its stability is marginal - the branch's smallest stiffness vanishes there, the
+    # test reads it either way by round-off; the branch's states up to it passed the
+    # runner's test)
     pb, before = as_runner_state(fold, tol)
     if not before.converged:
         raise ConvergenceError(f"edge route: the fold's state (d = {fold.d * 1e9:.6g} nm) "
@@ -129,7 +128,9 @@ def trace_retract_sweep(scene, sink, br, retract):
                                d=fold.d, residual=before.residual, n_iter=before.n_iter)
     d_fold = fold.d
     resolution = MIN_STEP_FRACTION * step
-    d_land = d_fold + resolution
+    # (within the sweep's first separation beyond the fold: one that lay between the fold
+    # and the landing would get no state)
+    d_land = min(d_fold + resolution, min(beyond))
     with phase("retract (landing)"):
         after = land(pb, d_land, before.w, tol=tol, max_iter=max_iter)
     if not (after.converged and after.stable):
@@ -138,6 +139,8 @@ def trace_retract_sweep(scene, sink, br, retract):
                                residual=after.residual, n_iter=after.n_iter)
     _on_grid(sink, pb)
     sink.jump(Jump("retract", d_fold, d_land, resolution, before, after))
+    if d_land == min(beyond):
+        sink.state("retract", after)  # the landing is that separation's state
     out["departed"], out["landing"] = d_fold, after
     rest = [d for d in d_all if d > d_land]
     if rest:
