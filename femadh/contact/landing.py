@@ -64,6 +64,18 @@ EDGE_SHIFTS = (1, -1, 2, -2)
 NEXT_NODE_SHIFTS = (2, 1)
 #: corrector iterations each of those starts may take (the converged ones took 2-8)
 NEXT_NODE_ITER = 12
+#: a smooth law's landing whose polish fails (no sigma-gap: no contact set, relaxation or
+#: separated state above) is polished from the descent's minimum with its contact edge moved
+#: by EDGE_SHIFTS nodes, then farther out up to EDGE_SCAN (:func:`_smooth_edges`). Measured on
+#: the 100-node GW slider of tests/test_topography.py (softening 6.3x a node's stiffness,
+#: the approach's landing at d = 1.05762 nm) with the Green operator's far field by the AGM
+#: (its last bits moved, validation/results/landrobust.md): the descent settled on 35 contact
+#: nodes (an energy minimum, stable), the collocation form's residual there 7e-13 m; Newton
+#: hovered at 1e-13 m for ~60 iterations and then diverged to 5e-8 m (the run failed), the
+#: pseudo-time relaxation ran its 400 steps without settling; with main's operator Newton
+#: wandered 75 iterations onto the state with node 35 snapped in (36 contact nodes). False:
+#: such a landing fails as before
+SMOOTH_EDGES = True
 #: points of the straight path from the descent's start to a candidate landing at which the
 #: energy must fall monotonically (no barrier: the descent's surface can slide there)
 PATH_SAMPLES = 16
@@ -169,6 +181,13 @@ def land(problem, d, w_start, *, tol, max_iter):
         # a vanished root): relax those equations in pseudo-time from it instead (the last
         # resort: every landing that polished before is untouched)
         st = _relaxed(problem, d, st, descent, tol=tol, max_iter=max_iter)
+    elif not (st.converged and st.stable) and SMOOTH_EDGES:
+        # a smooth law (no sigma-gap): the same vanished root at a lattice-trapped contact
+        # edge, the polish cycling about it (:func:`_smooth_edges`)
+        near = _smooth_edges(problem, d, w_start, descent[0], tol=tol, max_iter=max_iter)
+        if near is not None:
+            near.n_iter += st.n_iter
+            st = near
     return st
 
 
@@ -237,6 +256,61 @@ def _separated(problem, d, w, *, tol, max_iter):
     if st.converged and st.stable and not st.active.any() and \
             problem.energy(st.w, d) < problem.energy(w, d):
         return st
+    return None
+
+
+def _smooth_contact(problem, h):
+    """The contact set of a smooth law's state at gaps h (m): the nodes on the repulsive
+    side of the law's attraction peak, dP/dh > 0 (the sigma-gap's contact set's analogue)."""
+    J = problem.law_jacobian(h)
+    return (np.diag(J) if np.ndim(J) == 2 else np.asarray(J)) > 0
+
+
+def _smooth_edges(problem, d, w_start, w, *, tol, max_iter):
+    """The stable equilibrium, of total energy below the descent's start ``w_start``'s, that
+    Newton reaches from the descent's minimum ``w`` (m) of a smooth law with its disk-shaped
+    contact set (:func:`_smooth_contact`) moved by the fewest nodes: by 1, then 2 (EDGE_SHIFTS'
+    sizes, both ways; of two at one distance the one of least energy), then farther up to
+    EDGE_SCAN; None if none does (each Newton polish capped at ``max_iter``) or the contact is
+    not a disk.
+
+    A node joining the contact starts at the gap of the contact's last node, a node leaving
+    it at the gap of the first free node. Why: as in :func:`_next_edges` - at a contact edge
+    whose law softens beyond a node's stiffness the collocation form's equilibrium on the
+    descent's edge can have vanished while the energy's minimum remains; the equilibria on
+    the neighbouring edges are where the corrector lands."""
+    from .linalg import disk_size
+
+    b, n = problem.contour(d), w.size
+    h = b - w
+    m = disk_size(_smooth_contact(problem, h))
+    if not m:
+        return None
+    e_start = problem.energy(w_start, d)
+
+    def least(shifts):
+        best, e_best = None, e_start
+        for k in shifts:
+            if not 0 < m + k < n:
+                continue
+            w0 = np.array(w, float)
+            if k > 0:
+                w0[m:m + k] = b[m:m + k] - h[m - 1]
+            else:
+                w0[m + k:m] = b[m + k:m] - h[m]
+            st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter)
+            if st.converged and st.stable:
+                e = problem.energy(st.w, d)
+                if e < e_best:
+                    best, e_best = st, e
+        return best
+    # nearest edges first (the surface sits at the descent's minimum: the landing is the
+    # state next to it, not the deepest one the corrector can reach)
+    far = max((abs(x) for x in EDGE_SHIFTS), default=0)
+    for k in range(1, max(far, EDGE_SCAN) + 1 if EDGE_SHIFTS else 1):
+        best = least([x for x in EDGE_SHIFTS if abs(x) == k] if k <= far else [k, -k])
+        if best is not None:
+            return best
     return None
 
 
@@ -381,12 +455,14 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
     K, a = problem.K, problem.areas
     sdiag = np.diag(problem.S_sym)
     adhesion = problem.gap.adhesion if problem.gap is not None else 0.0
-    w, A = np.array(w, float), np.array(active, bool)
+    w = np.array(w, float)
+    A = np.zeros(w.size, bool) if sigma is None else np.array(active, bool)
     mu, r_prev = RELAX_MU0, None
     steps = RELAX_STEPS if max_steps is None else max_steps
     for step in range(1, steps + 1):
         safe_point()            # a signal stops the run between relaxation steps
-        w[A] = b[A] - sigma
+        if sigma is not None:
+            w[A] = b[A] - sigma
         h = b - w
         F = K @ w - problem.pressure(h)
         idx = np.flatnonzero(~A)
@@ -419,8 +495,11 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         h = b - w
         # a contact node stays while its asperities push (p_c = P - K w, plus eq 20's
         # adhesion P_LJa on the contact set, > 0), as in the corrector
-        pc = problem.pressure(h) - K @ w
-        new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))
+        if sigma is None:
+            new_A = A
+        else:
+            pc = problem.pressure(h) - K @ w
+            new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))
         if r <= tol and np.array_equal(new_A, A):
             return w, A, step
         A = new_A
