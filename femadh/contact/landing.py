@@ -455,14 +455,12 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
     K, a = problem.K, problem.areas
     sdiag = np.diag(problem.S_sym)
     adhesion = problem.gap.adhesion if problem.gap is not None else 0.0
-    w = np.array(w, float)
-    A = np.zeros(w.size, bool) if sigma is None else np.array(active, bool)
+    w, A = np.array(w, float), np.array(active, bool)
     mu, r_prev = RELAX_MU0, None
     steps = RELAX_STEPS if max_steps is None else max_steps
     for step in range(1, steps + 1):
         safe_point()            # a signal stops the run between relaxation steps
-        if sigma is not None:
-            w[A] = b[A] - sigma
+        w[A] = b[A] - sigma
         h = b - w
         F = K @ w - problem.pressure(h)
         idx = np.flatnonzero(~A)
@@ -495,11 +493,8 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         h = b - w
         # a contact node stays while its asperities push (p_c = P - K w, plus eq 20's
         # adhesion P_LJa on the contact set, > 0), as in the corrector
-        if sigma is None:
-            new_A = A
-        else:
-            pc = problem.pressure(h) - K @ w
-            new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))
+        pc = problem.pressure(h) - K @ w
+        new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))
         if r <= tol and np.array_equal(new_A, A):
             return w, A, step
         A = new_A
