@@ -1967,6 +1967,22 @@ DEFECTS = [
       "femadh/runner/edge_sweep.py",
       (("    d_land = min(d_fold + resolution, min(beyond))",
         "    d_land = d_fold + resolution"),)),
+    # -- a smooth law's stalled landing polished from the neighbouring contact edges
+    #    (branch landrobust, seeded_defects_landrobust.md)
+    D("landrobust_no_smooth_edges", "landing: a smooth law's failed polish is final (no "
+      "neighbouring edges)", "femadh/contact/landing.py",
+      (("elif not (st.converged and st.stable) and SMOOTH_EDGES:", "elif False:"),)),
+    D("landrobust_skips_nearest", "landing, smooth edges: the nearest shifts (1 node) skipped",
+      "femadh/contact/landing.py",
+      (("for k in range(1, max(far, EDGE_SCAN) + 1 if EDGE_SHIFTS else 1):",
+        "for k in range(2, max(far, EDGE_SCAN) + 1 if EDGE_SHIFTS else 1):"),)),
+    D("landrobust_join_gap_kept", "landing, smooth edges: a joining node starts at its own "
+      "gap (not the contact's)", "femadh/contact/landing.py",
+      (("w0[m:m + k] = b[m:m + k] - h[m - 1]", "w0[m:m + k] = w[m:m + k]"),)),
+    D("landrobust_contact_sign", "landing, smooth edges: the contact set taken where dP/dh < 0",
+      "femadh/contact/landing.py",
+      (("return (np.diag(J) if np.ndim(J) == 2 else np.asarray(J)) > 0",
+        "return (np.diag(J) if np.ndim(J) == 2 else np.asarray(J)) < 0"),)),
 ]
 
 
