@@ -160,7 +160,9 @@ def land(problem, d, w_start, *, tol, max_iter):
     h >= 0.5 z0 for a smooth sphere, never active at a minimum: the LJ repulsion is far steeper),
     then the Newton corrector of the problem's contact model polishes the state; where that
     polish ends off a stable equilibrium (a sigma-gap contact), the collocation equations
-    are relaxed in pseudo-time from the descent's minimum (:func:`_relax`) and polished again.
+    are relaxed in pseudo-time from the descent's minimum (:func:`_relax`) and polished again;
+    a smooth law's (no sigma-gap) is polished from the contact edges next to the descent's
+    (:func:`_smooth_edges`).
 
     The descent stops once settled at round-off (ROUNDOFF_STEPS) - except on a lattice-trapped
     grid (a law softening beyond a node's stiffness), where the polish is fragile and the
