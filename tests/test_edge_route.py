@@ -21,6 +21,32 @@ SMALL = {"sphere.radius": "20 um", "materials.disk.youngs_modulus": "10 GPa",
          "sweep.stop": "-3 nm", "solver.accuracy": 1e-2}
 
 
+@pytest.fixture(scope="module", autouse=True)
+def traces_once():
+    """Each edge-grid trace computed once for the module: the tests here run the route on
+    the same small scene ~11 times and its pilot and family members (edge_route.trace: a
+    deterministic function of the scene's laws, bodies, tolerance and the grid's numbers)
+    recur - the family of the default disk in nine runs. A trace already made is handed
+    out as a deep copy (the route's sweep works on the finest member's branch; no run sees
+    another's). What the route does with its family is each test's own; the traces
+    themselves are computed as in any run (the first time). ~6 CPU-s of ~14 saved
+    (validation/results/suite_time.md)."""
+    import copy
+
+    orig, made = edge_route.trace, {}
+
+    def trace(scene, *grid):
+        key = (repr(scene.sphere), repr(scene.effects), repr(scene.gap), scene.e_star,
+               scene.tolerance, grid)
+        if key not in made:
+            made[key] = orig(scene, *grid)
+        return copy.deepcopy(made[key])
+    mp = pytest.MonkeyPatch()
+    mp.setattr(edge_route, "trace", trace)
+    yield made
+    mp.undo()
+
+
 @pytest.fixture(scope="module")
 def small():
     return femadh.load_scene(SCENE).replace(SMALL)
