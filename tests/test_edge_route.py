@@ -261,6 +261,9 @@ def test_accuracy_out_of_reach_is_one_line(small, monkeypatch):
     reached = float(res.error.split("relative error ")[1].split()[0])
     assert reached == pytest.approx(res.accuracy["estimated_rel_error"], rel=0.05, abs=0)
     assert reached > 1e-4
+    # and it fails before the sweep's outputs: no approach, no retract at the separations
+    # (the branch's own curve alone, as route = "peak")
+    assert list(res.branches) == [edge_route.CURVE]
 
 
 def test_richardson_guarded():
