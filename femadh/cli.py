@@ -256,6 +256,8 @@ def _main(argv, program=False):
         return exc.exit_code
     except KeyboardInterrupt:
         # (outside a run's safe points: its imports, the scene's checks, another command)
+        if os.environ.get("FEMADH_DEBUG"):
+            raise
         _error("interrupted by SIGINT")
         return 130
     except FemadhError as exc:
@@ -373,7 +375,14 @@ def _run(scene, args):
         if w.startswith("resume: "):
             print(f"femadh: note: {w}", file=sys.stderr)
     if not args.quiet:
-        _report(res)
+        try:
+            _report(res)
+        except KeyboardInterrupt:
+            # the run has ended and its folder is complete: say so, not just "interrupted"
+            where = f" and its results are in {res.out_dir}" if res.out_dir else ""
+            _error(f"interrupted by SIGINT while printing the report; the run had ended "
+                   f"({res.status}){where}")
+            return 130
     if res.status in ("interrupted", "time limit"):
         # the command that continues it, as typed (pasted, it resumes this very folder)
         again = ["femadh", "run", args.scene, "--out", str(out), "--resume"] + [
