@@ -378,11 +378,13 @@ def _run(scene, args):
         try:
             _report(res)
         except KeyboardInterrupt:
-            # the run has ended and its folder is complete: say so, not just "interrupted"
-            where = f" and its results are in {res.out_dir}" if res.out_dir else ""
-            _error(f"interrupted by SIGINT while printing the report; the run had ended "
-                   f"({res.status}){where}")
-            return 130
+            # the run has ended: say so, not just "interrupted" (a stopped run goes on to
+            # say how to continue it)
+            if res.status not in ("interrupted", "time limit"):
+                where = f" and its results are in {res.out_dir}" if res.out_dir else ""
+                _error(f"interrupted by SIGINT while printing the report; the run had ended "
+                       f"({res.status}){where}")
+                return 130
     if res.status in ("interrupted", "time limit"):
         # the command that continues it, as typed (pasted, it resumes this very folder)
         again = ["femadh", "run", args.scene, "--out", str(out), "--resume"] + [

@@ -6,8 +6,11 @@ import sys
 # import femadh: where the environment sets PYTHONDONTWRITEBYTECODE (this CI image does) a
 # fresh checkout has no bytecode and every process compiled the package again (~25 CPU-s a
 # suite, measured: a fresh clone's suite 218-241 user-s against 192 where the bytecode
-# existed). The suite's own processes write it once; the rest read it.
-sys.dont_write_bytecode = False
+# existed). The suite's own processes write it once; the rest read it. Not under the
+# seeded-defect harness (tests/seeded_defects.py): it mutates and restores sources within a
+# second, and a .pyc of a mutated module of the same size would outlive its restore.
+if not os.environ.get("FEMADH_SEEDED_DEFECT"):
+    sys.dont_write_bytecode = False
 
 # Small dense solves: threaded BLAS only adds overhead on the CI machine's 2 cores.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

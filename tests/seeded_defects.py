@@ -1824,8 +1824,8 @@ DEFECTS = [
         "    except ValueError:\n        # a pilot that cannot be traced"),)),
     D("eroute_failure_part", "edge route: an unmet request blames the smallest error part",
       "femadh/runner/edge_route.py",
-      (('        big = "tail" if fam.stop == "tail" else max(("grid", "tail", "tolerance"),',
-        '        big = "tail" if fam.stop == "tail" else min(("grid", "tail", "tolerance"),'),)),
+      (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
+        '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
     # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
     D("lattice_part_off", "estimate: no lattice part where a step's cohesive zone acts at "
       "the contact edge", "femadh/runner/estimates.py",
@@ -1964,7 +1964,18 @@ DEFECTS = [
       (("                allowed -= tail + tolerance\n", ""),)),
     D("route_family_tail_ignored", "edge route: a tail beyond SAFETY of the target does not "
       "stop the family", "femadh/runner/edge_route.py",
-      (("                if tail > SAFETY * allowed:", "                if False:"),)),
+      (("                if tail_stops and tail > SAFETY * allowed:", "                if False:"),)),
+    D("route_family_tail_stops_always", "edge route: a tail stops the family where the disk "
+      "cannot grow any more", "femadh/runner/edge_route.py",
+      (("                if tail_stops and tail > SAFETY * allowed:",
+        "                if tail > SAFETY * allowed:"),)),
+    D("route_family_no_share_runs_on", "edge route: tail and tolerance that leave the grid no "
+      "share do not stop the family", "femadh/runner/edge_route.py",
+      (("                if allowed <= 0:\n", "                if False:\n"),)),
+    D("route_landing_resolution_step", "edge route: the jump's resolution the landing step, "
+      "not where it landed", "femadh/runner/edge_sweep.py",
+      (("Jump(\"retract\", d_fold, d_land, d_land - d_fold, before, after)",
+        "Jump(\"retract\", d_fold, d_land, resolution, before, after)"),)),
     D("route_landing_past_separation", "edge route: the jump-out lands past a sweep "
       "separation that lies within the landing's resolution of the fold",
       "femadh/runner/edge_sweep.py",
@@ -2028,7 +2039,8 @@ def run_one(defect, root, tests=()):
     original, problem = _apply(root, defect)
     if problem:
         return {"defect": defect, "caught": None, "test": problem, "seconds": 0.0}
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1",
+               FEMADH_SEEDED_DEFECT="1")
     t0 = time.perf_counter()
     text, code = "", 0
     try:

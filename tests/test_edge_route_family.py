@@ -24,7 +24,8 @@ def synthetic(monkeypatch):
     monkeypatch.setattr(edge_route, "_nodes_of", lambda a0, c, h, h0: int(1e-6 / h))
     pil = SimpleNamespace(c_star=1e-6, c_fold=0.5e-6, h0=H0)
     scene = SimpleNamespace(analysis_radius=1e-5)
-    return lambda target, other=None: edge_route.family(scene, pil, target, other=other)
+    return lambda target, other=None, tail_stops=True: edge_route.family(
+        scene, pil, target, other=other, tail_stops=tail_stops)
 
 
 def grid_part(n):
@@ -47,9 +48,16 @@ def test_the_grid_part_has_the_target_less_the_other_parts(synthetic):
 
 
 def test_a_tail_beyond_safety_stops_the_family_for_the_disk(synthetic):
-    """A tail above SAFETY (0.6) of the target: more grid members cannot meet it; the
-    family stops at its third member saying so ("tail"), for the disk to grow."""
+    """A tail above SAFETY (0.6) of the target where the disk can grow: the family stops at
+    its third member saying so ("tail"), for the disk to grow. Where it cannot, the grid
+    takes what the tail leaves (0.7 of the target: the fifth member's 2e-4 meets it); where
+    tail and tolerance leave nothing, the family stops at once, saying so."""
     from femadh.estimate.refine import SAFETY
 
     fam = synthetic(1e-3, other=lambda fam: (1.01 * SAFETY * 1e-3 * F0, 0.0))
     assert not fam.met and fam.stop == "tail" and len(fam.h) == 3
+    fam = synthetic(1e-3, other=lambda fam: (0.7e-3 * F0, 0.0), tail_stops=False)
+    assert fam.met and len(fam.h) == 5
+    assert fam.error == pytest.approx(grid_part(5), rel=1e-6)
+    fam = synthetic(1e-3, other=lambda fam: (0.5e-3 * F0, 0.6e-3 * F0))
+    assert not fam.met and len(fam.h) == 3 and "no share" in fam.stop

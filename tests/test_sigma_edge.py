@@ -277,4 +277,5 @@ def test_a_separation_within_the_landings_resolution_of_the_fold_gets_its_state(
     out = trace_retract_sweep(sc, sink, br, r)
     assert out["departed"] == d_f and len(jumps) == 1
     assert jumps[0].d_fold == d_f and jumps[0].d_land == ds[1]
+    assert jumps[0].resolution == ds[1] - d_f       # where it landed, not the landing step
     assert states == ds

@@ -276,7 +276,8 @@ class EdgeFamily:
         return self.runs[-1]
 
 
-def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None, other=None):
+def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None, other=None,
+           tail_stops=True):
     """Grow the family h0 / sqrt2^j (node k at the pilot's c*, analysis radius a_run c* /
     (LOW c_fold)) until Richardson's relative error of the max adhesion is at most
     ``target``: MIN_LEVELS members at least, ``max_levels`` (default MAX_LEVELS) at most,
@@ -285,8 +286,9 @@ def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None, 
     each member. ``other(fam)``, where given, is the (tail, tolerance) parts (N) of the
     finest member: the grid part then has the target less those (the run is judged on
     their sum, as the sweep's loop refines while grid + tail exceed the target), and a tail
-    above SAFETY of the target stops the family (``stop`` "tail": the disk, not the grid,
-    falls short). Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
+    above SAFETY of the target stops the family where ``tail_stops`` (``stop`` "tail": the
+    disk, not the grid, falls short, and it can still grow); tail and tolerance that leave
+    the grid no share stop it too. Returns an :class:`EdgeFamily` (``met`` False and ``stop`` saying why
     where the budget ended first)."""
     from ..estimate.refine import SAFETY
 
@@ -320,10 +322,13 @@ def family(scene, pil, target, max_levels=None, max_nodes=None, on_member=None, 
             allowed = target * abs(fam.value)
             if other is not None:
                 tail, tolerance = (abs(v) for v in other(fam))
-                if tail > SAFETY * allowed:
+                if tail_stops and tail > SAFETY * allowed:
                     fam.stop = "tail"
                     break
                 allowed -= tail + tolerance
+                if allowed <= 0:
+                    fam.stop = "the tail and the solver tolerance leave the grid no share"
+                    break
             if fam.error <= allowed:
                 fam.met = True
                 fam.stop = "met"
@@ -622,9 +627,16 @@ def _grown_family(scene, pil, target):
         parts = _error_parts(scene, fam)
         return parts["tail"], parts["tolerance"]
 
-    fam = family(scene, pil, target, other=lambda fam: other(fam, scene))
     grown = []
     cap = (0.5 if scene.sphere.profile == "sphere" else 1.0) * scene.sphere.radius
+
+    def can_grow(scene):
+        # a tail stops the family only where the disk can still grow: else the grid may
+        # still meet what the tail leaves
+        return len(grown) < MAX_DISK_DOUBLINGS and 2 * scene.analysis_radius < cap
+
+    fam = family(scene, pil, target, other=lambda fam: other(fam, scene),
+                 tail_stops=can_grow(scene))
     while len(grown) < MAX_DISK_DOUBLINGS:
         tail = abs(_error_parts(scene, fam)["tail"])
         a = scene.analysis_radius
@@ -633,7 +645,8 @@ def _grown_family(scene, pil, target):
         scene = variant(scene, radius=2 * a)
         grown.append(2 * a)
         with phase(f"edge route: analysis radius {2 * a * 1e6:.3g} um"):
-            fam = family(scene, pil, target, other=lambda fam, sc=scene: other(fam, sc))
+            fam = family(scene, pil, target, other=lambda fam, sc=scene: other(fam, sc),
+                         tail_stops=can_grow(scene))
     return scene, fam, grown
 
 
@@ -697,9 +710,7 @@ def _route(scene, res, pil, target, sink, fam, grown=()):
     guard_bounds(res, br._ref)
     if rel > target:
         comp = parts["max_adhesion_N"]
-        # (a family stopped by its tail names the tail: more members could not meet it)
-        big = "tail" if fam.stop == "tail" else max(("grid", "tail", "tolerance"),
-                                                     key=lambda n: abs(comp[n]))
+        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))
         # the family grows only the grid part's resolution: say which part is too large
         why = {"grid": f"stopped: {fam.stop}",
                "tail": (f"the largest part is the force beyond the analysis radius "

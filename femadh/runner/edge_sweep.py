@@ -138,7 +138,8 @@ def trace_retract_sweep(scene, sink, br, retract):
                                "nm did not reach a stable state", d=d_land,
                                residual=after.residual, n_iter=after.n_iter)
     _on_grid(sink, pb)
-    sink.jump(Jump("retract", d_fold, d_land, resolution, before, after))
+    # (the resolution is where the landing is: |d_land - d_fold|, as the stepping runner's)
+    sink.jump(Jump("retract", d_fold, d_land, d_land - d_fold, before, after))
     if d_land == min(beyond):
         sink.state("retract", after)  # the landing is that separation's state
     out["departed"], out["landing"] = d_fold, after
