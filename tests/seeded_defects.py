@@ -1053,10 +1053,7 @@ DEFECTS = [
         "mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r_prev / r))"),)),
     D("landing_edges_most_energy", "landing: of the neighbouring edges' stable states the one "
       "of most energy is kept", "femadh/contact/landing.py",
-      (("active0=A)\n            if st.converged and st.stable:\n                e = problem.energy("
-        "st.w, d)\n                if e < e_best:",
-        "active0=A)\n            if st.converged and st.stable:\n                e = problem.energy("
-        "st.w, d)\n                if best is None or e > e_best:"),)),
+      (("            if e < e_best:", "            if best is None or e > e_best:"),)),
     # -- the estimate's members solved where the headline numbers are read (estimate branch)
     D("mem_fold_lattice_step", "member fold search: each trial two lattice steps beyond the "
       "accepted ones (the fold off the fine run's lattice)", "femadh/runner/members.py",

@@ -268,6 +268,19 @@ def _smooth_contact(problem, h):
     return (np.diag(J) if np.ndim(J) == 2 else np.asarray(J)) > 0
 
 
+def _least_energy(problem, d, starts, bound, *, tol, max_iter):
+    """Of the corrector's converged, stable states from ``starts`` ((w0 (m), active0 or
+    None) each), the one of least total energy below ``bound`` (J); None if none."""
+    best, e_best = None, bound
+    for w0, active0 in starts:
+        st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter, active0=active0)
+        if st.converged and st.stable:
+            e = problem.energy(st.w, d)
+            if e < e_best:
+                best, e_best = st, e
+    return best
+
+
 def _smooth_edges(problem, d, w_start, w, *, tol, max_iter):
     """The stable equilibrium, of total energy below the descent's start ``w_start``'s, that
     Newton reaches from the descent's minimum ``w`` (m) of a smooth law with its disk-shaped
@@ -290,22 +303,17 @@ def _smooth_edges(problem, d, w_start, w, *, tol, max_iter):
         return None
     e_start = problem.energy(w_start, d)
 
+    def start(k):
+        w0 = np.array(w, float)
+        if k > 0:
+            w0[m:m + k] = b[m:m + k] - h[m - 1]
+        else:
+            w0[m + k:m] = b[m + k:m] - h[m]
+        return w0, None
+
     def least(shifts):
-        best, e_best = None, e_start
-        for k in shifts:
-            if not 0 < m + k < n:
-                continue
-            w0 = np.array(w, float)
-            if k > 0:
-                w0[m:m + k] = b[m:m + k] - h[m - 1]
-            else:
-                w0[m + k:m] = b[m + k:m] - h[m]
-            st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter)
-            if st.converged and st.stable:
-                e = problem.energy(st.w, d)
-                if e < e_best:
-                    best, e_best = st, e
-        return best
+        return _least_energy(problem, d, (start(k) for k in shifts if 0 < m + k < n),
+                             e_start, tol=tol, max_iter=max_iter)
     # nearest edges first (the surface sits at the descent's minimum: the landing is the
     # state next to it, not the deepest one the corrector can reach)
     far = max((abs(x) for x in EDGE_SHIFTS), default=0)
@@ -336,22 +344,16 @@ def _next_edges(problem, d, w, active, *, tol, max_iter):
         return None
     b, n = problem.contour(d), w.size
 
+    def start(k):
+        A = np.zeros(n, bool)
+        A[:m + k] = True
+        w0 = np.array(w, float)
+        w0[A] = b[A] - problem.sigma
+        return w0, A
+
     def least(shifts):
-        best, e_best = None, np.inf
-        for k in shifts:
-            if not 0 < m + k < n:
-                continue
-            A = np.zeros(n, bool)
-            A[:m + k] = True
-            w0 = np.array(w, float)
-            w0[A] = b[A] - problem.sigma
-            st = solve_complementarity(problem, d, w0, tol=tol, max_iter=max_iter,
-                                       active0=A)
-            if st.converged and st.stable:
-                e = problem.energy(st.w, d)
-                if e < e_best:
-                    best, e_best = st, e
-        return best
+        return _least_energy(problem, d, (start(k) for k in shifts if 0 < m + k < n),
+                             np.inf, tol=tol, max_iter=max_iter)
     best = least(EDGE_SHIFTS)
     if best is None and EDGE_SHIFTS:
         # the collocation form's equilibria may have vanished on several edges about the
