@@ -28,8 +28,8 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 #: the child: ``python -m femadh`` (runpy, as the program runs), or with FEMADH_TEST_SCRIPT
 #: what the ``femadh`` script pip writes does (``from femadh.cli import main``: no __main__
 #: module), with an audit hook that sends this process SIGINT when the module named in
-#: FEMADH_TEST_SIGINT_AT starts to be imported, or writes one byte to the fd in
-#: FEMADH_TEST_READY_FD when femadh.cli starts to be imported
+#: FEMADH_TEST_SIGINT_AT starts to be imported (forgotten first if a site hook imported it),
+#: or writes one byte to the fd in FEMADH_TEST_READY_FD when femadh.cli starts to be imported
 CHILD = r"""
 import os, signal, sys
 at, ready = os.environ.get("FEMADH_TEST_SIGINT_AT"), os.environ.get("FEMADH_TEST_READY_FD")
@@ -43,6 +43,11 @@ def hook(event, args):
     elif ready and args[0] == "femadh.cli":
         fired.append(1)
         os.write(int(ready), b"!")
+# a site hook may have imported the module already (a .pth of the interpreter's site-packages
+# imports shutil on CI's Python): forget it, so that its importer really imports it again and
+# the moment exists wherever the suite runs
+if at in sys.modules and not at.startswith("femadh"):
+    del sys.modules[at]
 sys.addaudithook(hook)
 if os.environ.get("FEMADH_TEST_SCRIPT"):
     sys.argv[0] = os.path.join(os.path.dirname(sys.executable), "femadh")
