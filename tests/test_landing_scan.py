@@ -9,28 +9,25 @@ from every disk of 153-159 nodes: the landing failed and ended the run. From 151
 (the descent's - 5) it converged in 6 iterations on a stable state of 155 nodes. That case
 costs minutes; here the same situation is made on the small landing of
 tests/test_landing_relax.py (the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05, 253 nodes,
-26 nm band spacing, its approach's second fold) by letting the corrector fail from every
-disk within EDGE_SHIFTS of the descent's, as it did there."""
+26 nm band spacing, its approach's second fold, built there from the 70-node branch state)
+by letting the corrector fail from every disk within EDGE_SHIFTS of the descent's, as it
+did there."""
 import numpy as np
 import pytest
 
 from femadh.contact import landing
 from femadh.contact.linalg import disk_size
 
-from test_landing_relax import _check_landing
+from test_landing_relax import D_LAND, _check_landing, corner_case
 
 
 @pytest.fixture(scope="module")
-def case(corner_approach):
+def case():
     """(scene, problem, d, descent (w, contact set), the state before the fold) of the
-    approach's second landing, the one whose polish from the descent fails
-    (test_landing_relax's case: the same trace, conftest.corner_approach)."""
-    scene, p, sweep, fallbacks = corner_approach
-    assert fallbacks, "the case's landing no longer needs a fallback"
-    d, _, descent = fallbacks[0]
-    before = [j.before for j in sweep.jumps if j.d_land == d]
-    assert len(before) == 1
-    return scene, p, d, descent, before[0]
+    landing whose polish from the descent fails (test_landing_relax's case, built there
+    without tracing the approach: :func:`test_landing_relax.corner_case`)."""
+    scene, p, before, descent = corner_case()
+    return scene, p, D_LAND, descent, before
 
 
 def _near_fail(monkeypatch, m, reach):
