@@ -8,7 +8,8 @@ A uniform pressure p on a disk of radius a displaces the half-space surface by
                    = p a^2 / (E* r) * 2F1(1/2, 1/2; 2; m)
 
 (E, K: complete elliptic integrals with parameter m; the hypergeometric form is the same
-function without the cancellation of E - (1-m)K for r >> a). An annulus [e_j, e_j+1] is the
+function without the cancellation of E - (1-m)K for r >> a, evaluated by
+:func:`outside_factor`). An annulus [e_j, e_j+1] is the
 difference of two disks, so the influence coefficients are exact: no Taylor series of the point-
 load Green function (paper 1 eq 1; the paper used 2000 terms of one) is needed.
 """
@@ -21,6 +22,52 @@ from .grid import RadialGrid
 from .operator import SurfaceOperator
 
 
+#: below this parameter m the outside kernel (:func:`outside_factor`) runs the AGM, above it
+#: E - (1-m) K from the elliptic integrals (cancellation ~4/m ulps there, <= 8 at the split)
+AGM_SPLIT = 0.5
+#: AGM steps after the first: c_n falls quadratically from c_1 <= 0.146 at m = 0.5 (c_5 ~ 1e-22)
+AGM_STEPS = 4
+
+
+def outside_factor(m):
+    """2F1(1/2, 1/2; 2; m) for 0 <= m < 1: the far-field factor of a loaded disk's displacement.
+
+    Equal to 4 / (pi m) [E(m) - (1 - m) K(m)] (E, K: complete elliptic integrals), which
+    cancels for small m. Below AGM_SPLIT it is taken from the arithmetic-geometric mean of 1
+    and k' = sqrt(1 - m) without that cancellation (Abramowitz & Stegun 17.6): with
+    a_n, b_n, c_n the AGM's sequences, K = pi / (2 a_N) and E = K (1 - sum 2^(n-1) c_n^2), so
+    E - (1 - m) K = K (m/2 - S), S = sum_{n>=1} 2^(n-1) c_n^2, and the factor is
+    (1 - 2 S / m) / a_N; c_n is carried as c_n^2 / (4 a_n+1), never as a difference.
+    Above AGM_SPLIT the elliptic form loses at most ~4/m ulps. Measured against a 40-digit
+    reference on 600 parameters over [1e-12, 1 - 1e-8]: within 3 ulps (scipy's hyp2f1, which
+    it replaces for speed, within 12), at ~1/3 of hyp2f1's time.
+
+    Parameters
+    ----------
+    m : ndarray
+        Parameter m = (a/r)^2 in [0, 1) (a: disk radius, r > a: observation radius).
+    """
+    m = np.asarray(m, float)
+    out = np.empty(m.shape)
+    low = m < AGM_SPLIT
+    ml = np.maximum(m[low], np.finfo(float).tiny)        # m = 0: S = 0, the factor 1
+    kp = np.sqrt(1.0 - ml)
+    c = ml / (2.0 * (1.0 + kp))                           # c_1 = (1 - k') / 2
+    a, b = 0.5 * (1.0 + kp), np.sqrt(kp)                  # a_1, b_1 (a_0 = 1, b_0 = k')
+    s, weight = c * c, 1.0
+    for _ in range(AGM_STEPS):
+        a_next = 0.5 * (a + b)
+        c = c * c / (4.0 * a_next)
+        b = np.sqrt(a * b)
+        a = a_next
+        weight *= 2.0
+        s += weight * c * c
+    out[low] = (1.0 - 2.0 * s / ml) / a
+    mh = m[~low]
+    out[~low] = 4.0 / (math.pi * mh) * (special.ellipe(mh) - (1.0 - mh) * special.ellipk(mh))
+    return out
+
+
 def _inside(r, a):
     """E* w / p (m) inside a uniformly loaded disk, r <= a: 4 a / pi E((r/a)^2) (Johnson
     eq 3.41); r, a broadcast, a > 0."""
@@ -28,9 +75,9 @@ def _inside(r, a):
 
 
 def _outside(r, a):
-    """E* w / p (m) outside a uniformly loaded disk, r > a: a^2 / r 2F1(1/2, 1/2; 2; (a/r)^2);
-    r, a broadcast, 0 < a < r."""
-    return a ** 2 / r * special.hyp2f1(0.5, 0.5, 2.0, (a / r) ** 2)
+    """E* w / p (m) outside a uniformly loaded disk, r > a: a^2 / r 2F1(1/2, 1/2; 2; (a/r)^2)
+    (:func:`outside_factor`); r, a broadcast, 0 < a < r."""
+    return a ** 2 / r * outside_factor((a / r) ** 2)
 
 
 def disk_displacement(r, a, e_star, p=1.0):
