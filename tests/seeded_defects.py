@@ -2019,6 +2019,24 @@ DEFECTS = [
       "femadh/elastic/green.py",
       (("(special.ellipe(mh) - (1.0 - mh) * special.ellipk(mh))",
         "(special.ellipe(mh) - mh * special.ellipk(mh))"),)),
+    # -- the AGM kernel and getri re-applied (branch landdet, seeded_defects_landdet.md)
+    D("landdet_agm_everywhere", "far-field factor: the AGM up to the disk edge (its 4 steps "
+      "do not converge as k' -> 0)", "femadh/elastic/green.py",
+      (("AGM_SPLIT = 0.5", "AGM_SPLIT = 1.0"),)),
+    D("landdet_branches_swapped", "far-field factor: the AGM above the split, E - (1-m)K "
+      "below it", "femadh/elastic/green.py",
+      (("    low = m < AGM_SPLIT\n", "    low = m >= AGM_SPLIT\n"),)),
+    D("landdet_elliptic_prefactor", "far-field factor, elliptic branch: 2 / (pi m), not "
+      "4 / (pi m)", "femadh/elastic/green.py",
+      (("out[~low] = 4.0 / (math.pi * mh)", "out[~low] = 2.0 / (math.pi * mh)"),)),
+    D("landdet_elliptic_k_sign", "far-field factor, elliptic branch: E + (1-m)K",
+      "femadh/elastic/green.py",
+      (("(special.ellipe(mh) - (1.0 - mh) * special.ellipk(mh))",
+        "(special.ellipe(mh) + (1.0 - mh) * special.ellipk(mh))"),)),
+    D("landdet_getri_transposed", "K = C^-T by getri (the compliance is not symmetric)",
+      "femadh/elastic/operator.py",
+      (("linalg.inv(self.compliance, check_finite=False)",
+        "linalg.inv(self.compliance.T, check_finite=False)"),)),
 ]
 
 
