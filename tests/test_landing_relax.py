@@ -79,13 +79,13 @@ def held_newton(p, d, w, active, max_iter=30):
 
 def _branch_state(p, scene):
     """The stable 70-node branch state at D_FOLD (the approach's, found without its path).
-    The energy descent from the flat surface settles on 70-78 contact nodes (the basin
-    follows the operator's last bits, measured over 13 operators); from its minimum with
-    the nodes beyond the disk put at the gap of its first free node, Newton held on the
-    disk (:func:`held_newton`) is continued in separation down to D_FOLD (3 steps) and the
-    corrector's state there is taken if stable on those nodes, else the descent at the next
-    start separation (BRANCH_STARTS) is tried. A state found is a property's, whichever
-    start gave it: at D_FOLD the 70-node disk has one stable equilibrium."""
+    The energy descent from the flat surface settles on 70-72 contact nodes (the basin
+    follows the operator's last bits: measured over 14 operators at D_FOLD and D_LAND);
+    from its minimum with the nodes beyond the disk put at the gap of its first free node,
+    Newton held on the disk (:func:`held_newton`) is continued in separation down to D_FOLD
+    (3 steps), and the corrector's state there is taken if it is stable with exactly those
+    nodes in contact; else the descent at the next start separation (BRANCH_STARTS) is
+    tried. Whichever start gives it, the state is the one with that property."""
     n = p.grid.n
     disk = np.arange(n) < M_FOLD
     for d0 in BRANCH_STARTS:

@@ -5,9 +5,9 @@ process, beside the whole run's CPU.
     python -m validation.operator_pace [--repeat 3]
 
 Runs paper1_fig3 at [solver] accuracy = 1e-4 and paper1_fig4 at 1e-3 (the bundled scenes
-with that accuracy, outputs in a temporary folder, figures off) ``--repeat`` times each, alternating, and
-prints per run: operators built (nodes), assembly, inversion, run CPU and the max adhesion;
-then the medians. Run it from the root of the tree whose femadh is to be timed (one BLAS
+with that accuracy, outputs in a temporary folder, figures off) ``--repeat`` times each,
+alternating, and prints per run: operators built (nodes), assembly, inversion, run CPU and
+the max adhesion; then the medians (results: validation/results/greenop.md). Run it from the root of the tree whose femadh is to be timed (one BLAS
 thread, set below before numpy loads); compare trees by running it in each, alternating.
 """
 import os
