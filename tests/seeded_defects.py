@@ -1845,10 +1845,6 @@ DEFECTS = [
     D("cohesive_note_missing", "a run where a cohesive zone acts at the contact edge does not "
       "name the route that traces it", "femadh/runner/estimates.py",
       (("        res.warnings.append(COHESIVE_NOTE)", "        pass"),)),
-    D("sigma_edge_force_scaling", "sigma-edge branch: the force scaled by lam, not lam^2 (an "
-      "area)", "femadh/contact/sigma_edge.py",
-      (("        return st.lam * st.lam * float(self.areas0 @ st.p_net)",
-        "        return st.lam * float(self.areas0 @ st.p_net)"),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
       (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
