@@ -1825,13 +1825,8 @@ DEFECTS = [
       (('        big = max(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))',
         '        big = min(("grid", "tail", "tolerance"), key=lambda n: abs(comp[n]))'),)),
     # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
-    D("lattice_part_off", "estimate: no lattice part where a step's cohesive zone acts at "
-      "the contact edge", "femadh/runner/estimates.py",
-      (("LATTICE_PART = True", "LATTICE_PART = False"),)),
-    D("lattice_tooth_max", "lattice part: the peak's fall to the highest sample, not the "
-      "lowest", "femadh/runner/peak.py",
-      (("    return float(max(f_peak - smooth(d_peak) - min(samples), 0.0)) if samples else 0.0",
-        "    return float(max(f_peak - smooth(d_peak) - max(samples), 0.0)) if samples else 0.0"),)),
+    # (lattice_part_off and lattice_tooth_max retired by sigedge: the lattice part is off,
+    # femadh.runner.estimates.LATTICE_PART, so peak.lattice_tooth no longer runs)
     D("lattice_period_quarter", "lattice part: the release period quartered (the window misses the "
       "tooth's trough)", "femadh/runner/peak.py",
       (("    return abs(nxt.d - prev.d) / dn if dn else None",
@@ -1844,6 +1839,13 @@ DEFECTS = [
       "femadh/runner/estimates.py",
       (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
         "    return secant > 0 and secant > 4 * problem.surface_force_stiffness()[2]"),)),
+    # -- the sweep against the sigma-edge branch on the map's sigma = 0.489 nm point (sigedge)
+    D("lattice_part_on", "estimate: a lattice part where a step's cohesive zone acts at the "
+      "contact edge (the error it stood for was a reference at another sigma)",
+      "femadh/runner/estimates.py", (("LATTICE_PART = False", "LATTICE_PART = True"),)),
+    D("cohesive_note_missing", "a run where a cohesive zone acts at the contact edge does not "
+      "name the route that traces it", "femadh/runner/estimates.py",
+      (("        res.warnings.append(COHESIVE_NOTE)", "        pass"),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
       (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",

@@ -48,7 +48,8 @@ POINTS = [
      "+- 1.17e-6 N (1.45e-3), 2 trials, 1362 s wall at load 7-10, 275 CPU-s"),
     (0.3, 0.05, 1.707, 3.3861e-4, "trial 2 (0.512-nm follow band, its estimate unfinished; "
      "trial 1: 8.8e-3 estimated)"),
-    (0.489, 0.15, 5.25, 1.567073e-4, "1772-node trial, converged: +- 1.36e-7 N (8.7e-4)"),
+    (0.489, 0.15, 5.25, 1.567073e-4, "1772-node trial, converged: +- 1.36e-7 N (8.7e-4); "
+     "at the map's sigma 0.48889 nm on a 28.28-um disk, not this point: see the notes"),
 ]
 #: family members h0 / sqrt2^j, j = 0..LEVELS-1
 LEVELS = 5
@@ -103,12 +104,15 @@ estimate 1.45e-3) lies 4.2e-4 below the branch's limit, d at max 1.4418 nm (the 
 1.4439 nm), jump-out 2.24238 nm (the fold 2.24312 nm; the runner's estimate 4e-3 nm): within
 its estimates. p/psat 0.05: 3.3861e-4 N, +5.4e-4 (its trial 1's estimate 8.8e-3; trial 2's
 unfinished), jump-out 1.7707 nm (the fold 1.77069 nm). sigma = 0.489 nm, p/psat 0.15: the
-runner's converged 1.567073e-4 N +- 1.36e-7 (8.7e-4) lies 1.42e-3 above the limit - 1.6 times
-its own estimate (effectivity 0.6). The branch's side of that: its members converge at order
-2.00 with effectivity 1.00 of the coarser triples' estimates, and the runner's own solver on
-the branch's fixed grid agrees with the branch there to 6.4e-6; so the difference is the
-runner's grid error (static band 4.04 nm, 1772 nodes, members lattice-trapped), which its
-estimate under-reads at this point.
+runner's converged 1.567073e-4 N +- 1.36e-7 (8.7e-4) is the map's point, sigma = 0.3 + 1.7/9 =
+0.48889 nm, on a 28.28-um disk - not this section's sigma = 0.489 nm on the 14.14-um disk
+(an earlier version of this paragraph compared them: +1.42e-3, "effectivity 0.6", "the
+runner's grid error under-read"). At the map's sigma the branch's limit is 1.56613766e-4 N
+(8.23e-4 above this section's: the meniscus edge 0.08 nm above sigma makes the force steep in
+sigma, d ln F / d ln sigma = -3.6), plus 1.20e-8 N for the larger disk: the runner lies
+5.2e-4 above it, within its estimate (effectivity 1.67), and the sweep's banded grids and
+the branch's edge grids converge to that one limit at order 2
+(validation/results/sigma_edge_limits.md, `python -m validation.sigma_edge_limits`).
 
 ## How it should be wired into the runner
 
