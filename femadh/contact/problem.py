@@ -14,6 +14,19 @@ from ..errors import ConvergenceError
 from ..indenter import Sphere
 from .constraints import AsperityGap
 
+_F8 = np.dtype(np.float64)
+
+
+def _finite_sum(v):
+    """True when the sum of v's entries is finite (then every entry is: see
+    :meth:`ContactProblem._finite`); a float array's one ufunc reduction."""
+    if type(v) is np.ndarray and v.dtype == _F8:
+        return math.isfinite(_ADD_REDUCE(v, axis=None))
+    return bool(np.isfinite(np.sum(v)))
+
+
+_ADD_REDUCE = np.add.reduce
+
 
 @dataclass(eq=False)
 class ContactProblem:
@@ -193,19 +206,38 @@ class ContactProblem:
 
     @staticmethod
     def _finite(name, part, v, h):
-        if not np.all(np.isfinite(v)):
-            k = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise ConvergenceError(f"law {name!r}: {part} is not finite at node {k} "
-                                   f"(gap h = {np.ravel(h)[k]:.6g} m)")
+        """v, after checking that every entry is finite (else a ConvergenceError names the law,
+        the part and the first node that is not).
+
+        One reduction decides it: a sum of finite numbers is finite unless it overflows, and
+        an inf or a NaN anywhere makes the sum inf or NaN; only a sum that is not finite is
+        followed by the elementwise scan (which passes an overflowing sum of finite values)."""
+        if not _finite_sum(v):
+            bad = ~np.isfinite(v)
+            if np.any(bad):
+                k = int(np.flatnonzero(bad)[0])
+                raise ConvergenceError(f"law {name!r}: {part} is not finite at node {k} "
+                                       f"(gap h = {np.ravel(h)[k]:.6g} m)")
         return v
 
     def _sum(self, part, h, laws=None):
         """Sum of one part of every law (or of ``laws``), pointwise; a non-finite value stops
-        the solve where it arose."""
-        out = np.zeros_like(h)
+        the solve where it arose.
+
+        The laws' values summed in their order from zero, ((0 + v1) + v2) + ...: the first
+        as v1 + 0.0 (the bits of 0.0 + v1, a -0.0 made +0.0 as before) when it is a float
+        array of h's shape, without the zeros it was added to."""
+        out = None
         for name, eff in (self.effects if laws is None else laws).items():
-            out += self._finite(name, part, getattr(eff, part)(h), h)
-        return out
+            v = self._finite(name, part, getattr(eff, part)(h), h)
+            if out is None:
+                if (type(v) is np.ndarray and type(h) is np.ndarray and v.dtype == _F8
+                        and h.dtype == _F8 and v.shape == h.shape):
+                    out = v + 0.0
+                    continue
+                out = np.zeros_like(h)
+            out += v
+        return np.zeros_like(h) if out is None else out
 
     def energy(self, w, d):
         """Total potential energy (J): elastic 1/2 w.S.w plus sum_k area_k U(h_k).
