@@ -1448,7 +1448,7 @@ DEFECTS = [
       (("self.q[:k - b, k - 1]", "self.q[:k - b, k - b - 1]"),)),
     D("carried_on_set_change", "corrector: the step's h, P, K w carried into an iteration "
       "whose contact set changed", "femadh/contact/complementarity.py",
-      (("if sigma is not None and (np.array_equal(new_A, A) or\n"
+      (("if sigma is not None and (same or\n"
         "                                  CARRY_RELEASES and not np.any(new_A & I)):",
         "if sigma is not None:"),)),
     D("refute_no_margin", "edge-block refutation at lambda_max > 0.5 (refutes positive "

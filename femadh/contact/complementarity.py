@@ -64,9 +64,9 @@ STALL_ITER, STALL_FACTOR = 8, 0.5
 def _damping(h, dh_closing):
     """Step length in (0, 1] so that no gap closes by more than MAX_GAP_CLOSURE of itself."""
     closing = dh_closing > 0
-    if not np.any(closing):
+    if not closing.any():       # (the array's own reductions: np.any's dispatch costs more)
         return 1.0
-    return float(min(1.0, np.min(MAX_GAP_CLOSURE * h[closing] / dh_closing[closing])))
+    return float(min(1.0, (MAX_GAP_CLOSURE * h[closing] / dh_closing[closing]).min()))
 
 
 def _effect_pressures(problem, h, A=None):
@@ -81,7 +81,7 @@ def _effect_pressures(problem, h, A=None):
 
 def _residual(problem, w, p_net):
     """max |w - C p_net| (m): the residual of eq (6)/(10)."""
-    return float(np.max(np.abs(w - problem.C @ p_net)))
+    return float(np.abs(w - problem.C @ p_net).max())
 
 
 #: extra nodes factorised inside the contact edge so a shrinking contact stays covered
@@ -168,6 +168,10 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
     res, res_prev, it = math.inf, math.inf, 0
     n_factor, res_it = 0, math.inf
     mark, it_mark, m_trend, m_last = math.inf, 0, 0, int(A.sum())
+    # the active set's bytes: two boolean sets are equal exactly when their bytes are (0 or
+    # 1 each), which the cycle test needs anyway - one comparison of bytes per iteration
+    # in place of np.array_equal's three or four
+    A_key = A.tobytes()
     stagnated = None
     # (h, P, K w) after the last step: the next iteration's own when its active set is the
     # same or a part of it - only releases (w on the set was put at b - sigma when the set
@@ -186,7 +190,7 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
             if sigma is not None:
                 w[A] = b[A] - sigma
             h = b - w
-        if np.any(h[I] <= 0):
+        if (h[I] <= 0).any():
             break  # the guess put the surfaces through each other: hopeless, report failure
         if carried is None:
             P = problem.pressure(h)
@@ -221,30 +225,34 @@ def solve_complementarity(problem, d, w0, *, tol, max_iter, active0=None, factor
         else:
             new_A = A
         res = _residual(problem, w, P - pc)
+        key = new_A.tobytes()
+        same = key == A_key
         if stats is not None and "history" in stats:
-            stats["history"].append((res, int(A.sum()), bool(np.array_equal(new_A, A)),
+            stats["history"].append((res, int(A.sum()), same,
                                      A.tobytes()))
-        if np.array_equal(new_A, A) and res <= tol and alpha == 1.0:
+        if same and res <= tol and alpha == 1.0:
             factor = (pre if fresh == "krylov" else lu if isinstance(lu, TrailingLU)
                       else (lu, lu_I))
             _count(stats, it, n_factor, False)
             return _finish(problem, d, w, h, pc, A, it, res, factor, fresh)
         res_it = res
-        key = new_A.tobytes()
-        if key in seen and not np.array_equal(new_A, A):
+        new_key = key
+        if key in seen and not same:
             # The active set cycles (non-convex LJ near the contact edge): accept only the
             # additions/removals adjacent to the current contact boundary to break the cycle.
             new_A = _restrict_change(A, new_A)
+            new_key = new_A.tobytes()
+            same = new_key == A_key
         seen.add(key)
-        if sigma is not None and (np.array_equal(new_A, A) or
+        if sigma is not None and (same or
                                   CARRY_RELEASES and not np.any(new_A & I)):
             carried = (h, P, Kw)
-        if not np.array_equal(new_A, A):
+        if not same:
             # a new active set: its first residual is not comparable with the last one, so
             # the next step is not a stall (a trailing LU that covers the new disk is reused
             # rather than refactorised: the contact edge moves node by node along a sweep)
             res, res_prev = math.inf, math.inf
-        A = new_A
+        A, A_key = new_A, new_key
         # progress: the residual halves against its mark, or the contact disk keeps moving
         # one way (an edge advancing node by node at a flat residual)
         m_new = int(A.sum())

@@ -47,6 +47,29 @@ def lu_solve(lu_and_piv, b):
     return x
 
 
+def diagonal(M):
+    """A writeable view of the diagonal of the square contiguous array M (C or Fortran
+    order): ``diagonal(M)[...] += d`` makes the adds of ``M[np.diag_indices_from(M)] += d``,
+    the same bits, without building the two index arrays and the gather/scatter (a
+    non-contiguous M: its diagonal by those indices)."""
+    if M.flags.c_contiguous:
+        return M.reshape(-1)[::M.shape[0] + 1]
+    if M.flags.f_contiguous:
+        return M.T.reshape(-1)[::M.shape[0] + 1]
+    return _DiagonalOf(M)
+
+
+class _DiagonalOf:
+    """``+=`` on the diagonal of a non-contiguous square array, by its index arrays."""
+
+    def __init__(self, M):
+        self.M = M
+
+    def __iadd__(self, d):
+        self.M[np.diag_indices_from(self.M)] += d
+        return self
+
+
 class TrailingLU:
     """One LU that solves every trailing block (K + D)[m:, m:] for m >= m0.
 
@@ -64,7 +87,8 @@ class TrailingLU:
         if D.ndim == 2:     # a sub-grid law's tridiagonal Jacobian (ContactProblem.law_jacobian)
             M += D[m0:, m0:][::-1, ::-1]
         else:
-            M[np.diag_indices_from(M)] += D[m0:][::-1]
+            d = diagonal(M)
+            d += D[m0:][::-1]
         # rows scaled by the annulus areas: diag(area) K is nearly symmetric (the energy
         # Hessian), for which partial pivoting rarely swaps rows - so one factorisation keeps
         # covering every trailing block
@@ -167,7 +191,8 @@ class TrailingCholesky:
         if D.ndim == 2:     # a sub-grid law: area x its Jacobian is the symmetric df/dh
             M += (areas[m0:, None] * D[m0:, m0:])[::-1, ::-1]
         else:
-            M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
+            d = diagonal(M)
+            d += (areas[m0:] * D[m0:])[::-1]
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
         self._k_valid = n - m0 if info == 0 else int(info) - 1
         # the factor in the kept precision is taken when a block is first asked for

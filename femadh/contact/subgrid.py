@@ -32,6 +32,8 @@ poles at x = +-i pi bound the error of 8 points on a panel of half-width 1 by ~1
 import numpy as np
 from scipy.special import expit
 
+from .linalg import diagonal
+
 #: |x| beyond which the logistic counts as saturated (S = 0 or 1 to e^-36 ~ 2e-16)
 WINDOW = 36.0
 #: largest panel (in x = (h_c - h)/w) of the quadrature across the step
@@ -220,7 +222,8 @@ class SubgridStep:
 def add_jacobian(M, J, idx):
     """M += J[idx, idx] in place (M the free block of K, rows and columns ``idx``)."""
     if J.ndim == 1:
-        M[np.diag_indices_from(M)] += J[idx]
+        d = diagonal(M)
+        d += J[idx]
     else:
         M += J[idx][:, idx] if not isinstance(idx, slice) else J[idx, idx]
     return M
