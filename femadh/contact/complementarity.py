@@ -376,7 +376,7 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
     else:
         if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
                 or stalled:
-            idx = np.flatnonzero(I)
+            idx = I.nonzero()[0]     # (np.flatnonzero of a 1-D mask, without its dispatch)
             # the free block in LAPACK's (Fortran) order, factorised in place (K.T's block,
             # transposed: the same values, without the wrapper's transposing copy)
             M = K.T[idx[:, None], idx].T

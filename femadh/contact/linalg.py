@@ -97,7 +97,7 @@ class TrailingLU:
             M *= self.scale[m0:][::-1, None]
         self.n, self.m0 = n, m0
         self.lu, self.piv = lu_factor(M, overwrite_a=True)
-        swaps = np.flatnonzero(self.piv != np.arange(n - m0))
+        swaps = (self.piv != np.arange(n - m0)).nonzero()[0]
         self.k_valid = int(swaps[0]) if swaps.size else n - m0
         self._block = (None, None)
 

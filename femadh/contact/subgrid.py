@@ -108,7 +108,7 @@ class SubgridStep:
         # rule is as accurate on the saturated part): one 8-point rule on [0, 1] whose
         # weights times the polynomials in t are constants (two small products)
         one = inside & (np.abs(dx) <= PANEL)
-        k = np.flatnonzero(one)
+        k = one.nonzero()[0]
         if k.size:
             x = x0[k, None] + dx[k, None] * _GT
             r = self._r8[k]
@@ -119,7 +119,7 @@ class SubgridStep:
                 svr = sv * r
                 out[:2, k] = (svr @ _WS).T
                 out[2:, k] = ((svr - sv * svr) @ _WD).T
-        quad = np.flatnonzero(inside & ~one)
+        quad = (inside & ~one).nonzero()[0]
         if quad.size:
             out[:, quad] = self._quadrature(x0[quad], dx[quad], re[quad], dr[quad], energy)
         return out
