@@ -2011,10 +2011,11 @@ DEFECTS = [
     D("hotpath_sum_aliased", "laws' sum: the first law's array itself (its -0.0 kept, a "
       "cached array added to)", "femadh/contact/problem.py",
       (("                    out = v + 0.0\n", "                    out = v\n"),)),
-    D("hotpath_sum_first_twice", "laws' sum: the first law added twice",
+    D("hotpath_sum_shape_unchecked", "laws' sum: a first law's value taken as the sum "
+      "whatever its shape (a law constant in h not broadcast to the nodes)",
       "femadh/contact/problem.py",
-      (("                    out = v + 0.0\n                    continue\n",
-        "                    out = v + 0.0\n"),)),
+      (("                        and h.dtype == _F8 and v.shape == h.shape):",
+        "                        and h.dtype == _F8):"),)),
     D("hotpath_finite_any", "laws' finite check: passes unless every node is not finite",
       "femadh/contact/problem.py",
       (("        if not finite.all():", "        if not finite.any():"),)),

@@ -94,6 +94,11 @@ def test_law_sum_gives_the_zeros_plus_laws_bits_and_leaves_the_laws_alone():
     ref2 += v2
     assert _bits(_summed([v1, v2], h)) == _bits(ref2)
     assert _bits(v1) == _bits(kept)             # the first law's (cached) array untouched
+    # a law constant in h (one value): broadcast to the nodes, as the zeros it was added to
+    ref3 = np.zeros_like(h)
+    ref3 += 2.5
+    got3 = _summed([2.5], h)
+    assert got3.shape == h.shape and _bits(got3) == _bits(ref3)
 
 
 def test_finite_check_and_sum_pass_finite_values_whose_sum_overflows_silently():
