@@ -374,8 +374,7 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
     if m is not None:
         dw = -lu.solve(m, F_I)
     else:
-        if isinstance(lu, TrailingLU) or not np.array_equal(I, lu_I) or lu is None \
-                or stalled:
+        if isinstance(lu, TrailingLU) or _other_set(I, lu_I) or lu is None or stalled:
             idx = I.nonzero()[0]     # (np.flatnonzero of a 1-D mask, without its dispatch)
             # the free block in LAPACK's (Fortran) order, factorised in place (K.T's block,
             # transposed: the same values, without the wrapper's transposing copy)
@@ -388,6 +387,12 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
             res_prev = res
         dw = -linalg.lu_solve(lu, F_I)
     return dw, lu, lu_I, fresh, res_prev, n_factor
+
+
+def _other_set(I, lu_I):
+    """not np.array_equal(I, lu_I) for the free-node masks (lu_I a mask of the same nodes, or
+    None), without its conversions."""
+    return lu_I is None or lu_I.shape != I.shape or bool((I != lu_I).any())
 
 
 def _count(stats, iterations, factorisations, stagnated):
