@@ -33,6 +33,7 @@ Stability of a converged state: :mod:`femadh.contact.stability` (the energy Hess
 import math
 
 import numpy as np
+
 from ..interrupt import check as safe_point
 # (the LU through femadh.contact.linalg's direct LAPACK calls, the bits of scipy's lu_factor
 # and lu_solve without their wrappers; read as linalg.lu_factor at the call, so that a test
