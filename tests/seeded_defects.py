@@ -890,7 +890,8 @@ DEFECTS = [
       (("else np.asfortranarray(self.lu[:k, :k])", "else np.asfortranarray(self.lu[-k:, -k:])"),)),
     D("general_lu_transposed", "the corrector's general LU: the free block of K transposed",
       "femadh/contact/complementarity.py",
-      (("            M = K.T[idx[:, None], idx].T", "            M = K.T[idx[:, None], idx]"),)),
+      (("            M = np.asfortranarray(K[idx][:, idx])",
+        "            M = np.asfortranarray(K[idx][:, idx].T)"),)),
     D("stability_without_law", "stability test (collocated laws): the elastic block factorised "
       "for the Hessian, the law's softening dropped", "femadh/contact/stability.py",
       (("lapack.dpotrf(H.T, lower=False, clean=False, overwrite_a=True)",

@@ -377,9 +377,11 @@ def _lu_step(problem, h, A, I, m, F_I, lu, lu_I, fresh, res, res_prev, tol, chor
     else:
         if isinstance(lu, TrailingLU) or _other_set(I, lu_I) or lu is None or stalled:
             idx = I.nonzero()[0]     # (np.flatnonzero of a 1-D mask, without its dispatch)
-            # the free block in LAPACK's (Fortran) order, factorised in place (K.T's block,
-            # transposed: the same values, without the wrapper's transposing copy)
-            M = K.T[idx[:, None], idx].T
+            # the free block in LAPACK's (Fortran) order, factorised in place: its rows
+            # gathered (each a contiguous copy), then its columns, laid out in Fortran order -
+            # the same values and layout as K.T's fancy-indexed block transposed, at a third
+            # of its cost (0.37 against 1.2 ms for 393 of 493 nodes)
+            M = np.asfortranarray(K[idx][:, idx])
             add_jacobian(M, problem.law_jacobian(h), idx)
             lu, lu_I, fresh = linalg.lu_factor(M, overwrite_a=True), I, True
             n_factor += 1
