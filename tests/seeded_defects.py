@@ -891,7 +891,8 @@ DEFECTS = [
       (("else np.asfortranarray(self.lu[:k, :k])", "else np.asfortranarray(self.lu[-k:, -k:])"),)),
     D("general_lu_transposed", "the corrector's general LU: the free block of K transposed",
       "femadh/contact/complementarity.py",
-      (("            M = K.T[idx[:, None], idx].T", "            M = K.T[idx[:, None], idx]"),)),
+      (("            M = np.asfortranarray(K[idx][:, idx])",
+        "            M = np.asfortranarray(K[idx][:, idx].T)"),)),
     D("stability_without_law", "stability test (collocated laws): the elastic block factorised "
       "for the Hessian, the law's softening dropped", "femadh/contact/stability.py",
       (("lapack.dpotrf(H.T, lower=False, clean=False, overwrite_a=True)",
@@ -1449,7 +1450,7 @@ DEFECTS = [
       (("self.q[:k - b, k - 1]", "self.q[:k - b, k - b - 1]"),)),
     D("carried_on_set_change", "corrector: the step's h, P, K w carried into an iteration "
       "whose contact set changed", "femadh/contact/complementarity.py",
-      (("if sigma is not None and (np.array_equal(new_A, A) or\n"
+      (("if sigma is not None and (same or\n"
         "                                  CARRY_RELEASES and not np.any(new_A & I)):",
         "if sigma is not None:"),)),
     D("refute_no_margin", "edge-block refutation at lambda_max > 0.5 (refutes positive "
@@ -1884,6 +1885,34 @@ DEFECTS = [
     D("corr_block_unchecked", "preconditioner: a solve reuses the last block whatever its size",
       "femadh/contact/linalg.py",
       (("        if blk[0] != k or k <= 0:\n", "        if blk[0] is None or k <= 0:\n"),)),
+    # -- the contact solve's hot path without scipy's wrappers (branch hotpath,
+    #    seeded_defects_hotpath.md)
+    D("hotpath_getrs_transposed", "direct LAPACK: the LU solve of the transposed system",
+      "femadh/contact/linalg.py",
+      (("    x, info = _GETRS(lu, piv, b, trans=0, overwrite_b=False)",
+        "    x, info = _GETRS(lu, piv, b, trans=1, overwrite_b=False)"),)),
+    D("hotpath_trtrs_untransposed", "direct LAPACK: GMRES's C-ordered R handed to trtrs "
+      "as if Fortran-ordered", "femadh/contact/linalg.py",
+      (("    x, info = _TRTRS(R.T, g, overwrite_b=False, lower=True, trans=True, unitdiag=False)",
+        "    x, info = _TRTRS(R, g, overwrite_b=False, lower=True, trans=True, unitdiag=False)"),)),
+    D("hotpath_diagonal_copy", "diagonal view: a Fortran-ordered matrix's diagonal taken "
+      "from a copy (the adds lost)", "femadh/contact/linalg.py",
+      (("        return M.T.reshape(-1)[::M.shape[0] + 1]",
+        "        return M.reshape(-1)[::M.shape[0] + 1]"),)),
+    D("hotpath_sum_aliased", "laws' sum: the first law's array itself (its -0.0 kept, a "
+      "cached array added to)", "femadh/contact/problem.py",
+      (("                    out = v + 0.0\n", "                    out = v\n"),)),
+    D("hotpath_sum_shape_unchecked", "laws' sum: a first law's value taken as the sum "
+      "whatever its shape (a law constant in h not broadcast to the nodes)",
+      "femadh/contact/problem.py",
+      (("                        and h.dtype == _F8 and v.shape == h.shape):",
+        "                        and h.dtype == _F8):"),)),
+    D("hotpath_finite_any", "laws' finite check: passes unless every node is not finite",
+      "femadh/contact/problem.py",
+      (("        if not finite.all():", "        if not finite.any():"),)),
+    D("hotpath_set_key_stale", "corrector: the active set's bytes not updated with the set "
+      "(later iterations compare against the first set)", "femadh/contact/complementarity.py",
+      (("        A, A_key = new_A, new_key\n", "        A = new_A\n"),)),
     # -- what a user sees: Ctrl-C at any moment, an ignored SIGINT, the figures' words and
     #    their prepared layout, a study's estimates (seeded_defects_ui.md)
     D("ui_sigign_overridden", "a run replaces a SIGINT its parent set to SIG_IGN",

@@ -1,8 +1,75 @@
 """Factorisations that follow a moving contact edge, and the Krylov solver they precondition."""
 import math
+import warnings
 
 import numpy as np
 from scipy import linalg
+from scipy.linalg import lapack
+
+
+# LAPACK called directly on float64 arrays: the bits of scipy.linalg.lu_factor, lu_solve and
+# solve_triangular with check_finite=False (which call these same routines, after a batch
+# decorator, an array-namespace lookup and a routine lookup by dtype that cost more than the
+# LAPACK call itself on the corrector's small systems: in a profile of the whole suite,
+# scipy.linalg's 556 000 wrapped calls - 185 000 LU factorisations, 284 000 LU solves, the
+# rest Cholesky and triangular solves - spent ~12 s under the profiler in the wrappers' own
+# Python: the batch decorator 5.6 s, the array-namespace conversions 5.2 s, the routine
+# lookup 1.4 s; validation/results/hotpath.md); any other dtype, shape or an empty system
+# goes through scipy's own functions
+_GETRF, _GETRS, _TRTRS = lapack.dgetrf, lapack.dgetrs, lapack.dtrtrs
+_F8 = np.dtype(np.float64)
+
+
+def lu_factor(a, overwrite_a=False):
+    """(lu, piv) of a square float matrix a: scipy.linalg.lu_factor(a, check_finite=False,
+    overwrite_a=overwrite_a), the same LAPACK getrf call and the same warning on an exactly
+    singular matrix, without its wrappers."""
+    if type(a) is not np.ndarray or a.dtype != _F8 or a.ndim != 2 or a.size == 0:
+        return linalg.lu_factor(a, check_finite=False, overwrite_a=overwrite_a)
+    lu, piv, info = _GETRF(a, overwrite_a=overwrite_a)
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal getrf (lu_factor)")
+    if info > 0:
+        warnings.warn(f"Diagonal number {info} is exactly zero. Singular matrix.",
+                      linalg.LinAlgWarning, stacklevel=2)
+    return lu, piv
+
+
+def lu_solve(lu_and_piv, b):
+    """x with a x = b from a's :func:`lu_factor`: scipy.linalg.lu_solve(lu_and_piv, b,
+    check_finite=False), the same LAPACK getrs call, without its wrappers."""
+    lu, piv = lu_and_piv
+    if (type(lu) is not np.ndarray or lu.dtype != _F8 or lu.ndim != 2 or type(b) is not
+            np.ndarray or b.dtype != _F8 or b.ndim != 1 or b.size == 0
+            or b.shape[0] != lu.shape[0]):
+        return linalg.lu_solve(lu_and_piv, b, check_finite=False)
+    x, info = _GETRS(lu, piv, b, trans=0, overwrite_b=False)
+    if info != 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal gesv|posv")
+    return x
+
+
+def diagonal(M):
+    """A writeable view of the diagonal of the square contiguous array M (C or Fortran
+    order): ``diagonal(M)[...] += d`` makes the adds of ``M[np.diag_indices_from(M)] += d``,
+    the same bits, without building the two index arrays and the gather/scatter (a
+    non-contiguous M: its diagonal by those indices)."""
+    if M.flags.c_contiguous:
+        return M.reshape(-1)[::M.shape[0] + 1]
+    if M.flags.f_contiguous:
+        return M.T.reshape(-1)[::M.shape[0] + 1]
+    return _DiagonalOf(M)
+
+
+class _DiagonalOf:
+    """``+=`` on the diagonal of a non-contiguous square array, by its index arrays."""
+
+    def __init__(self, M):
+        self.M = M
+
+    def __iadd__(self, d):
+        self.M[np.diag_indices_from(self.M)] += d
+        return self
 
 
 class TrailingLU:
@@ -22,7 +89,8 @@ class TrailingLU:
         if D.ndim == 2:     # a sub-grid law's tridiagonal Jacobian (ContactProblem.law_jacobian)
             M += D[m0:, m0:][::-1, ::-1]
         else:
-            M[np.diag_indices_from(M)] += D[m0:][::-1]
+            d = diagonal(M)
+            d += D[m0:][::-1]
         # rows scaled by the annulus areas: diag(area) K is nearly symmetric (the energy
         # Hessian), for which partial pivoting rarely swaps rows - so one factorisation keeps
         # covering every trailing block
@@ -30,8 +98,8 @@ class TrailingLU:
         if self.scale is not None:
             M *= self.scale[m0:][::-1, None]
         self.n, self.m0 = n, m0
-        self.lu, self.piv = linalg.lu_factor(M, check_finite=False, overwrite_a=True)
-        swaps = np.flatnonzero(self.piv != np.arange(n - m0))
+        self.lu, self.piv = lu_factor(M, overwrite_a=True)
+        swaps = (self.piv != np.arange(n - m0)).nonzero()[0]
         self.k_valid = int(swaps[0]) if swaps.size else n - m0
         self._block = (None, None)
 
@@ -56,7 +124,7 @@ class TrailingLU:
                              f"valid leading size {self.k_valid})")
         if self.scale is not None:
             rhs = rhs * self.scale[m:]
-        return linalg.lu_solve(self._lu_block(m), rhs[::-1], check_finite=False)[::-1]
+        return lu_solve(self._lu_block(m), rhs[::-1])[::-1]
 
 
 def disk_size(A):
@@ -125,7 +193,8 @@ class TrailingCholesky:
         if D.ndim == 2:     # a sub-grid law: area x its Jacobian is the symmetric df/dh
             M += (areas[m0:, None] * D[m0:, m0:])[::-1, ::-1]
         else:
-            M[np.diag_indices_from(M)] += (areas[m0:] * D[m0:])[::-1]
+            d = diagonal(M)
+            d += (areas[m0:] * D[m0:])[::-1]
         u, info = lapack.dpotrf(M, lower=False, clean=True, overwrite_a=True)
         self._k_valid = n - m0 if info == 0 else int(info) - 1
         # the factor in the kept precision is taken when a block is first asked for
@@ -260,7 +329,7 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
     (x, iterations, converged)
         x = M^-1 V y minimises |b - A x| over the Krylov space; converged: rtol met.
     """
-    beta = float(np.linalg.norm(b))
+    beta = math.sqrt(b @ b)        # np.linalg.norm's own sqrt(b . b), without its checks
     n = b.size
     if beta == 0.0 or n == 0:
         return np.zeros(n), 0, True
@@ -305,7 +374,16 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
 
 
 def _back_substitute(R, g):
-    """y with the upper triangular R y = g (small: GMRES's Hessenberg after rotation)."""
-    from scipy.linalg import solve_triangular
+    """y with the upper triangular R y = g (small: GMRES's Hessenberg after rotation).
 
-    return solve_triangular(R, g, lower=False, check_finite=False)
+    scipy.linalg.solve_triangular(R, g, check_finite=False) for R a block of a C-ordered
+    array, as it calls LAPACK trtrs (on the transpose: the lower triangle of R^T, transposed
+    system), without its wrappers."""
+    if R.dtype != _F8 or g.dtype != _F8 or R.flags.f_contiguous or g.size == 0:
+        return linalg.solve_triangular(R, g, lower=False, check_finite=False)
+    x, info = _TRTRS(R.T, g, overwrite_b=False, lower=True, trans=True, unitdiag=False)
+    if info > 0:
+        raise linalg.LinAlgError(f"singular matrix: resolution failed at diagonal {info-1}")
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}-th argument of internal trtrs")
+    return x

@@ -32,6 +32,8 @@ poles at x = +-i pi bound the error of 8 points on a panel of half-width 1 by ~1
 import numpy as np
 from scipy.special import expit
 
+from .linalg import diagonal
+
 #: |x| beyond which the logistic counts as saturated (S = 0 or 1 to e^-36 ~ 2e-16)
 WINDOW = 36.0
 #: largest panel (in x = (h_c - h)/w) of the quadrature across the step
@@ -106,7 +108,7 @@ class SubgridStep:
         # rule is as accurate on the saturated part): one 8-point rule on [0, 1] whose
         # weights times the polynomials in t are constants (two small products)
         one = inside & (np.abs(dx) <= PANEL)
-        k = np.flatnonzero(one)
+        k = one.nonzero()[0]
         if k.size:
             x = x0[k, None] + dx[k, None] * _GT
             r = self._r8[k]
@@ -117,7 +119,7 @@ class SubgridStep:
                 svr = sv * r
                 out[:2, k] = (svr @ _WS).T
                 out[2:, k] = ((svr - sv * svr) @ _WD).T
-        quad = np.flatnonzero(inside & ~one)
+        quad = (inside & ~one).nonzero()[0]
         if quad.size:
             out[:, quad] = self._quadrature(x0[quad], dx[quad], re[quad], dr[quad], energy)
         return out
@@ -220,7 +222,8 @@ class SubgridStep:
 def add_jacobian(M, J, idx):
     """M += J[idx, idx] in place (M the free block of K, rows and columns ``idx``)."""
     if J.ndim == 1:
-        M[np.diag_indices_from(M)] += J[idx]
+        d = diagonal(M)
+        d += J[idx]
     else:
         M += J[idx][:, idx] if not isinstance(idx, slice) else J[idx, idx]
     return M
