@@ -351,7 +351,7 @@ def test_a_deferred_refresh_factorised_later_is_counted(fig4, monkeypatch):
         made["lu"] += 1
         return real_lu(*a, **k)
 
-    # (scipy.linalg's: the corrector's own LU and TrailingLU's)
+    # (femadh.contact.linalg.lu_factor: the corrector's own LU and TrailingLU's both call it)
     monkeypatch.setattr(la.TrailingCholesky, "_factorise", fact)
     monkeypatch.setattr(cm.linalg, "lu_factor", lu)
     cases = 0
