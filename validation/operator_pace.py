@@ -7,8 +7,10 @@ process, beside the whole run's CPU.
 Runs paper1_fig3 at [solver] accuracy = 1e-4 and paper1_fig4 at 1e-3 (the bundled scenes
 with that accuracy, outputs in a temporary folder, figures off) ``--repeat`` times each,
 alternating, and prints per run: operators built (nodes), assembly, inversion, run CPU and
-the max adhesion; then the medians (results: validation/results/greenop.md). Run it from the root of the tree whose femadh is to be timed (one BLAS
-thread, set below before numpy loads); compare trees by running it in each, alternating.
+the max adhesion; then the medians (results: validation/results/greenop.md). Run it from
+the root of the tree whose femadh is to be timed (one BLAS thread: set below before numpy
+loads, unless OPENBLAS_NUM_THREADS is already set); compare trees by running it in each,
+alternating.
 """
 import os
 
@@ -25,6 +27,13 @@ from femadh.elastic import green, operator  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNS = (("paper1_fig3", 1e-4), ("paper1_fig4", 1e-3))
+
+
+def _positive(text):
+    n = int(text)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{text} is not a positive count")
+    return n
 
 
 def _instrument(log):
@@ -71,7 +80,7 @@ def one(name, accuracy, tmp):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=_positive, default=3, help="runs of each scene (>= 1)")
     args = ap.parse_args(argv)
     print(f"femadh from {Path(femadh.__file__).parent}; load {os.getloadavg()[0]:.2f}")
     rows = {name: [] for name, _ in RUNS}

@@ -168,7 +168,8 @@ def section_sweep_grids(out, scene, sigma, lim, c_star, variants=True):
 def sawtooth_scan(scene, pb, st, span, n):
     """The runner's solver on the fixed grid of problem ``pb`` scanned in d over st.d +- span
     (n states, outwards from the branch state ``st`` on that grid, each from its neighbour's
-    state): (d array, F_ex array on the runner's disk, contact-node counts)."""
+    state): (d array, F_ex array on the runner's disk, NaN where a state does not converge
+    to a stable one, contact-node counts)."""
     from femadh.contact import solve_state
     from femadh.contact.forces import state_forces
 
@@ -232,8 +233,13 @@ def section_fractions(out, scene, lim, c_star, h_nom=4.04e-9, n_scan=41):
         pb = ContactProblem(br.base, scene.sphere, dict(scene.effects), scene.gap)
         ds, F, cnt = sawtooth_scan(scene, pb, st, 0.006e-9, n_scan)
         ok = np.isfinite(F)
+        if not ok.any():
+            raise RuntimeError(f"section 4, f = {f}: none of the {n_scan} sawtooth states "
+                               f"converged to a stable state (h = {h * 1e9:.5f} nm)")
         rel = (F[ok] - lim) / lim
         releases = int(np.count_nonzero(np.diff(cnt[ok]) != 0))
+        if not ok.all():     # a state the scan skipped: say so in the table, not silently
+            releases = f"{releases} ({n_scan - int(ok.sum())} of {n_scan} unconverged)"
         out.append(f"| {f:.2f} | {h * 1e9:.5f} | {(fb - lim) / lim:+.4e} | "
                    f"{(jn.max() - lim) / lim:+.4e} | {rel.max():+.4e} | {rel.min():+.3e} | "
                    f"{releases} | {time.perf_counter() - t0:.1f} |")

@@ -19,7 +19,8 @@ class SurfaceOperator:
             self._stiffness = np.asfortranarray(linalg.inv(self.compliance, check_finite=False))
             if not np.all(np.isfinite(self._stiffness)):
                 raise FloatingPointError(f"stiffness K = C^-1 of the {self.grid.n}-node "
-                                         "operator is not finite (a singular compliance)")
+                                         "operator is not finite (a singular or non-finite "
+                                         "compliance)")
         return self._stiffness
 
     def displacement(self, pressure):
