@@ -2068,6 +2068,16 @@ DEFECTS = [
       "femadh/elastic/operator.py",
       (("linalg.inv(self.compliance, check_finite=False)",
         "linalg.inv(self.compliance.T, check_finite=False)"),)),
+    # -- the landing's Cholesky and relaxation LU by LAPACK directly (coordinator, session 11)
+    D("cho_lower", "direct potrf: the lower factor with potrs told upper",
+      "femadh/contact/linalg.py",
+      (("c, info = _POTRF(a, lower=False, overwrite_a=overwrite_a, clean=False)",
+        "c, info = _POTRF(a, lower=True, overwrite_a=overwrite_a, clean=False)"),)),
+    D("cho_indefinite_silent", "direct potrf: an indefinite matrix not refused (the descent "
+      "takes a step of a partial factor instead of raising its damping)",
+      "femadh/contact/linalg.py",
+      (("    if info > 0:\n        raise linalg.LinAlgError(f\"{info}-th leading minor",
+        "    if info > 999999:\n        raise linalg.LinAlgError(f\"{info}-th leading minor"),)),
 ]
 
 

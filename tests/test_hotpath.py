@@ -41,6 +41,29 @@ def test_direct_lapack_singular_lu_warns_as_scipy():
     assert [type(w.message) for w in caught] == [sla.LinAlgWarning]
 
 
+@pytest.mark.parametrize("n", [1, 7, 60])
+def test_direct_lapack_cholesky_gives_scipys_bits(n):
+    """The landing's damped descent: potrf/potrs called directly, scipy's cho_factor /
+    cho_solve bits (a Fortran copy factorised in place, as the descent does, and a C one)."""
+    rng = np.random.default_rng(n)
+    A = rng.standard_normal((n, n))
+    H = A @ A.T + n * np.eye(n)
+    g = rng.standard_normal(2 * n)[::2].copy()
+    for M in (H, np.asfortranarray(H)):
+        ref = sla.cho_factor(M.copy(order="A"), check_finite=False, overwrite_a=True)
+        got = la.cho_factor(M.copy(order="A"), overwrite_a=True)
+        assert _bits(got[0]) == _bits(ref[0]) and got[1] == ref[1]
+        assert _bits(la.cho_solve(got, g)) == _bits(sla.cho_solve(ref, g, check_finite=False))
+
+
+def test_direct_lapack_cholesky_refuses_an_indefinite_matrix_as_scipy():
+    M = np.diag([1.0, -1.0, 2.0])
+    with pytest.raises(sla.LinAlgError, match="2-th leading minor"):
+        la.cho_factor(M.copy())
+    with pytest.raises(sla.LinAlgError, match="2-th leading minor"):
+        sla.cho_factor(M.copy(), check_finite=False)
+
+
 @pytest.mark.parametrize("k", [2, 5, 12])
 def test_back_substitution_gives_solve_triangulars_bits(k):
     # GMRES's R: the leading k x k block of a C-ordered (maxiter + 1) x maxiter array

@@ -6,6 +6,7 @@ from scipy import linalg as sla
 from ..interrupt import check as safe_point
 from .complementarity import MAX_GAP_CLOSURE, STALL_ITER, solve_complementarity
 from .subgrid import add_jacobian
+from .linalg import cho_factor, cho_solve, lu_factor, lu_solve
 
 #: descent steps in a row that lower the energy by no more than its round-off after which the
 #: descent has settled in its basin (Newton polishes from there). Measured on the Fig 4 scene
@@ -122,14 +123,14 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
             M = np.array(H, order="F")
             M[np.diag_indices_from(M)] += lam * scale_diag[free]
             try:
-                c = sla.cho_factor(M, check_finite=False, overwrite_a=True)
+                c = cho_factor(M, overwrite_a=True)
             except sla.LinAlgError:
                 lam *= 4
                 if lam > 1e12:
                     return w, False
                 continue
             dw = np.zeros_like(w)
-            dw[free] = -sla.cho_solve(c, g[free], check_finite=False)
+            dw[free] = -cho_solve(c, g[free])
             w_new = np.minimum(w + dw, upper)
             e_new = problem.energy(w_new, d)
             if np.isfinite(e_new) and e_new <= e:
@@ -479,8 +480,7 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         M = a[idx, None] * M
         M[np.diag_indices_from(M)] += mu * sdiag[idx]
         try:
-            dw = -sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],
-                               check_finite=False)
+            dw = -lu_solve(lu_factor(M), a[idx] * F[idx])
         except (ValueError, sla.LinAlgError):
             return None, None, step
         if not np.all(np.isfinite(dw)):

@@ -17,6 +17,7 @@ from scipy.linalg import lapack
 # lookup 1.4 s; validation/results/hotpath.md); any other dtype, shape or an empty system
 # goes through scipy's own functions
 _GETRF, _GETRS, _TRTRS = lapack.dgetrf, lapack.dgetrs, lapack.dtrtrs
+_POTRF, _POTRS = lapack.dpotrf, lapack.dpotrs
 _F8 = np.dtype(np.float64)
 
 
@@ -46,6 +47,39 @@ def lu_solve(lu_and_piv, b):
     x, info = _GETRS(lu, piv, b, trans=0, overwrite_b=False)
     if info != 0:
         raise ValueError(f"illegal value in {-info}th argument of internal gesv|posv")
+    return x
+
+
+def cho_factor(a, overwrite_a=False):
+    """(c, lower) of a symmetric positive definite float matrix a: scipy.linalg.cho_factor(a,
+    check_finite=False, overwrite_a=overwrite_a), the same LAPACK potrf call (upper factor,
+    the other triangle left as it was) and the same LinAlgError where a is not positive
+    definite, without its wrappers (the landing's damped descent factorises ~26 000 small
+    Hessians in the suite)."""
+    if (type(a) is not np.ndarray or a.dtype != _F8 or a.ndim != 2 or a.size == 0
+            or a.shape[0] != a.shape[1]):
+        return linalg.cho_factor(a, check_finite=False, overwrite_a=overwrite_a)
+    c, info = _POTRF(a, lower=False, overwrite_a=overwrite_a, clean=False)
+    if info > 0:
+        raise linalg.LinAlgError(f"{info}-th leading minor of the array is not positive "
+                                 "definite")
+    if info < 0:
+        raise ValueError(f"LAPACK reported an illegal value in {-info}-th argument on entry "
+                         "to \"POTRF\".")
+    return c, False
+
+
+def cho_solve(c_and_lower, b):
+    """x with a x = b from a's :func:`cho_factor`: scipy.linalg.cho_solve(c_and_lower, b,
+    check_finite=False), the same LAPACK potrs call, without its wrappers."""
+    c, lower = c_and_lower
+    if (type(c) is not np.ndarray or c.dtype != _F8 or c.ndim != 2 or type(b) is not
+            np.ndarray or b.dtype != _F8 or b.ndim != 1 or b.size == 0
+            or b.shape[0] != c.shape[0] or c.shape[0] != c.shape[1]):
+        return linalg.cho_solve(c_and_lower, b, check_finite=False)
+    x, info = _POTRS(c, b, lower=lower, overwrite_b=False)
+    if info != 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal potrs")
     return x
 
 
@@ -273,8 +307,6 @@ class TrailingCholesky:
     def _factor_block(self, k):
         """The leading k x k block of U, contiguous (one copy per block size)."""
         if self._block[0] != k:
-            from scipy.linalg import blas
-
             kept = self.kept
             blk = kept if k == kept.shape[0] else np.asfortranarray(kept[:k, :k])
             # (the routine's name, not the f2py routine: a factor stays picklable)
