@@ -31,6 +31,7 @@ the prediction, is then halved after ~10 iterations instead of 40.
 Stability of a converged state: :mod:`femadh.contact.stability` (the energy Hessian's inertia).
 """
 import math
+import weakref
 
 import numpy as np
 
@@ -116,6 +117,19 @@ KRYLOV_MIN_FREE = 150
 #: set, two solves fewer; every grid state the same within 4e-22 m); every bundled scene's
 #: headline numbers move by < 5e-7 of their estimated errors (validation/results/corrector.md)
 GMRES_RTOL_NEW_SET = 1e-4
+#: the Krylov products K_II v of the corrector's Newton steps in single precision (a float32
+#: copy of K, :func:`_krylov_product`): the products read K whole, ~1/2 of the Krylov
+#: iteration's time on the grids of the accuracy goals (K_II v at 867 nodes 330 us in double,
+#: 150 us in single; 493 nodes 43 and 23 us), and single precision halves the bytes read.
+#: Only GMRES's operator moves: its relative error of ~1e-7 (measured on the Fig 4 disk's
+#: steps, tests/test_pace.py) is below GMRES_RTOL, so each step is still an inexact Newton
+#: step of the exact Jacobian to ~GMRES_RTOL; the residual of eq (6)/(10) that convergence
+#: is declared on, K w and the tangent stay in double. Measured (validation/results/pace.md):
+#: Fig 3 at accuracy 1e-4 Newton iterations 467 -> 469, Krylov 1760 -> 1805; Fig 4 at 1e-3
+#: 2476 -> 2476, 10 309 -> 10 350; every headline within 3e-7 of its estimated error
+KRYLOV_SINGLE = True
+#: the float32 copies of K, by problem (:func:`_single_k`)
+_SINGLE = weakref.WeakKeyDictionary()
 #: an iteration whose new active set only releases nodes carries its gaps, pressures and
 #: K w to the next (False: recomputed from w, the same bits - tests/test_corrector.py)
 CARRY_RELEASES = True
@@ -291,17 +305,18 @@ def _krylov_step(problem, h, A, m, F_I, pre, rtol=GMRES_RTOL):
     takes the step."""
     n = h.size
     D = problem.law_jacobian(h)     # a vector; a tridiagonal matrix with a sub-grid law
-    a, K_II = problem.areas[m:], problem.K[m:, m:]
+    a = problem.areas[m:]
     fr = slice(m, None)
+    product = _krylov_product(problem, m)
 
     if D.ndim == 1:
         D_I = D[fr]     # apply_jacobian's own product, its slice taken once per step
 
         def apply_a(v):
-            return a * (K_II @ v + D_I * v)
+            return a * (product(v) + D_I * v)
     else:
         def apply_a(v):
-            return a * (K_II @ v + apply_jacobian(D, fr, v))
+            return a * (product(v) + apply_jacobian(D, fr, v))
 
     rhs = -a * F_I
     n_factor = 0
@@ -331,6 +346,31 @@ def _krylov_step(problem, h, A, m, F_I, pre, rtol=GMRES_RTOL):
         if ok:
             return dw, pre, n_factor
     return None, pre, n_factor
+
+
+def _krylov_product(problem, m):
+    """v -> K[m:, m:] v for the Krylov iteration of a Newton step: in single precision with
+    KRYLOV_SINGLE (the product's float32 copy of K kept per problem, :func:`_single_k`),
+    else K's own double product."""
+    if not KRYLOV_SINGLE:
+        K_II = problem.K[m:, m:]
+        return K_II.__matmul__
+    K_II = _single_k(problem)[m:, m:]
+    single = np.float32
+
+    def product(v):
+        return (K_II @ v.astype(single)).astype(float)
+    return product
+
+
+def _single_k(problem):
+    """The float32 copy of ``problem.K``, made once per problem (and again if its K is
+    replaced): 4 bytes a coefficient beside K's 8."""
+    held = _SINGLE.get(problem)
+    if held is None or held[0] is not problem.K:
+        held = (problem.K, np.asarray(problem.K, dtype=np.float32))
+        _SINGLE[problem] = held
+    return held[1]
 
 
 def deferred_refresh(problem, D, A, m0, m):
