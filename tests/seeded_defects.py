@@ -1885,6 +1885,20 @@ DEFECTS = [
     D("corr_block_unchecked", "preconditioner: a solve reuses the last block whatever its size",
       "femadh/contact/linalg.py",
       (("        if blk[0] != k or k <= 0:\n", "        if blk[0] is None or k <= 0:\n"),)),
+    # -- the Krylov products in single precision (branch pace, seeded_defects_pace.md)
+    D("pace_single_stale", "single products: the float32 copy kept when the problem's K is "
+      "replaced", "femadh/contact/complementarity.py",
+      (("if held is None or held[0] is not problem.K:", "if held is None:"),)),
+    D("pace_single_half", "single products: K copied in half precision",
+      "femadh/contact/complementarity.py",
+      (("held = (problem.K, np.asarray(problem.K, dtype=np.float32))",
+        "held = (problem.K, np.asarray(problem.K, dtype=np.float16))"),)),
+    D("pace_single_rows", "single products: K_II's rows taken one node off",
+      "femadh/contact/complementarity.py",
+      (("K_II = _single_k(problem)[m:, m:]", "K_II = _single_k(problem)[m - 1:-1, m:]"),)),
+    D("pace_single_no_law", "single products: the law's stiffness left out of GMRES's operator",
+      "femadh/contact/complementarity.py",
+      (("            return a * (product(v) + D_I * v)", "            return a * product(v)"),)),
     # -- the contact solve's hot path without scipy's wrappers (branch hotpath,
     #    seeded_defects_hotpath.md)
     D("hotpath_getrs_transposed", "direct LAPACK: the LU solve of the transposed system",

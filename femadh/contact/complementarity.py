@@ -121,10 +121,11 @@ GMRES_RTOL_NEW_SET = 1e-4
 #: copy of K, :func:`_krylov_product`): the products read K whole, ~1/2 of the Krylov
 #: iteration's time on the grids of the accuracy goals (K_II v at 867 nodes 330 us in double,
 #: 150 us in single; 493 nodes 43 and 23 us), and single precision halves the bytes read.
-#: Only GMRES's operator moves: its relative error of ~1e-7 (measured on the Fig 4 disk's
-#: steps, tests/test_pace.py) is below GMRES_RTOL, so each step is still an inexact Newton
-#: step of the exact Jacobian to ~GMRES_RTOL; the residual of eq (6)/(10) that convergence
-#: is declared on, K w and the tangent stay in double. Measured (validation/results/pace.md):
+#: Only GMRES's operator moves: the product's relative error, 1.1e-7 on a random vector and
+#: 1.6e-6 on a contact state's smooth w (K's rows nearly cancel on it), leaves a Newton step
+#: within 4.4e-7 of the double one's (the Fig 4 disk, tests/test_pace.py): still an inexact
+#: Newton step of the exact Jacobian to ~GMRES_RTOL. The residual of eq (6)/(10) that
+#: convergence is declared on, K w and the tangent stay in double. Measured (validation/results/pace.md):
 #: Fig 3 at accuracy 1e-4 Newton iterations 467 -> 469, Krylov 1760 -> 1805; Fig 4 at 1e-3
 #: 2476 -> 2476, 10 309 -> 10 350; every headline within 3e-7 of its estimated error
 KRYLOV_SINGLE = True
