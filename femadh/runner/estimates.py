@@ -45,7 +45,7 @@ from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # fresh states between grid states and the peak search: their own home (members and the
 # instrument use them too)
-from .peak import lattice_tooth, peak_adhesion
+from .peak import peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
@@ -112,10 +112,7 @@ def refine_peak(scene, res, problem, sink):
     if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
         return 0.0
     branch, f_grid, prev, best, nxt = sink.peak
-    fresh = []
-    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,
-                               record=fresh)
-    sink.peak_fresh = fresh          # (the estimate's lattice part samples around the peak)
+    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
@@ -201,20 +198,13 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
-    # a sub-grid step's cohesive zone at the contact edge: the run says that the sigma-edge
-    # branch ([solver] route = "peak") reads the same largest adhesion; the lattice part
-    # (the tooth of the edge's node-release sawtooth, femadh.runner.peak.lattice_tooth) only
-    # where LATTICE_PART is set (it is not: see there)
-    peak_problem = getattr(sink, "peak_problem", problem)
-    if "max_adhesion_N" in hl and getattr(sink, "peak_fresh", None) is not None \
-            and cohesive_edge(peak_problem):
-        if LATTICE_PART:
-            _, _, prev, best, nxt = sink.peak
-            tooth = lattice_tooth(peak_problem, prev, best, nxt, scene,
-                                  hl["max_adhesion_N"], hl["d_at_max_adhesion_m"],
-                                  sink.peak_fresh)
-            if tooth > 0:
-                parts.setdefault("max_adhesion_N", {})["lattice"] = tooth
+    # a largest adhesion read off the sweep's peak where a sub-grid step's cohesive zone acts
+    # at the contact edge (on the peak's problem): the run says that the sigma-edge branch
+    # ([solver] route = "peak") reads the same limit. No part is added for the edge's
+    # node-release sawtooth: its tips are the branch's states, and the coarser members bound
+    # the sweep's error (:func:`cohesive_edge`)
+    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \
+            and cohesive_edge(getattr(sink, "peak_problem", problem)):
         res.warnings.append(COHESIVE_NOTE)
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
     # a layered body has none: its mesh part is the difference to the next coarser mesh,
@@ -333,25 +323,6 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     # search, which locates the headline's largest adhesion itself
     res.timings["error_estimate_s"] = time.perf_counter() - t0
     return parts
-
-
-#: the largest adhesion gets a lattice part (:func:`femadh.runner.peak.lattice_tooth`, the
-#: tooth of the contact edge's node-release sawtooth around the peak) where a sub-grid step's
-#: cohesive zone acts at the contact edge (:func:`cohesive_edge`). False: no such part. It
-#: was added (issue 21, session 10) for an under-read that was not one: on the stiction map's
-#: sigma = 0.489 nm, p/psat 0.15 point the sweep seemed to stay ~8.5e-4 of the force above the
-#: sigma-edge branch's limit at every spacing, but that limit had been computed at sigma =
-#: 0.489 nm exactly while the map's point (and the sweeps) sit at 0.3 + 1.7/9 = 0.48889 nm
-#: (the max adhesion moves 8.23e-4 of itself there: d ln F / d ln sigma = -3.6, the meniscus
-#: edge only 0.08 nm above sigma) and on the map's 14.14-um disk while the sweeps ran on
-#: 28.28 um (+7.7e-5). At one sigma and one disk the sweep's grid family and the branch's
-#: converge at order 2 to one limit (to 2e-6 of it), the sawtooth's tips are the branch's own
-#: states (the junctions) wherever the edge sits in a cell, and the members alone bound the
-#: sweep's error: effectivity 1.68, 1.35, 1.56, 1.19, 1.31 at band spacings 8.08 ... 2.02 nm
-#: (with the lattice part 3.18, 2.87, 3.13, 2.78, 2.90), 1.67 on the whole point's 1772-node
-#: trial (validation/results/sigma_edge_limits.md, `python -m validation.sigma_edge_limits`).
-#: The part doubled the stated error and cost an extra trial on the map's sweep points.
-LATTICE_PART = False
 
 
 def cohesive_edge(problem):
