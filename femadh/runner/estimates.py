@@ -337,11 +337,15 @@ def cohesive_edge(problem):
     after the landing) and the peak search reads a tooth's tip. Measured on the stiction
     map's sigma = 0.3 + 1.7/9 nm, p/psat 0.15 point (secant 9.8e17 Pa/m against LJ's
     2.77e17; validation/results/sigma_edge_limits.md): the tips are the sigma-edge branch's
-    states on the fixed grid (the junctions, to 5 digits of the error) wherever the edge sits
-    in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's maximum the same to
+    states on the fixed grid (the junctions, to 5 digits of the error or a scan step below)
+    wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's maximum the same to
     3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum converges with the
-    branch's: the two grid families' limits agree to 2e-6, both at order 2, and the
-    coarser members alone bound the sweep's error (effectivity 1.2-1.7 at 8.08-2.02 nm)."""
+    branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
+    of each other (1.5e-6 or 1.6e-5, by which three of the sweep family's members are
+    extrapolated), and on that point the coarser members alone bounded the sweep's error:
+    effectivity 1.68, 1.34, 2.45, 1.47, 1.31 at band spacings 8.08 ... 2.02 nm (one point's
+    measurements, and scattered: ulp-level changes of its input move the 4.04-nm value
+    between 1.56 and 2.45, 2.50 before the Green operator's AGM kernel)."""
     from ..laws.step import SmoothStepLaw
 
     if problem.sigma is None:
@@ -400,10 +404,10 @@ COHESIVE_NOTE = (
     f"{NOTE}a sub-grid step's cohesive zone acts at the contact edge: the sweep reads the "
     "largest adhesion on the node-release sawtooth of the contact edge, whose tips are the "
     "sigma-edge branch's states on this grid; [solver] route = \"peak\" traces that branch in "
-    "the edge radius and reads the same limit (checked on the stiction map's sigma = 0.489 nm, "
-    "p/psat 0.15 point: both converge at order 2 to one value, this estimate covers the "
-    "sweep's error with effectivity 1.2-1.7, and the route took 2 s where the sweep took "
-    "10 min to 1e-3; validation/results/sigma_edge_limits.md)")
+    "the edge radius and reads the same limit (checked on one point, the stiction map's "
+    "sigma = 0.48889 nm (0.3 + 1.7/9), p/psat 0.15: both converge at order 2 to one value, "
+    "where the coarser members' estimate covered the sweep's error; "
+    "validation/results/sigma_edge_limits.md)")
 
 
 def _short(error):
