@@ -1301,8 +1301,8 @@ DEFECTS = [
       (("    data.update(_fold_data(sink))\n", ""),)),
     D("peakfold_search_last_grid", "follow band: the peak searched on the sweep's last grid, "
       "not on its states' own", "femadh/runner/estimates.py",
-      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,',
-        "peak_adhesion(problem, prev, best, nxt, scene,"),)),
+      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)',
+        "peak_adhesion(problem, prev, best, nxt, scene)"),)),
     D("peakfold_resume_order", "resume: the folds not replayed (the resumed bracket reaches "
       "across them)",
       "femadh/runner/sink.py",
