@@ -1847,6 +1847,10 @@ DEFECTS = [
     D("cohesive_note_missing", "a run where a cohesive zone acts at the contact edge does not "
       "name the route that traces it", "femadh/runner/estimates.py",
       (("        res.warnings.append(COHESIVE_NOTE)", "        pass"),)),
+    D("cohesive_note_gate_inverted", "the cohesive-edge note gated on the sweep having no peak "
+      "(latmend: the gate is cohesive_edge and the sink's peak)", "femadh/runner/estimates.py",
+      (('    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \\',
+        '    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is None \\'),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
       (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
