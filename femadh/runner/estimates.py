@@ -202,7 +202,8 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     # at the contact edge (on the peak's problem): the run says that the sigma-edge branch
     # ([solver] route = "peak") reads the same limit. No part is added for the edge's
     # node-release sawtooth: its tips are the branch's states, and the coarser members bound
-    # the sweep's error (:func:`cohesive_edge`)
+    # the sweep's error (:func:`cohesive_edge`; issue 21's lattice part was refuted and
+    # deleted: validation/results/effectivity.md, session 11)
     if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \
             and cohesive_edge(getattr(sink, "peak_problem", problem)):
         res.warnings.append(COHESIVE_NOTE)
@@ -338,8 +339,8 @@ def cohesive_edge(problem):
     map's sigma = 0.3 + 1.7/9 nm, p/psat 0.15 point (secant 9.8e17 Pa/m against LJ's
     2.77e17; validation/results/sigma_edge_limits.md): the tips are the sigma-edge branch's
     states on the fixed grid (the junctions, to 5 digits of the error or a scan step below)
-    wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's maximum the same to
-    3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum converges with the
+    wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's
+    maximum the same to 3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum converges with the
     branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
     of each other (1.5e-6 or 1.6e-5, by which three of the sweep family's members are
     extrapolated), and on that point the coarser members alone bounded the sweep's error:
