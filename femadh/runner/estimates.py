@@ -340,8 +340,8 @@ def cohesive_edge(problem):
     2.77e17; validation/results/sigma_edge_limits.md): the tips are the sigma-edge branch's
     states on the fixed grid (the junctions, to 5 digits of the error or a scan step below)
     wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's
-    maximum the same to 3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum converges with the
-    branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
+    maximum the same to 3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum
+    converges with the branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
     of each other (1.5e-6 or 1.6e-5, by which three of the sweep family's members are
     extrapolated), and on that point the coarser members alone bounded the sweep's error:
     effectivity 1.68, 1.34, 2.45, 1.47, 1.31 at band spacings 8.08 ... 2.02 nm (one point's
