@@ -1301,8 +1301,8 @@ DEFECTS = [
       (("    data.update(_fold_data(sink))\n", ""),)),
     D("peakfold_search_last_grid", "follow band: the peak searched on the sweep's last grid, "
       "not on its states' own", "femadh/runner/estimates.py",
-      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,',
-        "peak_adhesion(problem, prev, best, nxt, scene,"),)),
+      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)',
+        "peak_adhesion(problem, prev, best, nxt, scene)"),)),
     D("peakfold_resume_order", "resume: the folds not replayed (the resumed bracket reaches "
       "across them)",
       "femadh/runner/sink.py",
@@ -1828,25 +1828,29 @@ DEFECTS = [
     # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
     # (lattice_part_off and lattice_tooth_max retired by sigedge: the lattice part is off,
     # femadh.runner.estimates.LATTICE_PART, so peak.lattice_tooth no longer runs)
-    D("lattice_period_quarter", "lattice part: the release period quartered (the window misses the "
-      "tooth's trough)", "femadh/runner/peak.py",
+    # (the release period moved with the refuted lattice part to validation/sigma_edge_limits.py
+    # by latmend; its test, test_release_period_is_one_spacing_of_the_edge, stays)
+    D("lattice_period_quarter", "release period quartered (the lattice column's window misses "
+      "the tooth's trough)", "validation/sigma_edge_limits.py",
       (("    return abs(nxt.d - prev.d) / dn if dn else None",
         "    return abs(nxt.d - prev.d) / (4 * dn) if dn else None"),)),
-    D("cohesive_edge_any_step", "lattice part taken wherever a sub-grid step is reachable",
+    D("cohesive_edge_any_step", "cohesive edge found wherever a sub-grid step is reachable",
       "femadh/runner/estimates.py",
       (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
         "    return secant > 0"),)),
-    D("cohesive_edge_scaled", "lattice part only where the step's secant exceeds 4x LJ's",
+    D("cohesive_edge_scaled", "cohesive edge only where the step's secant exceeds 4x LJ's",
       "femadh/runner/estimates.py",
       (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
         "    return secant > 0 and secant > 4 * problem.surface_force_stiffness()[2]"),)),
     # -- the sweep against the sigma-edge branch on the map's sigma = 0.489 nm point (sigedge)
-    D("lattice_part_on", "estimate: a lattice part where a step's cohesive zone acts at the "
-      "contact edge (the error it stood for was a reference at another sigma)",
-      "femadh/runner/estimates.py", (("LATTICE_PART = False", "LATTICE_PART = True"),)),
+    # (lattice_part_on retired by latmend: the lattice part and its flag are deleted)
     D("cohesive_note_missing", "a run where a cohesive zone acts at the contact edge does not "
       "name the route that traces it", "femadh/runner/estimates.py",
       (("        res.warnings.append(COHESIVE_NOTE)", "        pass"),)),
+    D("cohesive_note_gate_inverted", "the cohesive-edge note gated on the sweep having no peak "
+      "(latmend: the gate is cohesive_edge and the sink's peak)", "femadh/runner/estimates.py",
+      (('    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \\',
+        '    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is None \\'),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
       (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
