@@ -2088,6 +2088,20 @@ DEFECTS = [
       "argument: ValueError where scipy returns empty factors)", "femadh/contact/linalg.py",
       (("a.dtype != _F8 or a.ndim != 2 or a.size == 0:\n        return linalg.lu_factor(",
         "a.dtype != _F8 or a.ndim != 2:\n        return linalg.lu_factor("),)),
+    # -- which landing fallback lands (branch landfix, seeded_defects_landfix.md)
+    D("landfix_no_next_edges", "landing: a relaxation without a polished state is final "
+      "(no neighbouring edges after it)", "femadh/contact/landing.py",
+      (("    near = _next_edges(problem, d, w, active, tol=tol, max_iter=max_iter)",
+        "    near = None"),)),
+    D("landfix_relaxed_unpolished", "landing: the relaxed state taken though its polish "
+      "did not converge on a stable state", "femadh/contact/landing.py",
+      (("        if out.converged and out.stable:", "        if True:"),)),
+    D("landfix_relax_set_unsettled", "landing relaxation: stops on the residual alone, its "
+      "contact set still changing", "femadh/contact/landing.py",
+      (("if r <= tol and np.array_equal(new_A, A):", "if r <= tol:"),)),
+    D("landfix_relaxed_descent_set", "landing: the relaxed state polished from the descent's "
+      "contact set, not its own", "femadh/contact/landing.py",
+      (("max_iter=max_iter, active0=ar)", "max_iter=max_iter, active0=active)"),)),
 ]
 
 
