@@ -1301,8 +1301,8 @@ DEFECTS = [
       (("    data.update(_fold_data(sink))\n", ""),)),
     D("peakfold_search_last_grid", "follow band: the peak searched on the sweep's last grid, "
       "not on its states' own", "femadh/runner/estimates.py",
-      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,',
-        "peak_adhesion(problem, prev, best, nxt, scene,"),)),
+      (('peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)',
+        "peak_adhesion(problem, prev, best, nxt, scene)"),)),
     D("peakfold_resume_order", "resume: the folds not replayed (the resumed bracket reaches "
       "across them)",
       "femadh/runner/sink.py",
@@ -1828,25 +1828,29 @@ DEFECTS = [
     # -- the estimate's lattice part and a uniform grid's members (session 10, estimate)
     # (lattice_part_off and lattice_tooth_max retired by sigedge: the lattice part is off,
     # femadh.runner.estimates.LATTICE_PART, so peak.lattice_tooth no longer runs)
-    D("lattice_period_quarter", "lattice part: the release period quartered (the window misses the "
-      "tooth's trough)", "femadh/runner/peak.py",
+    # (the release period moved with the refuted lattice part to validation/sigma_edge_limits.py
+    # by latmend; its test, test_release_period_is_one_spacing_of_the_edge, stays)
+    D("lattice_period_quarter", "release period quartered (the lattice column's window misses "
+      "the tooth's trough)", "validation/sigma_edge_limits.py",
       (("    return abs(nxt.d - prev.d) / dn if dn else None",
         "    return abs(nxt.d - prev.d) / (4 * dn) if dn else None"),)),
-    D("cohesive_edge_any_step", "lattice part taken wherever a sub-grid step is reachable",
+    D("cohesive_edge_any_step", "cohesive edge found wherever a sub-grid step is reachable",
       "femadh/runner/estimates.py",
       (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
         "    return secant > 0"),)),
-    D("cohesive_edge_scaled", "lattice part only where the step's secant exceeds 4x LJ's",
+    D("cohesive_edge_scaled", "cohesive edge only where the step's secant exceeds 4x LJ's",
       "femadh/runner/estimates.py",
       (("    return secant > 0 and secant > problem.surface_force_stiffness()[2]",
         "    return secant > 0 and secant > 4 * problem.surface_force_stiffness()[2]"),)),
     # -- the sweep against the sigma-edge branch on the map's sigma = 0.489 nm point (sigedge)
-    D("lattice_part_on", "estimate: a lattice part where a step's cohesive zone acts at the "
-      "contact edge (the error it stood for was a reference at another sigma)",
-      "femadh/runner/estimates.py", (("LATTICE_PART = False", "LATTICE_PART = True"),)),
+    # (lattice_part_on retired by latmend: the lattice part and its flag are deleted)
     D("cohesive_note_missing", "a run where a cohesive zone acts at the contact edge does not "
       "name the route that traces it", "femadh/runner/estimates.py",
       (("        res.warnings.append(COHESIVE_NOTE)", "        pass"),)),
+    D("cohesive_note_gate_inverted", "the cohesive-edge note gated on the sweep having no peak "
+      "(latmend: the gate is cohesive_edge and the sink's peak)", "femadh/runner/estimates.py",
+      (('    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \\',
+        '    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is None \\'),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
       (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
@@ -2092,6 +2096,26 @@ DEFECTS = [
       "femadh/contact/linalg.py",
       (("    if info > 0:\n        raise linalg.LinAlgError(f\"{info}-th leading minor",
         "    if info > 999999:\n        raise linalg.LinAlgError(f\"{info}-th leading minor"),)),
+    D("gmres_strided_norm", "GMRES: |b| of a strided b as sqrt(b . b) (not norm's bits)",
+      "femadh/contact/linalg.py", (("    b = np.ascontiguousarray(b)\n", ""),)),
+    D("lu_empty_direct", "direct getrf on an empty system (its size read as an illegal "
+      "argument: ValueError where scipy returns empty factors)", "femadh/contact/linalg.py",
+      (("a.dtype != _F8 or a.ndim != 2 or a.size == 0:\n        return linalg.lu_factor(",
+        "a.dtype != _F8 or a.ndim != 2:\n        return linalg.lu_factor("),)),
+    # -- which landing fallback lands (branch landfix, seeded_defects_landfix.md)
+    D("landfix_no_next_edges", "landing: a relaxation without a polished state is final "
+      "(no neighbouring edges after it)", "femadh/contact/landing.py",
+      (("    near = _next_edges(problem, d, w, active, tol=tol, max_iter=max_iter)",
+        "    near = None"),)),
+    D("landfix_relaxed_unpolished", "landing: the relaxed state taken though its polish "
+      "did not converge on a stable state", "femadh/contact/landing.py",
+      (("        if out.converged and out.stable:", "        if True:"),)),
+    D("landfix_relax_set_unsettled", "landing relaxation: stops on the residual alone, its "
+      "contact set still changing", "femadh/contact/landing.py",
+      (("if r <= tol and np.array_equal(new_A, A):", "if r <= tol:"),)),
+    D("landfix_relaxed_descent_set", "landing: the relaxed state polished from the descent's "
+      "contact set, not its own", "femadh/contact/landing.py",
+      (("max_iter=max_iter, active0=ar)", "max_iter=max_iter, active0=active)"),)),
 ]
 
 
@@ -2130,10 +2154,9 @@ STAGES = (("-m", "not slow"), ("-m", "slow"))
 NO_TESTS = 5
 
 
-def run_one(defect, root, tests=()):
-    original, problem = _apply(root, defect)
-    if problem:
-        return {"defect": defect, "caught": None, "test": problem, "seconds": 0.0}
+def _run_tests(root, tests=()):
+    """The stages of pytest -x on the copy at ``root``: (exit code or "timeout", output,
+    seconds)."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1",
                FEMADH_SEEDED_DEFECT="1")
     t0 = time.perf_counter()
@@ -2151,7 +2174,14 @@ def run_one(defect, root, tests=()):
             code = 0
     except subprocess.TimeoutExpired:
         text, code = "", "timeout"
-    dt = time.perf_counter() - t0
+    return code, text, time.perf_counter() - t0
+
+
+def run_one(defect, root, tests=()):
+    original, problem = _apply(root, defect)
+    if problem:
+        return {"defect": defect, "caught": None, "test": problem, "seconds": 0.0}
+    code, text, dt = _run_tests(root, tests)
     (root / defect.path).write_text(original)
     if code == "timeout":
         return {"defect": defect, "caught": False, "test": f"suite hung > {TIMEOUT_S} s",
@@ -2175,6 +2205,8 @@ def main(argv=None):
     ap.add_argument("--tests", nargs="+", default=(), metavar="PATH",
                     help="run only these test files on each defect (a quick check of new "
                          "code; a defect they catch is caught by the whole suite too)")
+    ap.add_argument("--no-clean-check", action="store_true",
+                    help="do not run the tests on the unmodified tree first")
     args = ap.parse_args(argv)
     missing = [t for t in args.tests if not (ROOT / t.split("::")[0]).exists()]
     if missing:
@@ -2194,6 +2226,16 @@ def main(argv=None):
             r.mkdir()
             _copy_repo(r)
             roots.append(r)
+        # the same tests on the unmodified copy first: a test that already fails would report
+        # every defect that reaches it "caught" (a spy left on a renamed call did, once)
+        if not args.no_clean_check:
+            code, text, dt = _run_tests(roots[0], args.tests)
+            if code != 0:
+                print(f"seeded_defects: the unmodified tree fails its tests ({code}, "
+                      f"{_first_failure(text) or 'no test named'}) after {dt:.0f} s: fix that "
+                      f"first; no defect was run", file=sys.stderr)
+                return 2
+            print(f"clean tree: the tests pass ({dt:.0f} s)", flush=True)
         # one scratch copy per worker; each defect is applied and reverted on its worker's copy
         free = list(roots)
         import threading

@@ -1,20 +1,24 @@
 """The largest adhesion where a capillary step's cohesive zone acts at the contact edge
 (femadh.runner.estimates.cohesive_edge): the coarser members bound the sweep's error without a
-lattice part (femadh.runner.estimates.LATTICE_PART), the run says the sigma-edge branch reads
-the same limit, and the release period the peak search samples is one spacing of the edge.
+lattice part (issue 21's, refuted in session 11 and removed), the run says the sigma-edge
+branch reads the same limit, and the release period of the peak's grid states is one spacing
+of the edge.
 
-The case: the stiction map's point sigma = 0.3 + 1.7/9 nm, p/psat 0.15 (the meniscus edge
-0.08 nm above sigma: a Dugdale zone ~47 nm long at the contact edge) on a static band of
+The case: the stiction map's point sigma = 0.3 + 1.7/9 = 0.48889 nm, p/psat 0.15 (the meniscus
+edge 0.08 nm above sigma: a Dugdale zone ~47 nm long at the contact edge) on a static band of
 5.713 nm narrowed to 2.2 um for the short sweep 1.0 -> 0.5 nm and back that holds its peak
 (617 nodes, ~1.5 CPU-s). Its limit: the edge route's five-member order-2 family at this sigma
 on the map's 14.14-um disk, 1.56613766e-4 N +- 2.97e-9 N, plus the laws between that disk and
 the run's 28.28-um one on the undeformed paraboloid (1.20e-8 N; validation/sigma_edge_limits.py,
-sec. 1 and 5). Measured: the peak 1.5679984e-4 N, 1.74e-7 N (1.11e-3) above it; the members'
-grid part -2.33e-7 N, tail and tolerance 9.0e-10 N: stated 2.34e-7 N, effectivity 1.35 (the
-lattice part would add 2.65e-7 N: 2.87). Issue 21 had read this point's sweeps against the
-branch's limit at sigma = 0.489 nm exactly on the 14.14-um disk (1.564850e-4 N: 8.23e-4 lower
-for the sigma, 7.7e-5 for the disk), which made the members look short (effectivity 0.38-2.24
-falling with the spacing) and the lattice part look needed."""
+sec. 1 and 5). Measured (current main, AGM Green kernel): the peak 1.5679984e-4 N, 1.74e-7 N
+(1.11e-3) above it; the members' grid part -2.33e-7 N, tail and tolerance 9.0e-10 N: stated
+2.34e-7 N, effectivity 1.345 (the lattice part would have added 2.65e-7 N: 2.87). At the five
+spacings 8.08 ... 2.02 nm the members-only effectivity is 1.68, 1.34, 2.45, 1.47, 1.31
+(sigma_edge_limits.md sec. 5), and ulp-level changes of the input move the 4.04-nm one
+between 1.56 and 2.45 (2.50 before the AGM kernel). Issue 21 had read this point's sweeps
+against the branch's limit at sigma = 0.489 nm exactly on the 14.14-um disk (1.564850e-4 N:
+8.23e-4 lower for the sigma, 7.7e-5 for the disk), which made the members look short
+(effectivity 0.38-2.24 falling with the spacing) and the lattice part look needed."""
 import copy
 import warnings
 
@@ -62,13 +66,14 @@ def traced():
 
 
 def test_release_period_is_one_spacing_of_the_edge(traced):
-    """The window the lattice part samples is one release of the contact edge: the
-    separation over which the node count of the peak's grid states changes by one
-    (release_period: 0.2 nm, 277 -> 243 contact nodes, 0.00588 nm) equals the separation over
-    which their contact radius (the outermost contact node) moves by one band spacing,
-    h |d_next - d_prev| / |r_c,prev - r_c,next| (1.580 -> 1.385 um): the edge's path lies in
-    the band's uniform part. Measured equal to 1e-14; 1e-12 allowed."""
-    from femadh.runner.peak import release_period
+    """One release of the contact edge (the period of the peak's node-release sawtooth,
+    validation/sigma_edge_limits.py's release_period, the window its reproduction of the
+    refuted lattice part samples): the separation over which the node count of the peak's
+    grid states changes by one (0.2 nm, 277 -> 243 contact nodes, 0.00588 nm) equals the
+    separation over which their contact radius (the outermost contact node) moves by one band
+    spacing, h |d_next - d_prev| / |r_c,prev - r_c,next| (1.580 -> 1.385 um): the edge's path
+    lies in the band's uniform part. Measured equal to 1e-14; 1e-12 allowed."""
+    from validation.sigma_edge_limits import release_period
 
     _, got, _ = traced
     assert got["problem"].grid.n == 617                  # the fine run's grid
@@ -80,10 +85,12 @@ def test_release_period_is_one_spacing_of_the_edge(traced):
 
 def test_members_bound_the_sweep_error(traced):
     """The stated error of the largest adhesion covers its distance to the edge route's limit
-    (and that limit's own error) with the coarser members' grid part alone, and is not
-    inflated by a part for an error the run does not have: effectivity 1.35 measured (1.19-1.68
-    at 8.08-2.02 nm, sigma_edge_limits.md sec. 5); at most 2.2 allowed (1.6x the measured; a
-    lattice part, 2.65e-7 N here, would make it 2.87). The run names the route that traces
+    (and that limit's own error) with the coarser members' grid part alone: effectivity 1.345
+    measured here. Its upper bound is loose on purpose: this quantity scatters (1.31-2.45 at
+    8.08-2.02 nm, and ulp-level input changes move one spacing's between 1.56 and 2.50,
+    sigma_edge_limits.md sec. 5), so at most 3.5 is allowed (1.4x the largest measured,
+    2.50): an estimate several times too large fails it. No lattice part is added (the key
+    check: a part for an error the run does not have). The run names the route that traces
     the branch."""
     from femadh.contact.sigma_edge import tail_between
 
@@ -94,19 +101,19 @@ def test_members_bound_the_sweep_error(traced):
                         sc.analysis_radius)
     off = abs(hl["max_adhesion_N"] - (LIMIT + disk))
     stated = hl["max_adhesion_N_error"]
-    assert off + LIMIT_ERROR <= stated <= 2.2 * off
+    assert off + LIMIT_ERROR <= stated <= 3.5 * off
     assert "lattice" not in run.estimates["max_adhesion_N"]
     assert any("cohesive zone acts at the contact edge" in w and 'route = "peak"' in w
                for w in run.warnings)
 
 
 def test_cohesive_edge_only_where_the_step_dominates_the_edge():
-    """The lattice part is taken only where a sub-grid step's secant softening across its
-    edge exceeds every collocated law's steepest softening: at p/psat 0.15 (9.8e17 against
-    LJ's 2.77e17 Pa/m), not at 0.05 (the edge below sigma), 0.25 (2.0e17) or the bundled
-    slider's 0.95 (1.1e14), nor without a step (the Fig 3 and Fig 4 scenes, whose lattice
-    tips are the faithful states: Fig 4's uniform runs converge at order 2 to the same
-    branch's limit)."""
+    """A cohesive edge (the run's note naming route = "peak") is found only where a sub-grid
+    step's secant softening across its edge exceeds every collocated law's steepest
+    softening: at p/psat 0.15 (9.8e17 against LJ's 2.77e17 Pa/m), not at 0.05 (the edge
+    below sigma), 0.25 (2.0e17) or the bundled slider's 0.95 (1.1e14), nor without a step
+    (the Fig 3 and Fig 4 scenes, whose lattice tips are the faithful states: Fig 4's uniform
+    runs converge at order 2 to the same branch's limit)."""
     def edge(sc):
         return cohesive_edge(build_problem(variant(sc, nodes=64)))
     assert edge(_point(0.15))

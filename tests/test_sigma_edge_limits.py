@@ -1,5 +1,6 @@
 """The sweep's grids and the sigma-edge branch's grids converge to one max adhesion on the
-stiction map's sigma = 0.489 nm, p/psat 0.15 point (validation/results/sigma_edge_limits.md).
+stiction map's sigma = 0.48889 nm (0.3 + 1.7/9; printed "0.489" in the map's tables), p/psat
+0.15 point (validation/results/sigma_edge_limits.md).
 
 The point is the map's own: sigma = 0.3 + 1.7/9 nm (its "0.3 nm..2 nm:10" axis), where the
 meniscus edge sits 0.08 nm above sigma (a Dugdale cohesive zone ~47 nm long at the contact
@@ -18,6 +19,9 @@ them ~8.5e-4 apart ("which limit is right is not settled"): that was the branch'
 at sigma = 0.489 nm exactly (8.23e-4 of the force lower) against sweeps on a 28.3-um disk
 (+7.7e-5). Measured: the edge pair 1.56613782e-4 N, the banded pair 1.56611172e-4 N
 (1.67e-5 apart), the edge route's five-member limit 1.56613766e-4 N +- 2.97e-9; ~1.2 CPU-s.
+How close the two families' limits are depends on which members are extrapolated: the sweep
+family's 5.713/4.04/2.857-nm triple lies +1.62e-5 from the edge route's limit, its
+4.04/2.857/2.02-nm triple -1.52e-6 (sigma_edge_limits.md sec. 2): they agree within ~2e-5.
 """
 import math
 

@@ -1,4 +1,5 @@
-"""Which limit is right on the stiction map's sigma = 0.489 nm, p/psat 0.15 point: the sweep's
+"""Which limit is right on the stiction map's sigma = 0.48889 nm (0.3 + 1.7/9; printed "0.489" in
+the map's tables), p/psat 0.15 point: the sweep's
 (adaptive banded grid, nodes fixed while the contact edge crosses them) or the sigma-edge
 branch's (femadh/contact/sigma_edge.py, the grid scaled so that the contact edge sits on a
 node)? (issue 21; validation/results/effectivity.md, "the lattice part at finer spacings".)
@@ -31,8 +32,10 @@ are traced here:
    through the peak (the sweep's sawtooth: its tips, troughs and mean) - does either depend
    on where the edge sits in a cell?
 5. the runner's sweeps (femadh.run, the test's narrowed point at the map's sigma) at the five
-   spacings with their estimates (members' grid part, the lattice part, the total), judged
-   against the limit of 1 at the same sigma: effectivities with and without the lattice part.
+   spacings with their estimates (members' grid part, the total), judged against the limit
+   of 1 at the same sigma: effectivities of the runner's estimate (members only) and with the
+   refuted lattice part (issue 21's; no longer the runner's: :func:`lattice_tooth` here
+   computes it from each run's own peak search, to reproduce that column).
 """
 import argparse
 import copy
@@ -143,6 +146,7 @@ def section_sweep_grids(out, scene, sigma, lim, c_star, variants=True):
                      "band 4.4 um": {"band": 4.4e-6},
                      "radius 66 um": {"radius": 66.04e-6}})
     summary = []
+    base = {}              # the sweep's family's maxima by h: the variants' shifts against it
     for name, kw in fams.items():
         hs = SPACINGS if not kw else SPACINGS[1:4]
         F = []
@@ -155,13 +159,26 @@ def section_sweep_grids(out, scene, sigma, lim, c_star, variants=True):
                        f"{time.perf_counter() - t0:.1f} |")
             print(f"  [2] sigma {sigma * 1e9:.6g} {name} h {h * 1e9:.4g} F {f:.8e} "
                   f"{(f - lim) / lim:+.3e}", file=sys.stderr, flush=True)
-        p, ext, err = richardson(hs, F)
-        summary.append((name, p, ext, err))
+        if not kw:
+            base = dict(zip(hs, F))
+            p, ext, err = richardson(hs, F)
+            summary.append((name, p, ext, err, "the three finest (4.04, 2.857, 2.02 nm)", None))
+            # the triple the variants have: the limit depends on which three members
+            p, ext, err = richardson(SPACINGS[1:4], F[1:4])
+            summary.append((name, p, ext, err, "5.713, 4.04, 2.857 nm", None))
+        else:
+            shift = max((abs(f - base[h]) / lim, f - base[h], h) for h, f in zip(hs, F)
+                        if h in base)
+            p, ext, err = richardson(hs, F)
+            summary.append((name, p, ext, err, "5.713, 4.04, 2.857 nm", shift))
     out.append("")
-    for name, p, ext, err in summary:
-        out.append(f"- {name}: Richardson of the three finest, order {p:.2f}, limit "
+    for name, p, ext, err, which, shift in summary:
+        out.append(f"- {name}: Richardson of {which}, order {p:.2f}, limit "
                    f"{ext:.8e} N ({(ext - lim) / lim:+.2e} from the edge route's; the "
-                   f"finest member's estimated error {err / lim:.1e})")
+                   f"finest member's estimated error {err / lim:.1e})"
+                   + ("" if shift is None else
+                      f"; its members against the sweep's family's at the same h: largest "
+                      f"shift {shift[1] / lim:+.2e} (at {shift[2] * 1e9:.4g} nm)"))
     return summary
 
 
@@ -268,15 +285,111 @@ def _point(sigma, h):
 OLD_REFERENCE = 1.564850e-4
 
 
-def _with_lattice(sc):
-    from femadh.runner import estimates
+#: the lattice part issue 21 added and session 11 refuted (the part was removed from
+#: femadh.runner.estimates; kept here only to reproduce its column): fresh states solved on
+#: each side of the peak, at these fractions of the release period
+TOOTH_SAMPLES = (0.5, 1.0)
 
-    keep = estimates.LATTICE_PART
-    estimates.LATTICE_PART = True
+
+def release_period(prev, nxt):
+    """Separation (m) over which the contact edge releases (or joins) one node between the
+    grid states ``prev`` and ``nxt`` around a peak: |d_next - d_prev| over the difference
+    of their contact node counts; None where the counts are equal (no node released in the
+    bracket) or a state has no contact set."""
+    if prev.active is None or nxt.active is None:
+        return None
+    dn = abs(int(np.count_nonzero(prev.active)) - int(np.count_nonzero(nxt.active)))
+    return abs(nxt.d - prev.d) / dn if dn else None
+
+
+def _grid_parabola(problem, prev, best, nxt):
+    """F_ex(d) (N; d in m) of the parabola through the three grid states around a peak: the
+    curve's own fall over a release period, taken off the samples. At a fold (two distinct
+    states) nothing is taken off."""
+    from femadh.contact.forces import state_forces
+
+    ds = [float(s.d - best.d) for s in (prev, best, nxt)]      # (centred: d ~ 1e-9 m)
+    if len(set(ds)) < 3:
+        return lambda x: 0.0
+    fs = [float(s.f_ex if hasattr(s, "f_ex") else state_forces(problem, s)[2])
+          for s in (prev, best, nxt)]
+    c = np.polyfit(ds, fs, 2)
+    return lambda x: float(np.polyval(c, x - best.d))
+
+
+def lattice_tooth(problem, prev, best, nxt, scene, f_peak, d_peak, fresh=()):
+    """The refuted lattice part (N, >= 0): how far F_ex falls from the refined peak
+    (``f_peak`` at ``d_peak``) within one release period on either side of it, the grid
+    parabola's own fall taken off. ``fresh``: the peak search's [(d, F or None, state or
+    None)] (those within a period count as samples); TOOTH_SAMPLES more on each side are
+    solved as the peak search's fresh states. The tooth is real (sec. 4: the sawtooth's
+    troughs) but the error it was added for was a reference at another sigma and disk."""
+    from femadh.contact.forces import state_forces
+    from femadh.runner.peak import _warm, state_between
+
+    if problem.sigma is None or problem.contact_model == "hertz-closure":
+        return 0.0
+    period = release_period(prev, nxt)
+    if period is None:
+        return 0.0
+    lo, hi = sorted((prev.d, nxt.d))
+    smooth = _grid_parabola(problem, prev, best, nxt)
+    near = [st for _, _, st in fresh if st is not None]
+    samples = [f - smooth(x) for x, f, _ in fresh
+               if f is not None and abs(x - d_peak) <= period]
+    for frac in TOOTH_SAMPLES:
+        for side in (-1.0, 1.0):
+            x = d_peak + side * frac * period
+            if not lo < x < hi:
+                continue
+            a, b = (prev, best) if nxt.d == best.d or (x - best.d) * (prev.d - best.d) > 0 \
+                else (best, nxt)
+            if a.d == b.d:
+                continue
+            st = state_between(problem, a, b, x, scene, False, _warm(near, a, b, x))
+            if st is not None:
+                near.append(st)
+                samples.append(state_forces(problem, st)[2] - smooth(x))
+    return float(max(f_peak - smooth(d_peak) - min(samples), 0.0)) if samples else 0.0
+
+
+def run_with_tooth(sc):
+    """(femadh.run's result, the lattice part N of its fine run's peak) - the part computed
+    as femadh.runner.estimates did while it had one: from the fine run's own peak search
+    (its fresh states recorded), right after it, where the step's cohesive zone acts at the
+    edge (0.0 elsewhere). The run itself is the runner's, unchanged."""
+    from femadh.runner import estimates, peak
+
+    got = {}
+    real_refine = estimates.refine_peak
+
+    def refine(scene, res, problem, sink):
+        if got:                   # an unreduced member traced whole: not the fine run's
+            return real_refine(scene, res, problem, sink)
+        fresh = []
+
+        def recorded(*a, **kw):
+            kw["record"] = fresh
+            return peak.peak_adhesion(*a, **kw)
+        estimates.peak_adhesion = recorded
+        try:
+            half = real_refine(scene, res, problem, sink)
+        finally:
+            estimates.peak_adhesion = peak.peak_adhesion
+        pb, hl = getattr(sink, "peak_problem", problem), res.headline
+        got["tooth"] = 0.0
+        if sink.peak is not None and "max_adhesion_N" in hl and estimates.cohesive_edge(pb):
+            _, _, prev, best, nxt = sink.peak
+            if prev is not None and nxt is not None:
+                got["tooth"] = lattice_tooth(pb, prev, best, nxt, scene, hl["max_adhesion_N"],
+                                             hl["d_at_max_adhesion_m"], fresh)
+        return half
+    estimates.refine_peak = refine
     try:
-        return femadh.run(sc, progress=False, figures=False)
+        res = femadh.run(sc, progress=False, figures=False)
     finally:
-        estimates.LATTICE_PART = keep
+        estimates.refine_peak = real_refine
+    return res, got.get("tooth", 0.0)
 
 
 def section_sweeps(out, sigma, lim, lim_err, a_map):
@@ -289,13 +402,14 @@ def section_sweeps(out, sigma, lim, lim_err, a_map):
                f"map's {a_map * 1e6:.2f}-um disk, {lim:.8e} N (+- {lim_err:.1e} N), plus the "
                f"laws between that disk and the run's on the undeformed paraboloid at the run's "
                f"d at max (tail_between: the column 'disk'). Effectivity = stated error / "
-               f"|error| with the lattice part (as issue 21 had it, LATTICE_PART = True; each "
-               f"run repeated so) and without it ('members only': the runner's estimate now). 'Old' = "
+               f"|error| with the lattice part (as issue 21 had it; the part is no longer the "
+               f"runner's: run_with_tooth computes it here from the run's own peak search) "
+               f"and without it ('members only': the runner's estimate). 'Old' = "
                f"against the review's reference {OLD_REFERENCE:.6e} N (sigma = 0.489 nm, the "
                f"map's disk): the review's 2.24 ... 0.38.\n")
     out.append("| h (nm) | nodes | max adhesion (N) | disk (rel.) | error (rel.) | grid part "
                "(rel.) | lattice part (rel.) | stated (rel.) | effectivity | members only | "
-               "old: error, effectivity | wall s |")
+               "old: error, effectivity | wall s (run and part) |")
     out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for h, sig in ([(h, sigma) for h in SPACINGS] + [(SPACINGS[2], SIGMA_MAP_FLOAT_TEXT),
@@ -304,16 +418,14 @@ def section_sweeps(out, sigma, lim, lim_err, a_map):
         sc = _point(sig, h)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshResolutionWarning)
-            res = femadh.run(sc, progress=False, figures=False)
+            # the run with its estimate (members only), and the refuted lattice part of its
+            # peak beside it (run_with_tooth): the part would add to the total
+            res, lat = run_with_tooth(sc)
             wall = time.perf_counter() - t0
-            # the same run with the lattice part (femadh.runner.estimates.LATTICE_PART):
-            # the value and the members' part are the same, the part adds to the total
-            with_lattice = _with_lattice(sc)
         hl, parts = res.headline, res.estimates["max_adhesion_N"]
         v, stated = hl["max_adhesion_N"], hl["max_adhesion_N_error"]
-        lat = with_lattice.estimates["max_adhesion_N"].get("lattice", 0.0)
-        assert with_lattice.headline["max_adhesion_N"] == v
-        stated = stated + lat - parts.get("lattice", 0.0)     # the total with the part
+        assert "lattice" not in parts
+        stated = stated + lat                                  # the total with the part
         disk = tail_between(sc.effects, sc.sphere, hl["d_at_max_adhesion_m"], a_map,
                             sc.analysis_radius)
         ref = lim + disk
@@ -345,8 +457,8 @@ def main(argv=None):
 
     load = os.getloadavg()
     t_all = time.perf_counter()
-    out = ["# Sweep against sigma-edge branch on the stiction map's sigma = 0.489 nm, "
-           "p/psat 0.15 point (`python -m validation.sigma_edge_limits`)", "",
+    out = ["# Sweep against sigma-edge branch on the stiction map's sigma = 0.48889 nm "
+           "(0.3 + 1.7/9), p/psat 0.15 point (`python -m validation.sigma_edge_limits`)", "",
            f"Machine: 2 cores shared with other sessions, load (1/5/15 min) "
            f"{load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} at the start; one BLAS thread. "
            f"The map's sigma: {SIGMA_MAP * 1e9!r} nm; sigma_edge.md's: 0.489 nm."]
@@ -384,11 +496,13 @@ def main(argv=None):
                               scene_at(SIGMA_MAP).analysis_radius)
     # the answer in numbers
     shift = (lims[s1] - lims[s2]) / lims[s2]
-    same = [(ext - lims[s]) / lims[s] for s in (s1, s2) for _, _, ext, _ in grids[s][:1]]
+    same = [(ext - lims[s]) / lims[s] for s in (s1, s2) for _, _, ext, _, _, _ in grids[s][:2]]
     out.append("\n## Summary\n")
     out.append(f"- At one sigma and one disk the sweep's grid family and the edge route's "
-               f"converge to one limit: {same[0]:+.2e} (map's sigma), {same[1]:+.2e} (0.489 nm) "
-               f"of it apart.")
+               f"converge to one limit, to within the Richardson triple's own spread: the "
+               f"sweep's family extrapolated from 4.04/2.857/2.02 nm lies {same[0]:+.2e} "
+               f"(map's sigma) and {same[2]:+.2e} (0.489 nm) from the edge route's limit, "
+               f"from 5.713/4.04/2.857 nm {same[1]:+.2e} and {same[3]:+.2e}.")
     out.append(f"- The edge route's limit at the map's sigma lies {shift:+.3e} above its limit "
                f"at 0.489 nm (sigma_edge.md's).")
     if rows:

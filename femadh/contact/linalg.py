@@ -361,7 +361,10 @@ def gmres(apply_a, apply_m, b, rtol, maxiter=GMRES_MAX):
     (x, iterations, converged)
         x = M^-1 V y minimises |b - A x| over the Krylov space; converged: rtol met.
     """
-    beta = math.sqrt(b @ b)        # np.linalg.norm's own sqrt(b . b), without its checks
+    # np.linalg.norm's own sqrt(b . b) without its checks - for a contiguous b (norm ravels
+    # a strided or reversed b first, which changes the sum's order): both callers pass one
+    b = np.ascontiguousarray(b)
+    beta = math.sqrt(b @ b)
     n = b.size
     if beta == 0.0 or n == 0:
         return np.zeros(n), 0, True

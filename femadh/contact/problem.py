@@ -221,7 +221,7 @@ class ContactProblem:
             v = self._finite(name, part, getattr(eff, part)(h), h)
             if out is None:
                 if (type(v) is np.ndarray and type(h) is np.ndarray and v.dtype == _F8
-                        and h.dtype == _F8 and v.shape == h.shape):
+                        and h.dtype == _F8 and v.shape == h.shape and v.ndim > 0):
                     out = v + 0.0
                     continue
                 out = np.zeros_like(h)

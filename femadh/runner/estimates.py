@@ -45,7 +45,7 @@ from ..contact.forces import tail_force
 from .members import deepest_locked, reduced_member
 # fresh states between grid states and the peak search: their own home (members and the
 # instrument use them too)
-from .peak import lattice_tooth, peak_adhesion
+from .peak import peak_adhesion
 # the error machinery's one home (Richardson, the guards), re-exported for the runner
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
@@ -112,10 +112,7 @@ def refine_peak(scene, res, problem, sink):
     if sink.peak is None or sink.peak[2] is None or sink.peak[4] is None:
         return 0.0
     branch, f_grid, prev, best, nxt = sink.peak
-    fresh = []
-    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene,
-                               record=fresh)
-    sink.peak_fresh = fresh          # (the estimate's lattice part samples around the peak)
+    F, d, half = peak_adhesion(getattr(sink, "peak_problem", problem), prev, best, nxt, scene)
     hl["max_adhesion_grid_N"] = f_grid
     hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = F, d
     hl["max_adhesion_branch"] = branch     # (the searched piece's: a fold state may lead)
@@ -201,20 +198,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
         # within the jump's resolution beyond it (:func:`fold_end_error`)
         parts.setdefault("d_at_max_adhesion_m", {})["fold_resolution"] = fold[0]
         parts.setdefault("max_adhesion_N", {})["fold_resolution"] = fold[1]
-    # a sub-grid step's cohesive zone at the contact edge: the run says that the sigma-edge
-    # branch ([solver] route = "peak") reads the same largest adhesion; the lattice part
-    # (the tooth of the edge's node-release sawtooth, femadh.runner.peak.lattice_tooth) only
-    # where LATTICE_PART is set (it is not: see there)
-    peak_problem = getattr(sink, "peak_problem", problem)
-    if "max_adhesion_N" in hl and getattr(sink, "peak_fresh", None) is not None \
-            and cohesive_edge(peak_problem):
-        if LATTICE_PART:
-            _, _, prev, best, nxt = sink.peak
-            tooth = lattice_tooth(peak_problem, prev, best, nxt, scene,
-                                  hl["max_adhesion_N"], hl["d_at_max_adhesion_m"],
-                                  sink.peak_fresh)
-            if tooth > 0:
-                parts.setdefault("max_adhesion_N", {})["lattice"] = tooth
+    # a largest adhesion read off the sweep's peak where a sub-grid step's cohesive zone acts
+    # at the contact edge (on the peak's problem): the run says that the sigma-edge branch
+    # ([solver] route = "peak") reads the same limit. No part is added for the edge's
+    # node-release sawtooth: its tips are the branch's states, and the coarser members bound
+    # the sweep's error (:func:`cohesive_edge`; issue 21's lattice part was refuted and
+    # deleted: validation/results/effectivity.md, session 11)
+    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is not None \
+            and cohesive_edge(getattr(sink, "peak_problem", problem)):
         res.warnings.append(COHESIVE_NOTE)
     # discretisation: the coarser members of the grid family (and, for FE, the exact Green;
     # a layered body has none: its mesh part is the difference to the next coarser mesh,
@@ -335,25 +326,6 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
     return parts
 
 
-#: the largest adhesion gets a lattice part (:func:`femadh.runner.peak.lattice_tooth`, the
-#: tooth of the contact edge's node-release sawtooth around the peak) where a sub-grid step's
-#: cohesive zone acts at the contact edge (:func:`cohesive_edge`). False: no such part. It
-#: was added (issue 21, session 10) for an under-read that was not one: on the stiction map's
-#: sigma = 0.489 nm, p/psat 0.15 point the sweep seemed to stay ~8.5e-4 of the force above the
-#: sigma-edge branch's limit at every spacing, but that limit had been computed at sigma =
-#: 0.489 nm exactly while the map's point (and the sweeps) sit at 0.3 + 1.7/9 = 0.48889 nm
-#: (the max adhesion moves 8.23e-4 of itself there: d ln F / d ln sigma = -3.6, the meniscus
-#: edge only 0.08 nm above sigma) and on the map's 14.14-um disk while the sweeps ran on
-#: 28.28 um (+7.7e-5). At one sigma and one disk the sweep's grid family and the branch's
-#: converge at order 2 to one limit (to 2e-6 of it), the sawtooth's tips are the branch's own
-#: states (the junctions) wherever the edge sits in a cell, and the members alone bound the
-#: sweep's error: effectivity 1.68, 1.35, 1.56, 1.19, 1.31 at band spacings 8.08 ... 2.02 nm
-#: (with the lattice part 3.18, 2.87, 3.13, 2.78, 2.90), 1.67 on the whole point's 1772-node
-#: trial (validation/results/sigma_edge_limits.md, `python -m validation.sigma_edge_limits`).
-#: The part doubled the stated error and cost an extra trial on the map's sweep points.
-LATTICE_PART = False
-
-
 def cohesive_edge(problem):
     """True where a sub-grid step law (the capillary condensate, :mod:`femadh.contact.subgrid`)
     has its edge just above the sigma floor and softens, by its secant across that edge
@@ -366,11 +338,15 @@ def cohesive_edge(problem):
     after the landing) and the peak search reads a tooth's tip. Measured on the stiction
     map's sigma = 0.3 + 1.7/9 nm, p/psat 0.15 point (secant 9.8e17 Pa/m against LJ's
     2.77e17; validation/results/sigma_edge_limits.md): the tips are the sigma-edge branch's
-    states on the fixed grid (the junctions, to 5 digits of the error) wherever the edge sits
-    in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's maximum the same to
-    3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum converges with the
-    branch's: the two grid families' limits agree to 2e-6, both at order 2, and the
-    coarser members alone bound the sweep's error (effectivity 1.2-1.7 at 8.08-2.02 nm)."""
+    states on the fixed grid (the junctions, to 5 digits of the error or a scan step below)
+    wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's
+    maximum the same to 3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum
+    converges with the branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
+    of each other (1.5e-6 or 1.6e-5, by which three of the sweep family's members are
+    extrapolated), and on that point the coarser members alone bounded the sweep's error:
+    effectivity 1.68, 1.34, 2.45, 1.47, 1.31 at band spacings 8.08 ... 2.02 nm (one point's
+    measurements, and scattered: ulp-level changes of its input move the 4.04-nm value
+    between 1.56 and 2.45, 2.50 before the Green operator's AGM kernel)."""
     from ..laws.step import SmoothStepLaw
 
     if problem.sigma is None:
@@ -429,10 +405,10 @@ COHESIVE_NOTE = (
     f"{NOTE}a sub-grid step's cohesive zone acts at the contact edge: the sweep reads the "
     "largest adhesion on the node-release sawtooth of the contact edge, whose tips are the "
     "sigma-edge branch's states on this grid; [solver] route = \"peak\" traces that branch in "
-    "the edge radius and reads the same limit (checked on the stiction map's sigma = 0.489 nm, "
-    "p/psat 0.15 point: both converge at order 2 to one value, this estimate covers the "
-    "sweep's error with effectivity 1.2-1.7, and the route took 2 s where the sweep took "
-    "10 min to 1e-3; validation/results/sigma_edge_limits.md)")
+    "the edge radius and reads the same limit (checked on one point, the stiction map's "
+    "sigma = 0.48889 nm (0.3 + 1.7/9), p/psat 0.15: both converge at order 2 to one value, "
+    "where the coarser members' estimate covered the sweep's error; "
+    "validation/results/sigma_edge_limits.md)")
 
 
 def _short(error):
