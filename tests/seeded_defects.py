@@ -1043,8 +1043,8 @@ DEFECTS = [
       (("st = _relaxed(problem, d, st, descent, tol=tol, max_iter=max_iter)", "pass"),)),
     D("landing_relax_sign", "landing relaxation: the pseudo-time step taken uphill",
       "femadh/contact/landing.py",
-      (("        dw = -sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],",
-        "        dw = sla.lu_solve(sla.lu_factor(M, check_finite=False), a[idx] * F[idx],"),)),
+      (("            dw = -lu_solve(lu_factor(M), a[idx] * F[idx])",
+        "            dw = lu_solve(lu_factor(M), a[idx] * F[idx])"),)),
     D("landing_relax_no_join", "landing relaxation: a free node reaching the floor never "
       "joins the contact set", "femadh/contact/landing.py",
       (("new_A = (A & (pc + adhesion > 0)) | (~A & (h < sigma))",
@@ -1923,8 +1923,8 @@ DEFECTS = [
     D("hotpath_sum_shape_unchecked", "laws' sum: a first law's value taken as the sum "
       "whatever its shape (a law constant in h not broadcast to the nodes)",
       "femadh/contact/problem.py",
-      (("                        and h.dtype == _F8 and v.shape == h.shape):",
-        "                        and h.dtype == _F8):"),)),
+      (("                        and h.dtype == _F8 and v.shape == h.shape and v.ndim > 0):",
+        "                        and h.dtype == _F8 and v.ndim > 0):"),)),
     D("hotpath_finite_any", "laws' finite check: passes unless every node is not finite",
       "femadh/contact/problem.py",
       (("        if not finite.all():", "        if not finite.any():"),)),

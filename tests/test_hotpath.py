@@ -122,6 +122,8 @@ def test_law_sum_gives_the_zeros_plus_laws_bits_and_leaves_the_laws_alone():
     ref3 += 2.5
     got3 = _summed([2.5], h)
     assert got3.shape == h.shape and _bits(got3) == _bits(ref3)
+    got4 = _summed([[2.5]], h)                  # one value in a 1-element array: the same
+    assert got4.shape == h.shape and _bits(got4) == _bits(ref3)
 
 
 def test_finite_check_and_sum_pass_finite_values_whose_sum_overflows_silently():

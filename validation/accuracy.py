@@ -194,7 +194,7 @@ def reference_tails(ref_hl, problem, skip=()):
     leaves ~1/16 of the adaptive run's tail (the LJ's U ~ b^-2, b ~ a^2 / 2R): 1.5e-6 of the
     slider's largest adhesion, more than half the uniform N = 200 run's whole error (4.06e-6
     against the reference alone, 2.56e-6 with its tail; validation/results/effectivity.md,
-    session 12)."""
+    session 11, helper effect)."""
     from femadh.contact.forces import tail_force
 
     return {q: tail_force(problem, ref_hl[d]) for q, d in TAILED.items()

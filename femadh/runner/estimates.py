@@ -341,9 +341,9 @@ def cohesive_edge(problem):
     states on the fixed grid (the junctions, to 5 digits of the error or a scan step below)
     wherever the edge sits in a cell (f = 0, 1/4, 1/2, 3/4 of a 4.04-nm cell: the branch's
     maximum the same to 3e-6 of the force, the troughs 8.5e-4 below), so the sweep's maximum
-    converges with the branch's: both grid families converge at order 2, their limits within ~2e-5 of the force
-    of each other (1.5e-6 or 1.6e-5, by which three of the sweep family's members are
-    extrapolated), and on that point the coarser members alone bounded the sweep's error:
+    converges with the branch's: both grid families converge at order 2, their limits
+    within ~2e-5 of the force of each other (1.5e-6 or 1.6e-5, by which three of the sweep
+    family's members are extrapolated), and on that point the coarser members alone bounded the sweep's error:
     effectivity 1.68, 1.34, 2.45, 1.47, 1.31 at band spacings 8.08 ... 2.02 nm (one point's
     measurements, and scattered: ulp-level changes of its input move the 4.04-nm value
     between 1.56 and 2.45, 2.50 before the Green operator's AGM kernel)."""

@@ -213,8 +213,9 @@ def kink_peak(problem, prev, best, nxt, scene, known=(), window=None, reuse=Fals
     at its edge): its ends are solved, and each side of the bracket outside it is searched
     where the curve rises away from the window or holds a state above the window's end there
     (both sides where the window holds a valley between two kinks); then the search refines
-    around the best state found anywhere, inside the window or out. Fresh states as :func:`state_between` (``reuse``; warm starts
-    from the nearest fresh state as :func:`peak_adhesion`); a state that is not found counts
+    around the best state found anywhere, inside the window or out. Fresh states as
+    :func:`state_between` (``reuse``; warm starts from the nearest fresh state as
+    :func:`peak_adhesion`); a state that is not found counts
     as no larger than the best and bounds the bracket. ``f_of``: F_ex of a grid state
     (default its ``f_ex``, else :func:`~femadh.contact.forces.state_forces`). Returns
     (F, d, xatol) as
