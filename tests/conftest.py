@@ -16,9 +16,16 @@ if not os.environ.get("FEMADH_SEEDED_DEFECT"):
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # the tests run on the committed FE mesh ladder (fixed meshes whatever gmsh is installed)
 os.environ.setdefault("FEMADH_MESH_PATH", str(Path(__file__).resolve().parents[1] / "meshes"))
-# condensed FE operators cached per test process, not in the user's ~/.cache
-os.environ.setdefault("FEMADH_OPERATOR_CACHE", __import__("tempfile").mkdtemp(
-    prefix="femadh-operators-"))
+# condensed FE operators cached per test run, not in the user's ~/.cache; the process that
+# made the folder removes it at exit (its workers and children inherit the variable and use
+# it; it was left behind before: ~8800 folders in /tmp after a day of runs)
+if not os.environ.get("FEMADH_OPERATOR_CACHE"):
+    import atexit  # noqa: E402
+    import shutil  # noqa: E402
+    import tempfile  # noqa: E402
+
+    os.environ["FEMADH_OPERATOR_CACHE"] = tempfile.mkdtemp(prefix="femadh-operators-")
+    atexit.register(shutil.rmtree, os.environ["FEMADH_OPERATOR_CACHE"], ignore_errors=True)
 # The signal tests send SIGINT to the runs they start, which must take it. A suite started
 # with SIGINT ignored (a non-interactive shell's background job, nohup'ed CI) would pass that
 # SIG_IGN to every child, and femadh keeps an ignored SIGINT ignored (as a user's background
