@@ -2272,6 +2272,8 @@ def main(argv=None):
             lines.append(f"| {d.name} | {d.what} | `{d.path}` | {test} | {r['seconds']:.1f} |")
         report = (Path(args.report) if args.report else
                   REPORT.with_name("seeded_defects_partial.md") if args.only else REPORT)
+        if args.no_clean_check:
+            lines[2] += " The tests were not run on the unmodified tree first (--no-clean-check)."
         if args.only:
             lines[2] = (f"Partial run (--only {args.only}"
                         + (f" --tests {' '.join(args.tests)}" if args.tests else "")

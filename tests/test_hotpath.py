@@ -163,6 +163,16 @@ def test_direct_lapack_routes_other_inputs_to_scipy(case):
         x = la.lu_solve(got, b)
         assert _bits(b) == _bits(b_keep)
         assert _bits(x) == _bits(sla.lu_solve(ref, b, check_finite=False))
+    # the same inputs made symmetric positive definite, through the Cholesky pair
+    S = (M + M.T) if M.size else M
+    keep = S.copy()
+    ref = sla.cho_factor(S, check_finite=False)
+    got = la.cho_factor(S)
+    assert _bits(S) == _bits(keep)
+    assert got[0].dtype == ref[0].dtype and _bits(got[0]) == _bits(ref[0])
+    if S.size:
+        b = np.arange(1.0, S.shape[0] + 1)
+        assert _bits(la.cho_solve(got, b)) == _bits(sla.cho_solve(ref, b, check_finite=False))
 
 
 def test_back_substitution_of_a_singular_r_raises_as_scipy():

@@ -125,9 +125,10 @@ GMRES_RTOL_NEW_SET = 1e-4
 #: 1.6e-6 on a contact state's smooth w (K's rows nearly cancel on it), leaves a Newton step
 #: within 4.4e-7 of the double one's (the Fig 4 disk, tests/test_pace.py): still an inexact
 #: Newton step of the exact Jacobian to ~GMRES_RTOL. The residual of eq (6)/(10) that
-#: convergence is declared on, K w and the tangent stay in double. Measured (validation/results/pace.md):
-#: Fig 3 at accuracy 1e-4 Newton iterations 467 -> 469, Krylov 1760 -> 1805; Fig 4 at 1e-3
-#: 2476 -> 2476, 10 309 -> 10 350; every headline within 3e-7 of its estimated error
+#: convergence is declared on, K w and the tangent stay in double. Measured
+#: (validation/results/pace.md): Fig 3 at accuracy 1e-4 Newton iterations 467 -> 469, Krylov
+#: 1760 -> 1805; Fig 4 at 1e-3 2476 -> 2476, 10 309 -> 10 350; every bundled scene's headline
+#: within 1e-6 of its estimated error (most within 1e-9; five scenes bit-identical)
 KRYLOV_SINGLE = True
 #: the float32 copies of K, by problem (:func:`_single_k`)
 _SINGLE = weakref.WeakKeyDictionary()
