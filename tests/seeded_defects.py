@@ -2096,6 +2096,11 @@ DEFECTS = [
       "femadh/contact/linalg.py",
       (("    if info > 0:\n        raise linalg.LinAlgError(f\"{info}-th leading minor",
         "    if info > 999999:\n        raise linalg.LinAlgError(f\"{info}-th leading minor"),)),
+    D("krylov_banded_law_sign", "Newton-Krylov with a sub-grid law: its tridiagonal "
+      "Jacobian entered with the wrong sign in GMRES's product",
+      "femadh/contact/complementarity.py",
+      (("            return a * (product(v) + apply_jacobian(D, fr, v))",
+        "            return a * (product(v) - apply_jacobian(D, fr, v))"),)),
     D("gmres_strided_norm", "GMRES: |b| of a strided b as sqrt(b . b) (not norm's bits)",
       "femadh/contact/linalg.py", (("    b = np.ascontiguousarray(b)\n", ""),)),
     D("lu_empty_direct", "direct getrf on an empty system (its size read as an illegal "
