@@ -28,7 +28,11 @@ ROUNDOFF_REJECTS = True
 #: pseudo-time steps the relaxation of the collocation equations may take (:func:`_relax`).
 #: Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05 (253 nodes, 26 nm band
 #: spacing): the drift past the vanished equilibrium of the descent's contact set took 60
-#: steps, the convergence on the next set 55 more
+#: steps, the convergence on the next set 55 more (24 and 19 with the damping of
+#: RELAX_MU0). Started far from a landing it releases about one contact node per 60-70
+#: steps: from held equilibria on disks of 85 and 86 nodes it lands on 84 in 56 and 136
+#: steps, from 88-100 nodes it needs 572-1073 (measured with the cap lifted) and ends at
+#: this cap without a state, the landing's other fallbacks then tried
 RELAX_STEPS = 400
 #: pseudo-time damping mu (relative to the diagonal of S) at each contact set's first step,
 #: and its floor. On a set, mu follows the residual's progress since that first step,
