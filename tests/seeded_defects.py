@@ -1051,8 +1051,8 @@ DEFECTS = [
         "new_A = A & (pc + adhesion > 0)"),)),
     D("landing_relax_ser_inverted", "landing relaxation: the pseudo-time damping follows the "
       "inverse residual ratio", "femadh/contact/landing.py",
-      (("mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r / r_prev))",
-        "mu = min(RELAX_MU_MAX, max(RELAX_MU_MIN, mu * r_prev / r))"),)),
+      (("mu = RELAX_MU0 * min(1.0, r / r_set) if r_set > 0",
+        "mu = RELAX_MU0 * min(1.0, r_set / r) if r > 0"),)),
     D("landing_edges_most_energy", "landing: of the neighbouring edges' stable states the one "
       "of most energy is kept", "femadh/contact/landing.py",
       (("            if e < e_best:", "            if best is None or e > e_best:"),)),
@@ -2121,6 +2121,18 @@ DEFECTS = [
     D("landfix_relaxed_descent_set", "landing: the relaxed state polished from the descent's "
       "contact set, not its own", "femadh/contact/landing.py",
       (("max_iter=max_iter, active0=ar)", "max_iter=max_iter, active0=active)"),)),
+    # -- the relaxation's damping referred to each contact set's first residual (branch
+    #    relaxfix, seeded_defects_relaxfix.md)
+    D("relaxfix_ref_not_reset", "landing relaxation: the damping's reference residual kept "
+      "from the first step, not reset when the contact set changes", "femadh/contact/landing.py",
+      (("if A_set is None or not np.array_equal(A, A_set):", "if A_set is None:"),)),
+    D("relaxfix_no_ceiling", "landing relaxation: the damping follows a rising residual above "
+      "RELAX_MU0 (no ceiling)", "femadh/contact/landing.py",
+      (("mu = RELAX_MU0 * min(1.0, r / r_set) if r_set > 0",
+        "mu = RELAX_MU0 * (r / r_set) if r_set > 0"),)),
+    D("relaxfix_ref_every_step", "landing relaxation: the reference residual renewed every "
+      "step (the damping stays RELAX_MU0, never Newton's)", "femadh/contact/landing.py",
+      (("if A_set is None or not np.array_equal(A, A_set):", "if True:"),)),
 ]
 
 
