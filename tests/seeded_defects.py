@@ -2126,10 +2126,12 @@ DEFECTS = [
     D("relaxfix_ref_not_reset", "landing relaxation: the damping's reference residual kept "
       "from the first step, not reset when the contact set changes", "femadh/contact/landing.py",
       (("if A_set is None or not np.array_equal(A, A_set):", "if A_set is None:"),)),
-    D("relaxfix_no_ceiling", "landing relaxation: the damping follows a rising residual above "
-      "RELAX_MU0 (no ceiling)", "femadh/contact/landing.py",
-      (("mu = RELAX_MU0 * min(1.0, r / r_set) if r_set > 0",
-        "mu = RELAX_MU0 * (r / r_set) if r_set > 0"),)),
+    # (relaxfix_no_ceiling retired: with the reference the running largest residual,
+    # r / r_set <= 1 and the ceiling cannot act - the mutant was equivalent)
+    D("relaxfix_first_residual", "landing relaxation: the damping referred to each set's first "
+      "residual, not its running largest (a set entered at a small residual that then rises "
+      "keeps mu at RELAX_MU0)", "femadh/contact/landing.py",
+      (("        r_set = max(r_set, r)\n", ""),)),
     D("relaxfix_ref_every_step", "landing relaxation: the reference residual renewed every "
       "step (the damping stays RELAX_MU0, never Newton's)", "femadh/contact/landing.py",
       (("if A_set is None or not np.array_equal(A, A_set):", "if True:"),)),

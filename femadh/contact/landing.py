@@ -28,16 +28,14 @@ ROUNDOFF_REJECTS = True
 #: pseudo-time steps the relaxation of the collocation equations may take (:func:`_relax`).
 #: Measured on the 2-mm slider at sigma = 0.3 nm, p/psat = 0.05 (253 nodes, 26 nm band
 #: spacing): the drift past the vanished equilibrium of the descent's contact set took 60
-#: steps, the convergence on the next set 55 more (24 and 19 with the damping of
-#: RELAX_MU0). Started far from a landing it releases about one contact node per 60-70
-#: steps: from held equilibria on disks of 85 and 86 nodes it lands on 84 in 56 and 136
-#: steps, from 88-100 nodes it needs 572-1073 (measured with the cap lifted) and ends at
-#: this cap without a state, the landing's other fallbacks then tried
+#: steps, the convergence on the next set 55 more (43 steps in all with the damping below).
+#: Started far from a landing, from held equilibria on disks of 85, 86, 88, 92 and 100
+#: nodes, it lands on the same 84-node state in 22, 36, 67, 116 and 191 steps
 RELAX_STEPS = 400
-#: pseudo-time damping mu (relative to the diagonal of S) at each contact set's first step,
-#: and its floor. On a set, mu follows the residual's progress since that first step,
-#: mu = RELAX_MU0 min(1, r / r_set) (switched evolution relaxation referred to the set's
-#: first residual r_set, SER-B), never above RELAX_MU0. Why not mu_k+1 = mu_k r_k / r_k-1
+#: pseudo-time damping mu (relative to the diagonal of S) while the residual is at its
+#: largest on the current contact set, and its floor. On a set, mu follows the residual's
+#: progress from that largest value, mu = RELAX_MU0 min(1, r / r_set) (switched evolution
+#: relaxation referred to the set's running largest residual r_set), never above RELAX_MU0. Why not mu_k+1 = mu_k r_k / r_k-1
 #: clamped to [1e-14, 1e6] (the rule before): a node released from a converged state
 #: (1.6e-25 m) raised the residual to 1.70e-12 m and mu to its ceiling, after which each step
 #: moved the surface by ~1e-6 of a Newton step, r_k / r_k-1 stayed 1 and mu never came down
@@ -486,7 +484,13 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         if not np.isfinite(r):
             return None, None, step
         if A_set is None or not np.array_equal(A, A_set):
-            r_set, A_set = r, A     # a new contact set: its first residual is the reference
+            r_set, A_set = r, A.copy()  # a new contact set: its residual is the reference
+        # referred to the largest residual seen on the set, not its first: a set entered at
+        # a small residual that then rises (the drift) would otherwise keep mu at RELAX_MU0
+        # until r fell below that first value again (measured on test_landing_relax's corner
+        # case: from held 88-100-node disks 572-1073 steps to the 84-node landing, 67-191
+        # with the running largest; the descent's own relaxation 43 steps either way)
+        r_set = max(r_set, r)
         mu = RELAX_MU0 * min(1.0, r / r_set) if r_set > 0 else RELAX_MU0
         mu = max(RELAX_MU_MIN, mu)
         M = K[np.ix_(idx, idx)]
