@@ -1983,8 +1983,8 @@ DEFECTS = [
       (('            rec["estimate"] = "errors"\n', '            pass\n'),)),
     D("ui_study_estimate_unrecorded", "a point's record says 'errors' whatever its run "
       "estimated", "femadh/studies/executors.py",
-      (('           "estimate": ESTIMATE_NAMES[estimate], "pid": os.getpid()}',
-        '           "estimate": "errors", "pid": os.getpid()}'),)),
+      (('           "estimate": ESTIMATE_NAMES[estimate], "femadh": code_id(), "pid": os.getpid()}',
+        '           "estimate": "errors", "femadh": code_id(), "pid": os.getpid()}'),)),
     D("ui_study_no_estimate_ignored", "study sweep --no-estimate still estimates",
       "femadh/cli.py",
       (('                          estimate="peak" if args.no_estimate else True)',
@@ -2101,6 +2101,10 @@ DEFECTS = [
       "femadh/contact/complementarity.py",
       (("            return a * (product(v) + apply_jacobian(D, fr, v))",
         "            return a * (product(v) - apply_jacobian(D, fr, v))"),)),
+    D("study_reuses_other_code", "study: a point computed by other femadh code reused "
+      "(its record's code fingerprint not compared)", "femadh/studies/sweep.py",
+      (("        other = {k for k, r in done.items() if r.get(\"femadh\") != code_id()}",
+        "        other = set()"),)),
     D("gmres_strided_norm", "GMRES: |b| of a strided b as sqrt(b . b) (not norm's bits)",
       "femadh/contact/linalg.py", (("    b = np.ascontiguousarray(b)\n", ""),)),
     D("lu_empty_direct", "direct getrf on an empty system (its size read as an illegal "

@@ -101,6 +101,21 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
                                               "status", "error"]
     assert rows[1][2:5] == ["effects.asperity_gap.sigma = 0.5 nm, sphere.radius = 1 mm",
                             repr(0.5e-9), repr(1e-3)]
+    # a point computed by other femadh code (its record's fingerprint differs) is run again,
+    # and the study says so; the others are reused
+    from femadh._version import code_id
+
+    f = sorted((tmp_path / "here").glob("points/*/record.json"))[0]
+    rec = json.loads(f.read_text())
+    assert rec["femadh"] == code_id()
+    rec["femadh"] = "0.2.0+000000000000"
+    f.write_text(json.dumps(rec))
+    again = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    timing = json.loads((tmp_path / "here" / "timing.json").read_text())
+    assert timing["computed"] == 1 and timing["reused"] == 3
+    assert any("computed by other femadh code run again" in n for n in again.notes)
+    assert json.loads(f.read_text())["femadh"] == code_id()
+    assert _table(tmp_path / "here") == rows
 
 
 def test_killed_study_loses_no_completed_point(tmp_path):
@@ -237,8 +252,9 @@ def _table(out):
 def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, tmp_path, sig,
                                                                   executor, capsys):
     """SIGINT/SIGTERM to the driver mid-way: exit 130/143 within seconds, no process left,
-    the finished points kept; the interrupted points are redone by the next run, whose
-    study.csv equals the uninterrupted study's cell by cell (same solver, same inputs)."""
+    the finished points kept; the points not finished (if any: see below) are computed by
+    the next run, whose study.csv equals the uninterrupted study's cell by cell (same
+    solver, same inputs)."""
     scene, ref = study_scene
     out = tmp_path / "study"
     extra = ("--workers", "2") if executor == "pool" else ("--scheduler", "local:2")
@@ -262,7 +278,11 @@ def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, t
         time.sleep(0.1)
     assert kids and not _alive(kids), _alive(kids)
     kept = _finished(out)
-    assert 2 <= len(kept) < 8
+    # every point may have finished before the signal landed (the 60-node points take
+    # ~0.05 s: Dask's workers finished all 8 within one 0.05-s poll, measured, the driver
+    # still writing its table): the stop is then tested and the rerun reuses every point;
+    # that a point cut short is redone is test_killed_study_loses_no_completed_point's
+    assert 2 <= len(kept) <= 8
     # study.csv after the signal holds exactly the finished points
     assert {row[1] for row in _table(out)[1:]} == kept
     # the rest in this process (no pool, no interpreter to start: the same solver, the same

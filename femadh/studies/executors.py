@@ -30,6 +30,7 @@ import time
 
 import numpy as np
 
+from .._version import code_id
 from ..errors import (DependencyError, FemadhError, Interrupted, MeshResolutionWarning,
                       OutputError)
 from ..io.atomic import write_atomic
@@ -124,7 +125,7 @@ def run_point(point, root, estimate=True):
     folder = Path(root) / "points" / point.id
     rec = {"id": point.id, "index": point.index, "changes": point.changes,
            "status": "running", "finished": False, "error": None, "operator_reused": False,
-           "estimate": ESTIMATE_NAMES[estimate], "pid": os.getpid()}
+           "estimate": ESTIMATE_NAMES[estimate], "femadh": code_id(), "pid": os.getpid()}
     write_record(folder, rec)       # a dead worker's point is known by this record's pid
     signum = None
     try:

@@ -30,6 +30,7 @@ import json
 from pathlib import Path
 import time
 
+from .._version import code_id
 from ..errors import Interrupted, SceneError
 from ..io.atomic import write_atomic
 from ..io.progress import StudyProgress
@@ -203,13 +204,20 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         old = _load_records(out)
         ids = {p.id for p in points}
         done = {k: r for k, r in old.items() if finished(r) and k in ids}
+        # a point finished by other code (another femadh, or this one edited) is run again:
+        # a study never mixes results of two versions of the solver
+        other = {k for k, r in done.items() if r.get("femadh") != code_id()}
         # a point finished without the estimates this run asks for is run again with them
-        short = {k for k, r in done.items() if not serves(r, estimate)}
-        done = {k: r for k, r in done.items() if k not in short}
+        short = {k for k, r in done.items() if k not in other and not serves(r, estimate)}
+        done = {k: r for k, r in done.items() if k not in short and k not in other}
         todo = [p for p in points if p.id not in done]
         result = StudyRun(points, dict(done), reused=len(done),
                           redone=sum(p.id in old for p in todo),
                           new=sum(p.id not in old for p in todo))
+        if other:
+            result.notes.append(f"{len(other)} finished point{'s' * (len(other) > 1)} "
+                                f"computed by other femadh code run again (this code: "
+                                f"{code_id()})")
         if short:
             old_femadh = any("estimate" not in old[k] for k in short)
             what = ("without error estimates (--no-estimate"
