@@ -9,7 +9,8 @@ Python API::
     softer = scene.replace({"effects.asperity_gap.sigma": "0.5 nm"})   # validated again
     femadh.run(softer, "out/sigma-0.5")                # csv, json, figures into that folder
 """
-from ._version import __version__  # noqa: F401  (the package version, femadh.__version__)
+# the package version, femadh.__version__, and the fingerprint of its code (a study's records)
+from ._version import __version__, code_id  # noqa: F401
 from .errors import (ConvergenceError, DependencyError, DomainError,  # noqa: F401
                      FemadhError, Interrupted, LawError, MeshResolutionWarning, OutputError,
                      SceneError, TimeLimitReached)
@@ -20,7 +21,7 @@ _RESULTS = ("RunResult", "ContactResult", "MeniscusRunResult")
 __all__ = ["load_scene", "scene_from_dict", "run", "Scene", *_RESULTS,
            "FemadhError", "SceneError", "OutputError", "ConvergenceError", "DependencyError",
            "LawError", "DomainError", "Interrupted", "TimeLimitReached",
-           "MeshResolutionWarning", "__version__"]
+           "MeshResolutionWarning", "__version__", "code_id"]
 
 
 def __getattr__(name):

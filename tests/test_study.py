@@ -103,7 +103,7 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
                             repr(0.5e-9), repr(1e-3)]
     # a point computed by other femadh code (its record's fingerprint differs) is run again,
     # and the study says so; the others are reused
-    from femadh._version import code_id
+    from femadh import code_id
 
     f = sorted((tmp_path / "here").glob("points/*/record.json"))[0]
     rec = json.loads(f.read_text())
