@@ -2105,6 +2105,11 @@ DEFECTS = [
       "(its record's code fingerprint not compared)", "femadh/studies/sweep.py",
       (("        other = {k for k, r in done.items() if r.get(\"femadh\") != code_id()}",
         "        other = set()"),)),
+    D("lifecycle_running_signal_unhandled", "lifecycle: a signal while the 'running' "
+      "summary is written escapes the block before it runs (generator didn't yield)",
+      "femadh/runner/lifecycle.py",
+      (("                except Interrupted:\n                    # a signal while the",
+        "                except ImportError:\n                    # a signal while the"),)),
     D("gmres_strided_norm", "GMRES: |b| of a strided b as sqrt(b . b) (not norm's bits)",
       "femadh/contact/linalg.py", (("    b = np.ascontiguousarray(b)\n", ""),)),
     D("lu_empty_direct", "direct getrf on an empty system (its size read as an illegal "

@@ -95,7 +95,15 @@ def lifecycle(result, write=None, *, failures=(), announce=True, t0=None):
     with interrupt.interruptible():
         try:
             if announce:
-                life.write_summary("running")
+                try:
+                    life.write_summary("running")
+                except Interrupted:
+                    # a signal while the "running" summary was written (it writes whole
+                    # files in an immediate block): it stays pending and the block stops at
+                    # its first safe point - a context manager must yield once (returning
+                    # here was "generator didn't yield": a study point recorded an internal
+                    # error where it had been interrupted)
+                    pass
             yield life
             # a signal that arrived after the last safe point is still a stop
             interrupt.check()
