@@ -21,11 +21,25 @@ _POTRF, _POTRS = lapack.dpotrf, lapack.dpotrs
 _F8 = np.dtype(np.float64)
 
 
+def _plain(a, ndim):
+    """Whether ``a`` is a non-empty float64 ndarray of ``ndim`` dimensions (what the direct
+    LAPACK calls take; anything else goes through scipy's own function)."""
+    return type(a) is np.ndarray and a.dtype == _F8 and a.ndim == ndim and a.size > 0
+
+
+def _direct_matrix(a):
+    return _plain(a, 2) and a.shape[0] == a.shape[1]
+
+
+def _direct_system(m, b):
+    return _direct_matrix(m) and _plain(b, 1) and b.shape[0] == m.shape[0]
+
+
 def lu_factor(a, overwrite_a=False):
     """(lu, piv) of a square float matrix a: scipy.linalg.lu_factor(a, check_finite=False,
     overwrite_a=overwrite_a), the same LAPACK getrf call and the same warning on an exactly
     singular matrix, without its wrappers."""
-    if type(a) is not np.ndarray or a.dtype != _F8 or a.ndim != 2 or a.size == 0:
+    if not _direct_matrix(a):
         return linalg.lu_factor(a, check_finite=False, overwrite_a=overwrite_a)
     lu, piv, info = _GETRF(a, overwrite_a=overwrite_a)
     if info < 0:
@@ -40,9 +54,7 @@ def lu_solve(lu_and_piv, b):
     """x with a x = b from a's :func:`lu_factor`: scipy.linalg.lu_solve(lu_and_piv, b,
     check_finite=False), the same LAPACK getrs call, without its wrappers."""
     lu, piv = lu_and_piv
-    if (type(lu) is not np.ndarray or lu.dtype != _F8 or lu.ndim != 2 or type(b) is not
-            np.ndarray or b.dtype != _F8 or b.ndim != 1 or b.size == 0
-            or b.shape[0] != lu.shape[0]):
+    if not _direct_system(lu, b):
         return linalg.lu_solve(lu_and_piv, b, check_finite=False)
     x, info = _GETRS(lu, piv, b, trans=0, overwrite_b=False)
     if info != 0:
@@ -56,8 +68,7 @@ def cho_factor(a, overwrite_a=False):
     the other triangle left as it was) and the same LinAlgError where a is not positive
     definite, without its wrappers (the landing's damped descent factorises ~26 000 small
     Hessians in the suite)."""
-    if (type(a) is not np.ndarray or a.dtype != _F8 or a.ndim != 2 or a.size == 0
-            or a.shape[0] != a.shape[1]):
+    if not _direct_matrix(a):
         return linalg.cho_factor(a, check_finite=False, overwrite_a=overwrite_a)
     c, info = _POTRF(a, lower=False, overwrite_a=overwrite_a, clean=False)
     if info > 0:
@@ -73,9 +84,7 @@ def cho_solve(c_and_lower, b):
     """x with a x = b from a's :func:`cho_factor`: scipy.linalg.cho_solve(c_and_lower, b,
     check_finite=False), the same LAPACK potrs call, without its wrappers."""
     c, lower = c_and_lower
-    if (type(c) is not np.ndarray or c.dtype != _F8 or c.ndim != 2 or type(b) is not
-            np.ndarray or b.dtype != _F8 or b.ndim != 1 or b.size == 0
-            or b.shape[0] != c.shape[0] or c.shape[0] != c.shape[1]):
+    if not _direct_system(c, b):
         return linalg.cho_solve(c_and_lower, b, check_finite=False)
     x, info = _POTRS(c, b, lower=lower, overwrite_b=False)
     if info != 0:
