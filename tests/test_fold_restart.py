@@ -80,18 +80,24 @@ def test_a_stalled_landing_restarts_on_the_branch_beyond_the_fold(case, monkeypa
     # fold was found), and a landing whose polish ended off a stable state
     assert sweep.work.get("rejected_energy", 0) > 0
     stalled = [(d, w0) for d, w0, st in lands if not (st.converged and st.stable)]
-    assert len(stalled) == 1, [(d, st.converged, st.stable) for d, _, st in lands]
+    # one such landing (the third fold's, d = 0.8475 nm) with Intel AVX-512 BLAS kernels;
+    # with Haswell's or Sandybridge's last bits the second fold's (0.8898 nm) stalls too:
+    # each is the restart's to land
+    assert stalled, [(d, st.converged, st.stable) for d, _, st in lands]
     # ... landed by the restart, not by the halving fallback from the grid step's start
     assert sweep.work.get("fold_fallbacks", 0) == 0, sweep.work
-    d, w0 = stalled[0]
-    jump = [j for j in sweep.jumps if j.d_land == d]
-    assert len(jump) == 1
-    after = jump[0].after
-    assert after.converged and after.stable
-    _check_equilibrium(p, after, tol)
+    restored = []
+    for d, w0 in stalled:
+        jump = [j for j in sweep.jumps if j.d_land == d]
+        assert len(jump) == 1
+        after = jump[0].after
+        assert after.converged and after.stable
+        _check_equilibrium(p, after, tol)
+        restored.append((d, w0, after))
     # the full landing (its fallbacks restored) from the same start lands on the same state
     monkeypatch.undo()
-    full = landing.land(p, d, w0, tol=tol, max_iter=sc.max_iter)
-    assert full.converged and full.stable
-    assert np.array_equal(full.active, after.active)
-    assert np.max(np.abs(full.w - after.w)) <= 0.1 * tol
+    for d, w0, after in restored:
+        full = landing.land(p, d, w0, tol=tol, max_iter=sc.max_iter)
+        assert full.converged and full.stable
+        assert np.array_equal(full.active, after.active)
+        assert np.max(np.abs(full.w - after.w)) <= 0.1 * tol
