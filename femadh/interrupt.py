@@ -37,6 +37,7 @@ import time
 
 from .errors import Interrupted, TimeLimitReached
 
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM raised at once, as Python raises KeyboardInterrupt for SIGINT (see the module
     docstring): whatever catches a Ctrl-C catches it; ``signum`` / ``exit_code`` say which
