@@ -2161,6 +2161,18 @@ DEFECTS = [
       "in place", "femadh/studies/executors.py",
       (("            signal.signal(signal.SIGTERM, signal.SIG_DFL)\n",
         "            pass\n"),)),
+    D("startup_main_sigterm_default", "python -m femadh: SIGTERM while femadh.cli is imported "
+      "is the default (a silent death)", "femadh/__main__.py",
+      (("if _ours:\n    signal.signal(signal.SIGTERM, _sigterm_while_importing)",
+        "if False:\n    signal.signal(signal.SIGTERM, _sigterm_while_importing)"),)),
+    # -- a signal while a run folder is claimed (review of this session)
+    D("folder_claim_signal_keeps_lock", "run folder: a signal while the folder is claimed "
+      "leaves its lock file", "femadh/io/run_folder.py",
+      (("        except BaseException:\n            # a refusal, or a signal",
+        "        except OutputError:\n            # a refusal, or a signal"),)),
+    D("folder_lock_signal_keeps_file", "run folder: a signal at the lock leaves the lock file "
+      "it created", "femadh/io/run_folder.py",
+      (("                _drop_unheld(fd, lock)\n", "                os.close(fd)\n"),)),
 ]
 
 

@@ -126,16 +126,24 @@ def test_damaged_folder_refused_or_repaired_in_one_line(ref, ref_states, tmp_pat
     assert len(curve_rows(tmp_path / "out")) == ref_states + 1
 
 
-def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
-    # 141 states each way on 100 nodes. The limit is half of what the uninterrupted run took
-    # on this host (its summary's total: 0.21 s on a fast host, ~0.4 s on CI's slower one),
-    # so it falls inside the sweep whatever the host's speed (a fixed 0.3 s let the whole
-    # run finish in time on a fast host)
+def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path, monkeypatch):
+    # 141 states each way on 100 nodes, on the run's clock made to advance by 1 s at each of
+    # its readings (one when the limit is armed, one at each safe point: every corrector
+    # iteration and committed state), so a 100-s limit falls inside the sweep on any host
+    # and at any load (a limit in real seconds - a fixed 0.3 s, or half of a reference
+    # run's time - let the whole run finish in time on a fast or briefly less loaded host)
+    import types
+
+    import femadh.interrupt
+
+    ticks = [0.0]
+
+    def monotonic():
+        ticks[0] += 1.0
+        return ticks[0]
+    monkeypatch.setattr(femadh.interrupt, "time", types.SimpleNamespace(monotonic=monotonic))
+    limit = "100 s"
     scene = short_scene(tmp_path, nodes=100, step="0.05 nm")
-    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-estimate",
-               "--no-figures")[0] == 0
-    ref_s = summary(tmp_path / "ref")["timings_s"]
-    limit = f"{0.5 * ref_s['total_s']:.3g} s"
     out = tmp_path / "out"
     code, err = cli("run", scene, "--out", out, "--quiet", "--no-estimate", "--no-figures",
                     "--time-limit", limit)
@@ -147,6 +155,8 @@ def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
                     "--resume")
     assert code == 0, err
     # continued from the checkpoint of its last state: the uninterrupted rows, bit for bit
+    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-estimate",
+               "--no-figures")[0] == 0
     assert curve_rows(out) == curve_rows(tmp_path / "ref") and len(curve_rows(out)) == 283
     # the scene key, with units; a bare number is refused like any dimensional key
     text = scene.read_text().replace("[solver]\n", f'[solver]\ntime_limit = "{limit}"\n', 1)
@@ -381,3 +391,34 @@ def test_a_lock_taken_on_a_removed_lock_file_is_taken_again(tmp_path, monkeypatc
     finally:
         folder.release()
     assert not (tmp_path / rf.LOCK).exists()
+
+
+@pytest.mark.parametrize("at", ["lock", "previous run"])
+def test_a_signal_while_a_folder_is_claimed_leaves_no_lock(tmp_path, monkeypatch, at):
+    """A SIGINT/SIGTERM (raised as KeyboardInterrupt) while RunFolder takes its lock or reads
+    the previous run - before any ``with`` could release it - leaves no lock file in the
+    folder (found by a review: a SIGTERM at the lock during ``femadh study`` left
+    .femadh.lock behind); the folder can be claimed at once."""
+    import fcntl
+
+    import femadh.io.run_folder as rf
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+    if at == "lock":
+        real = fcntl.flock
+        calls = []
+
+        def flock(fd, op):
+            calls.append(op)
+            if len(calls) == 1:
+                raise KeyboardInterrupt        # the signal at the lock, before it is taken
+            return real(fd, op)
+        monkeypatch.setattr(rf.fcntl, "flock", flock)
+    else:
+        monkeypatch.setattr(rf, "previous_run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        rf.RunFolder(tmp_path, "id", "x", "new")
+    assert not (tmp_path / rf.LOCK).exists()
+    monkeypatch.undo()
+    rf.RunFolder(tmp_path, "id", "x", "new").release()

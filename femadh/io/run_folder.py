@@ -40,6 +40,18 @@ def previous_run(path):
     return None
 
 
+def _drop_unheld(fd, lock):
+    """Close ``fd`` (open on the lock file ``lock``), removing the file first if this process
+    holds (or can now take) its lock and it is still the folder's."""
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        if os.stat(lock).st_ino == os.fstat(fd).st_ino:
+            os.unlink(lock)
+    except OSError:
+        pass                        # another run's lock, or the file already gone
+    os.close(fd)
+
+
 class RunFolder:
     """Claim ``path`` for a run.
 
@@ -71,10 +83,14 @@ class RunFolder:
         except OSError as exc:
             raise OutputError(f"cannot create the output folder {self.path}: "
                               f"{exc.strerror or exc}") from None
-        self._lock()
+        self.lock_fd = None
         try:
+            self._lock()
             self.previous = self._check_previous()
-        except OutputError:
+        except BaseException:
+            # a refusal, or a signal while the folder was being claimed (SIGINT or SIGTERM
+            # raised as KeyboardInterrupt: no ``with`` was entered to release it): the lock
+            # file is not left behind
             self.release()
             raise
 
@@ -84,19 +100,26 @@ class RunFolder:
         # just before) guards nothing: taken again on the folder's current file (budget 5)
         for _ in range(5):
             try:
-                self.lock_fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+                fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
             except OSError as exc:
                 raise OutputError(f"output folder {self.path} is not writable: "
                                   f"{exc.strerror or exc}") from None
             try:
-                fcntl.flock(self.lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
-                other = os.read(self.lock_fd, 64).decode(errors="replace").strip() or "?"
-                os.close(self.lock_fd)
-                self.lock_fd = None
+                other = os.read(fd, 64).decode(errors="replace").strip() or "?"
+                os.close(fd)
                 raise OutputError(f"output folder {self.path} is in use by another femadh "
                                   f"run (pid {other}); wait for it or give another --out") \
                     from None
+            except BaseException:
+                # a signal (raised as KeyboardInterrupt) at the lock: the file this run
+                # created is removed if the lock is (or now becomes) ours - never another
+                # run's - and the descriptor closed
+                _drop_unheld(fd, lock)
+                raise
+            # held from here on: release() removes the file and closes it
+            self.lock_fd = fd
             try:
                 same = os.stat(lock).st_ino == os.fstat(self.lock_fd).st_ino
             except FileNotFoundError:
