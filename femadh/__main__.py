@@ -16,8 +16,10 @@ def _sigterm_while_importing(signum, frame):
     os._exit(128 + signum)
 
 
-# (only where SIGTERM has its default action: a parent that ignores it keeps it ignored)
-_ours = signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+# (only where SIGTERM has its default action: a parent that ignores it keeps it ignored;
+# not under a coverage run, which keeps its teardown, as femadh.cli._as_program)
+_ours = (signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+         and not os.environ.get("COVERAGE_PROCESS_START"))
 if _ours:
     signal.signal(signal.SIGTERM, _sigterm_while_importing)
 try:
