@@ -257,3 +257,20 @@ def fields_by_state(out):
         for row in csv.DictReader(f):
             rows.setdefault(row["state"], []).append((float(row["r_m"]), float(row["h_m"])))
     return {k: tuple(np.array(v).T) for k, v in rows.items()}
+
+
+@pytest.fixture(scope="session")
+def regime_run(tmp_path_factory):
+    """(exit code, stdout, folder) of one ``femadh regime --mu 0.5 1.0 --points 2``: the
+    printed table (test_output) and the files (test_roughness) of the same command, run once
+    a test process (~0.5 CPU-s, most of it its two figures)."""
+    import contextlib
+    import io
+
+    from femadh.cli import main
+
+    out = tmp_path_factory.mktemp("regime") / "reg"
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text):
+        code = main(["regime", "--mu", "0.5", "1.0", "--points", "2", "--out", str(out)])
+    return code, text.getvalue(), out

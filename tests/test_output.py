@@ -176,14 +176,15 @@ def test_figures_are_named_for_what_they_show_and_the_loop_is_visible(tmp_path):
     plt.close(fig)
 
 
-def test_regime_prints_a_short_table_and_keeps_the_csv_in_the_file(tmp_path, capsys):
+def test_regime_prints_a_short_table_and_keeps_the_csv_in_the_file(regime_run):
     """`femadh regime` prints one header and one row per point (a few columns, aligned), not
-    the csv; regime.csv keeps every column."""
-    from femadh.cli import main
+    the csv; regime.csv keeps every column. (conftest's regime_run: mu 0.5 and 1, the run
+    test_roughness reads the files of.)"""
     from femadh.studies.regime import REGIME_HEADER
 
-    assert main(["regime", "--mu", "0.3", "2", "--points", "2", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out.splitlines()
+    code, text, tmp_path = regime_run
+    assert code == 0
+    out = text.splitlines()
     assert out[0].split() == ["mu", "pull-off/πRΔγ", "Maugis-Dugdale", "jump-in", "d/z0",
                               "jump-out", "d/z0", "hysteresis", "nodes"]
     assert len(out) == 4 and out[-1].startswith(f"results in {tmp_path}: regime.csv")

@@ -97,14 +97,15 @@ def test_regime_map_limits_and_hysteresis():
     assert abs(hi.pull_off / hi.maugis - 1) < abs(mid.pull_off / mid.maugis - 1)
 
 
-def test_regime_cli_writes_table_and_figures(tmp_path, capsys):
-    """`femadh regime`: csv with one row per mu, the two figures; units are checked."""
+def test_regime_cli_writes_table_and_figures(regime_run, capsys):
+    """`femadh regime`: csv with one row per mu, the two figures; units are checked.
+    (conftest's regime_run: the run whose printed table test_output reads.)"""
     import csv
 
     from femadh.cli import main
 
-    out = tmp_path / "reg"
-    assert main(["regime", "--mu", "0.5", "1.0", "--points", "2", "--out", str(out)]) == 0
+    code, _, out = regime_run
+    assert code == 0
     rows = list(csv.DictReader(open(out / "regime.csv")))
     assert [float(r["mu"]) for r in rows] == [0.5, 1.0]
     assert rows[0]["jump_in_d_over_z0"] == "" and float(rows[1]["jump_in_d_over_z0"]) > 2

@@ -247,7 +247,9 @@ def _table(out):
 # each signal and each executor once: the driver turns SIGINT and SIGTERM into one flag
 # (femadh.studies.executors) and always stops its pool's workers with SIGTERM, so a SIGTERM to
 # a pool's driver repeated the SIGINT case but for the exit code, which the Dask case checks
-# (that third case cost ~3.3 CPU-s: a driver and two workers started)
+# (that third case cost ~3.3 CPU-s: a driver and two workers started). The Dask case runs a
+# LocalCluster of one worker process: stopping a cluster's workers is the same call for one as
+# for two, and each worker process started costs ~1 CPU-s of imports (distributed, femadh)
 @pytest.mark.parametrize("sig, executor", [(signal.SIGINT, "pool"), (signal.SIGTERM, "dask")])
 def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, tmp_path, sig,
                                                                   executor, capsys):
@@ -257,7 +259,7 @@ def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, t
     solver, same inputs)."""
     scene, ref = study_scene
     out = tmp_path / "study"
-    extra = ("--workers", "2") if executor == "pool" else ("--scheduler", "local:2")
+    extra = ("--workers", "2") if executor == "pool" else ("--scheduler", "local:1")
     p = subprocess.Popen(_cmd(scene, out, *extra), cwd=ROOT, env=ENV,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     kids, t0 = set(), time.time()
