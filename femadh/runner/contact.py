@@ -31,7 +31,8 @@ STIFFNESS_WARNING = 0.5
 
 
 def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overwrite=False,
-                resume=False, operator=None, estimate=True, folder_id=None, resume_from=None):
+                resume=False, operator=None, estimate=True, folder_id=None, resume_from=None,
+                defer_estimate=None):
     """Solve a contact scene (called by :func:`femadh.runner.run.run`, which documents the
     arguments, inside the run's signal handling, time limit and progress display): an
     adaptive grid or an accuracy target is refined over several runs, else one run into its
@@ -50,13 +51,13 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
                                progress=progress, overwrite=overwrite, resume=resume)
     if out_dir is None:
         return _run(scene, None, progress=progress, operator=operator, estimate=estimate,
-                    run=run)
+                    run=run, defer=defer_estimate)
     from ..io.run_folder import RunFolder
 
     mode = "resume" if resume else "overwrite" if overwrite else "new"
     with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
         res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
-                   resume_from=resume_from, run=run)
+                   resume_from=resume_from, run=run, defer=defer_estimate)
         if figures and res.status in ("converged", "failed") and any(
                 len(next(iter(b.values()))) for b in res.branches.values()):
             with phase("figures"):
@@ -95,7 +96,8 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_from=None):
+def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_from=None,
+         defer=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     from ..io.progress import note
@@ -187,7 +189,7 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
         if folder is not None and (folder.path / CHECKPOINT).exists():
             (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
         if res.status == "running":
-            _finish(scene, res, problem, sink, estimate, run)
+            _finish(scene, res, problem, sink, estimate, run, defer)
             if folder is not None and res.instrument is not None:
                 from ..io.writers import write_instrument
 
@@ -195,8 +197,9 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
     return res
 
 
-def _finish(scene, res, problem, sink, estimate, run):
-    """Headline numbers, their error estimates and the bound guard of a finished sweep."""
+def _finish(scene, res, problem, sink, estimate, run, defer=None):
+    """Headline numbers, their error estimates and the bound guard of a finished sweep
+    (``defer``: :func:`femadh.runner.estimates.estimate_errors`')."""
     from .estimates import estimate_errors, guard_bounds, refine_peak
     from .headline import headline
 
@@ -214,7 +217,8 @@ def _finish(scene, res, problem, sink, estimate, run):
             res.instrument["fresh_states"] = refine_instrument(scene, res, problem, sink)
             res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
-            res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
+            res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
+                                            defer=defer)
         guard_bounds(res, problem)      # a BoundError: its kind decides the refinement
     res.timings["estimate_s"] = time.perf_counter() - t1
 
