@@ -20,35 +20,49 @@ def _as_program():
     not a script that calls :func:`main`; a coverage run keeps its teardown (its data is
     written at exit)."""
     prog = os.path.normpath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    # a worker that multiprocessing spawned for a study or a fit has the program's argv
+    # and, spawned by the ``femadh`` script, imports this module while it re-runs that
+    # script as its "__mp_main__": it is not the program (its signals are its pool's,
+    # femadh.studies.executors). It is renamed from "MainProcess" before that import (its
+    # parent_process() is set only after it)
+    mp = sys.modules.get("multiprocessing.process")
     return (not os.environ.get("COVERAGE_PROCESS_START")
+            and (mp is None or (mp.current_process().name == "MainProcess"
+                                and mp.parent_process() is None))
             and (os.path.basename(prog).removesuffix(".exe") == "femadh"
                  or prog.endswith(os.path.join("femadh", "__main__.py"))))
 
 
-#: the line a Ctrl-C prints while the program starts (see :func:`_stop_at_once`)
-_STOP_LINE = [b"femadh: error: interrupted by SIGINT while starting; nothing was written\n"]
-#: its exit code: 130 while starting; the command's own once it has ended
-_STOP_CODE = [130]
+#: what a signal outside :func:`main`'s guard says after its name (:func:`_stop_at_once`)
+_STOP_WHEN = [b"while starting; nothing was written"]
+#: its exit code: None while starting (the signal's own: 130 SIGINT, 143 SIGTERM, as a run
+#: stopped by it); the command's own code once it has ended
+_STOP_CODE = [None]
 
 
 def _stop_at_once(signum, frame):
-    """SIGINT to the program outside :func:`main`'s guard - while it imports itself (before
-    :func:`main` runs) or after the command has ended: one line, at once, exit 130 (or the
-    ended command's own code). Nothing
-    is being written then (the line says what stands), and a KeyboardInterrupt raised in the
-    middle of an import would end in a traceback of the import machinery instead."""
+    """SIGINT or SIGTERM to the program outside :func:`main`'s guard - while it imports itself
+    (before :func:`main` runs) or after the command has ended: one line naming the signal, at
+    once, exit 128 + its number (130, 143; or the ended command's own code). Nothing is being
+    written then (the line says what stands), and a KeyboardInterrupt raised in the middle of
+    an import would end in a traceback of the import machinery instead (SIGTERM's default
+    action: a silent death, exit -15, no line)."""
+    name = b"SIGTERM" if signum == signal.SIGTERM else b"SIGINT"
     try:
-        os.write(2, _STOP_LINE[0])
+        os.write(2, b"femadh: error: interrupted by " + name + b" " + _STOP_WHEN[0] + b"\n")
     except OSError:
         pass                        # (no stderr: the exit code still says it)
-    os._exit(_STOP_CODE[0])
+    os._exit(128 + signum if _STOP_CODE[0] is None else _STOP_CODE[0])
 
 
-# First thing, before the imports below: the program's Ctrl-C is one line from here on. Not
-# when imported by a script or a test (their Ctrl-C is theirs), nor when the parent set
-# SIGINT to be ignored (nohup, a background job: it stays ignored).
+# First thing, before the imports below: the program's Ctrl-C and SIGTERM are one line from
+# here on. Not when imported by a script or a test (their signals are theirs), nor in a
+# study's or a fit's worker process (see _as_program), nor when the parent set the signal to
+# be ignored (nohup, a background job: it stays ignored).
 if _as_program() and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
     signal.signal(signal.SIGINT, _stop_at_once)
+if _as_program() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+    signal.signal(signal.SIGTERM, _stop_at_once)
 
 import argparse  # noqa: E402  (after the handler: a Ctrl-C during these imports is one line)
 
@@ -207,12 +221,18 @@ def main(argv=None):
     flushed. Called with ``argv`` (a script, a test) it forks nothing and returns."""
     program = argv is None and _as_program()
     code = _main(argv, program)
-    if program and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        # the command has ended: a Ctrl-C now (the interpreter's teardown) is one line too
-        _STOP_LINE[0] = (f"femadh: error: interrupted by SIGINT while exiting; the command "
-                         f"had ended (exit code {code})\n").encode()
+    if program:
+        # the command has ended: a Ctrl-C or SIGTERM now (the interpreter's teardown) is one
+        # line too, with the command's own exit code
+        _STOP_WHEN[0] = f"while exiting; the command had ended (exit code {code})".encode()
         _STOP_CODE[0] = code
-        signal.signal(signal.SIGINT, _stop_at_once)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            signal.signal(signal.SIGINT, _stop_at_once)
+        # (_main set it from femadh.interrupt, imported then: no import here, whose time
+        # would be one more moment for a SIGTERM to escape as a Terminated)
+        if signal.getsignal(signal.SIGTERM) is getattr(sys.modules.get("femadh.interrupt"),
+                                                       "raise_terminated", _stop_at_once):
+            signal.signal(signal.SIGTERM, _stop_at_once)
     if program and sys.argv[1:2] == ["run"]:
         _exit_now(code)
     return code
@@ -236,6 +256,13 @@ def _main(argv, program=False):
             # from here a Ctrl-C is a KeyboardInterrupt, taken below (or, in a run, deferred
             # to its next safe point by femadh.interrupt)
             signal.signal(signal.SIGINT, signal.default_int_handler)
+        if signal.getsignal(signal.SIGTERM) is _stop_at_once:
+            # SIGTERM likewise: raised as a KeyboardInterrupt (Terminated), taken below, so
+            # that what the command has begun (a study's folder claimed) is undone on the way
+            # out; a run's own handlers replace it while it runs
+            from .interrupt import raise_terminated
+
+            signal.signal(signal.SIGTERM, raise_terminated)
         args = _parser().parse_args(argv)
         args.program = program
         from ._threads import blas_threads
@@ -254,12 +281,13 @@ def _main(argv, program=False):
     except Interrupted as exc:
         _error(f"{exc}; nothing was being written")
         return exc.exit_code
-    except KeyboardInterrupt:
-        # (outside a run's safe points: its imports, the scene's checks, another command)
+    except KeyboardInterrupt as exc:
+        # (outside a run's safe points: its imports, the scene's checks, another command; a
+        # SIGTERM there is a KeyboardInterrupt too: femadh.interrupt.Terminated)
         if os.environ.get("FEMADH_DEBUG"):
             raise
-        _error("interrupted by SIGINT")
-        return 130
+        _error(f"interrupted by {_signal_name(exc)}")
+        return _signal_code(exc)
     except FemadhError as exc:
         _error(exc)
         return EXIT_SOLVE
@@ -273,6 +301,16 @@ def _main(argv, program=False):
         _error(f"internal error {type(exc).__name__}: {exc} (a bug in femadh; run with "
                "FEMADH_DEBUG=1 for the traceback and please report it)")
         return EXIT_BUG
+
+
+def _signal_name(exc):
+    """The signal behind a KeyboardInterrupt: SIGTERM for femadh.interrupt.Terminated."""
+    return "SIGTERM" if getattr(exc, "signum", signal.SIGINT) == signal.SIGTERM else "SIGINT"
+
+
+def _signal_code(exc):
+    """Its exit code: 130 SIGINT, 143 SIGTERM (as a run stopped by it)."""
+    return getattr(exc, "exit_code", 128 + signal.SIGINT)
 
 
 def _dispatch(args):
@@ -377,14 +415,14 @@ def _run(scene, args):
     if not args.quiet:
         try:
             _report(res)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:
             # the run has ended: say so, not just "interrupted" (a stopped run goes on to
             # say how to continue it)
             if res.status not in ("interrupted", "time limit"):
                 where = f" and its results are in {res.out_dir}" if res.out_dir else ""
-                _error(f"interrupted by SIGINT while printing the report; the run had ended "
-                       f"({res.status}){where}")
-                return 130
+                _error(f"interrupted by {_signal_name(exc)} while printing the report; the "
+                       f"run had ended ({res.status}){where}")
+                return _signal_code(exc)
     if res.status in ("interrupted", "time limit"):
         # the command that continues it, as typed (pasted, it resumes this very folder)
         again = ["femadh", "run", args.scene, "--out", str(out), "--resume"] + [

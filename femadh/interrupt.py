@@ -22,6 +22,13 @@ the member and turned into a warning).
 
 A deadline (``[solver] time_limit``, ``--time-limit``) is checked at the same safe points and
 raises :class:`TimeLimitReached`.
+
+Outside a run's blocks the ``femadh`` program takes SIGTERM as Python takes SIGINT:
+:func:`raise_terminated` raises :class:`Terminated`, a KeyboardInterrupt, wherever the program
+is (its start: parsing, the scene's checks, the lazy imports, a study claiming its folder; or
+the report after the run), so that every ``finally`` and ``with`` on the way out runs (a lock
+released, a temporary file removed: nothing half-written) and the command ends in one line,
+exit 143 (:mod:`femadh.cli`), as a run stopped by SIGTERM does.
 """
 from contextlib import contextmanager
 import signal
@@ -29,6 +36,22 @@ import threading
 import time
 
 from .errors import Interrupted, TimeLimitReached
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM raised at once, as Python raises KeyboardInterrupt for SIGINT (see the module
+    docstring): whatever catches a Ctrl-C catches it; ``signum`` / ``exit_code`` say which
+    signal it was (SIGINT's KeyboardInterrupt has neither: 2 / 130)."""
+
+    signum = signal.SIGTERM
+    exit_code = 128 + signal.SIGTERM
+
+
+def raise_terminated(signum, frame):
+    """The femadh program's SIGTERM outside a run's blocks (set by :func:`femadh.cli.main`;
+    a run's :func:`interruptible` replaces it and puts it back)."""
+    raise Terminated("SIGTERM")
+
 
 _pending = []
 #: nesting depth of interruptible() blocks (only the outermost installs and restores)

@@ -2178,6 +2178,24 @@ DEFECTS = [
     D("relaxfix_ref_every_step", "landing relaxation: the reference residual renewed every "
       "step (the damping stays RELAX_MU0, never Newton's)", "femadh/contact/landing.py",
       (("if A_set is None or not np.array_equal(A, A_set):", "if True:"),)),
+    # -- SIGTERM while the femadh program starts (branch startup)
+    D("startup_sigterm_default", "the program's SIGTERM while it starts is the default (a "
+      "silent death, exit -15)", "femadh/cli.py",
+      (("if _as_program() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:",
+        "if False:"),)),
+    D("startup_sigterm_exits_in_main", "SIGTERM inside main's guard ends the process at once "
+      "(a study's claimed folder keeps its lock file)", "femadh/cli.py",
+      (("            signal.signal(signal.SIGTERM, raise_terminated)",
+        "            signal.signal(signal.SIGTERM, _stop_at_once)"),)),
+    D("startup_handler_in_workers", "a worker spawned by the femadh script takes the "
+      "program's start-up handlers (an idle worker's SIGTERM: exit 143 and a line)",
+      "femadh/cli.py",
+      (('            and (mp is None or (mp.current_process().name == "MainProcess"',
+        '            and (True or (mp.current_process().name == "MainProcess"'),)),
+    D("startup_worker_keeps_handler", "the workers' set-up leaves a start-up SIGTERM handler "
+      "in place", "femadh/studies/executors.py",
+      (("            signal.signal(signal.SIGTERM, signal.SIG_DFL)\n",
+        "            pass\n"),)),
 ]
 
 

@@ -88,11 +88,16 @@ def test_releasing_iterations_carry_the_same_bits(problem, as_merged, monkeypatc
 def test_an_inexact_first_step_at_each_set_reaches_the_same_states(problem, as_merged,
                                                                    monkeypatch):
     """GMRES to 1e-4 on the first step at each active set against 1e-6 on every step: the
-    same separations, contact sets and folds; every grid state within 3x the tolerance of
-    the other within 2x the measured 7.6e-21 m (N = 240; tolerance 1e-19 m: GMRES to 1e-2
-    on the first step moves them 8.8e-20 m, to 1e-4 on every step 3.6e-20 m); every state's residual recomputed here within the tolerance (measured at
-    most 6.6e-20 m: the corrector's own test); fewer Krylov iterations (measured 2736 ->
-    2348) and no more Newton iterations (measured 589 on both)."""
+    same separations, contact sets and folds; every grid state as far from the other as
+    their two residuals allow - each state's error is its residual amplified by
+    (I - C dP/dh)^-1 - within 2x the largest measured ratio |w_a - w_b| / (r_a + r_b + 16 eps
+    |w|) (N = 240: 0.93 with Intel AVX-512 BLAS kernels, 1.15 with Haswell's, 1.31 with
+    Sandybridge's; the hosts' last bits decide whether a solve stops at 9.8e-20 m or takes
+    one step more to 2.5e-25 m, so an absolute bound measured on one host (7.6e-21 m) failed
+    on another at 1.13e-19 m); every state's residual recomputed here within the tolerance
+    (measured at most 6.6e-20 m: the corrector's own test); fewer Krylov iterations
+    (measured 2736 -> 2348) and no more Newton iterations than the round-off of a
+    stopping test allows (below)."""
     p = problem
     ap1, re1, c1 = as_merged
     assert cm.GMRES_RTOL_NEW_SET > cm.GMRES_RTOL
@@ -101,7 +106,8 @@ def test_an_inexact_first_step_at_each_set_reaches_the_same_states(problem, as_m
         assert [s.d for s in new.states] == [s.d for s in old.states]
         for a, b in zip(new.states, old.states):
             assert np.array_equal(a.active, b.active)
-            assert np.max(np.abs(a.w - b.w)) <= 2 * 7.6e-21
+            floor = 16 * np.finfo(float).eps * np.max(np.abs(a.w))
+            assert np.max(np.abs(a.w - b.w)) <= 2 * 1.31 * (a.residual + b.residual + floor)
             # the residual of eq (6)/(10), recomputed: w - C (P(h) - pc) with pc on the set
             pc = np.where(a.active, p.pressure(a.h) - p.K @ a.w, 0.0)
             assert np.max(np.abs(a.w - p.C @ (p.pressure(a.h) - pc))) <= TOL
@@ -110,7 +116,10 @@ def test_an_inexact_first_step_at_each_set_reaches_the_same_states(problem, as_m
                                                     abs=1e-3 * old.jumps[0].resolution)
     it1 = ap1.work["iterations"] + re1.work["iterations"]
     it0 = ap0.work["iterations"] + re0.work["iterations"]
-    assert it1 <= it0, (it1, it0)
+    # Newton iterations: 589 on both with Intel AVX-512 BLAS kernels, 590 vs 588 with
+    # Sandybridge's (one state's last step lands just above or below the tolerance):
+    # no more than 1 % more, 3x the largest measured excess (0.34 %)
+    assert it1 <= 1.01 * it0, (it1, it0)
     assert c1["krylov"] < c0["krylov"], (c1, c0)
 
 

@@ -127,13 +127,19 @@ def test_damaged_folder_refused_or_repaired_in_one_line(ref, ref_states, tmp_pat
 
 
 def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
-    # 141 states each way on 100 nodes: ~1 s through the CLI on a quiet machine, so the
-    # limits below (0.3 s, 0.2 s) fall inside the sweep
+    # 141 states each way on 100 nodes. The limit is half of what the uninterrupted run took
+    # on this host (its summary's total: 0.21 s on a fast host, ~0.4 s on CI's slower one),
+    # so it falls inside the sweep whatever the host's speed (a fixed 0.3 s let the whole
+    # run finish in time on a fast host)
     scene = short_scene(tmp_path, nodes=100, step="0.05 nm")
+    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-estimate",
+               "--no-figures")[0] == 0
+    ref_s = summary(tmp_path / "ref")["timings_s"]
+    limit = f"{0.5 * ref_s['total_s']:.3g} s"
     out = tmp_path / "out"
     code, err = cli("run", scene, "--out", out, "--quiet", "--no-estimate", "--no-figures",
-                    "--time-limit", "0.3 s")
-    assert code == 6 and "time limit 0.3 s reached" in err and err.count("\n") == 1
+                    "--time-limit", limit)
+    assert code == 6 and f"time limit {limit} reached" in err and err.count("\n") == 1
     s = summary(out)
     assert s["status"] == "time limit"
     assert 0 < len(curve_rows(out)) - 1 < 282
@@ -141,14 +147,12 @@ def test_time_limit_ends_the_run_cleanly_and_resume_completes(tmp_path):
                     "--resume")
     assert code == 0, err
     # continued from the checkpoint of its last state: the uninterrupted rows, bit for bit
-    assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-estimate",
-               "--no-figures")[0] == 0
     assert curve_rows(out) == curve_rows(tmp_path / "ref") and len(curve_rows(out)) == 283
     # the scene key, with units; a bare number is refused like any dimensional key
-    text = scene.read_text().replace("[solver]\n", '[solver]\ntime_limit = "0.2 s"\n', 1)
+    text = scene.read_text().replace("[solver]\n", f'[solver]\ntime_limit = "{limit}"\n', 1)
     scene.write_text(text)
     assert cli("run", scene, "--out", tmp_path / "o2", "--quiet", "--no-estimate")[0] == 6
-    scene.write_text(text.replace('"0.2 s"', "2"))
+    scene.write_text(text.replace(f'"{limit}"', "2"))
     code, err = cli("check", scene)
     assert code == 2 and "solver.time_limit" in err and err.count("\n") == 1
 

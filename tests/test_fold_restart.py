@@ -13,6 +13,7 @@ neighbouring contact edges, EDGE_SHIFTS) such a landing is rescued inside ``land
 the stepping's restart is reached; with both turned off here, the restart from the
 energy-rejected trial is the path that lands it (measured: 3 Newton iterations, 28 contact
 nodes), without the sweep's halving fallback."""
+import dataclasses
 import warnings
 
 import numpy as np
@@ -59,16 +60,34 @@ def test_a_stalled_landing_restarts_on_the_branch_beyond_the_fold(case, monkeypa
     the sweep takes no halving fallback, and the state it lands on is a converged, stable
     equilibrium (checked independently: residual, gap bound, traction, Hessian) that is the
     landing the full ``land`` (relaxation and neighbouring edges on) finds from the same start
-    - to 0.1 tol (measured max |dw| = 3.7e-21 m = 0.037 tol, same 28 contact nodes)."""
+    - to 0.1 tol (measured max |dw| = 3.7e-21 m = 0.037 tol, same 28 contact nodes).
+
+    Whether the descent's polish stalls hangs on the host's last bits (the third fold's does
+    with Intel AVX-512 BLAS kernels, the second's too with Haswell's, none with Haswell's and
+    numpy's AVX2 loops), so a landing that follows an energy-rejected step and does polish is
+    reported here as stalled (its state marked unconverged): the restart is exercised on
+    every host. The comparison with the full landing is made where the polish stalled by
+    itself."""
     sc, p = case
     tol = sc.tolerance
     lands = []
-    real_land = stepping.land
+    rejected = [False]
+    real_land, real_crossed = stepping.land, stepping.crossed_fold
+
+    def crossed_spy(*a, **k):
+        out = real_crossed(*a, **k)
+        rejected[0] = rejected[0] or out
+        return out
 
     def land_spy(problem, d, w_start, **kw):
         st = real_land(problem, d, w_start, **kw)
-        lands.append((d, np.array(w_start), st))
+        forced = rejected[0] and st.converged and st.stable
+        if forced:
+            st = dataclasses.replace(st, converged=False)
+        rejected[0] = False
+        lands.append((d, np.array(w_start), st, forced))
         return st
+    monkeypatch.setattr(stepping, "crossed_fold", crossed_spy)
     monkeypatch.setattr(stepping, "land", land_spy)
     monkeypatch.setattr(landing, "RELAX_STEPS", 0)
     monkeypatch.setattr(landing, "EDGE_SHIFTS", ())
@@ -79,19 +98,29 @@ def test_a_stalled_landing_restarts_on_the_branch_beyond_the_fold(case, monkeypa
     # the case is the restart's: trials turned down by the energy check (a state beyond a
     # fold was found), and a landing whose polish ended off a stable state
     assert sweep.work.get("rejected_energy", 0) > 0
-    stalled = [(d, w0) for d, w0, st in lands if not (st.converged and st.stable)]
-    assert len(stalled) == 1, [(d, st.converged, st.stable) for d, _, st in lands]
+    stalled = [(d, w0, forced) for d, w0, st, forced in lands
+               if not (st.converged and st.stable)]
+    # each is the restart's to land (measured: the third fold's, d = 0.8475 nm, on every
+    # host; the second's, 0.8898 nm, where its polish stalls)
+    assert stalled, [(d, st.converged, st.stable) for d, _, st, _ in lands]
     # ... landed by the restart, not by the halving fallback from the grid step's start
     assert sweep.work.get("fold_fallbacks", 0) == 0, sweep.work
-    d, w0 = stalled[0]
-    jump = [j for j in sweep.jumps if j.d_land == d]
-    assert len(jump) == 1
-    after = jump[0].after
-    assert after.converged and after.stable
-    _check_equilibrium(p, after, tol)
+    restored = []
+    for d, w0, forced in stalled:
+        jump = [j for j in sweep.jumps if j.d_land == d]
+        assert len(jump) == 1
+        after = jump[0].after
+        assert after.converged and after.stable
+        _check_equilibrium(p, after, tol)
+        if not forced:
+            restored.append((d, w0, after))
     # the full landing (its fallbacks restored) from the same start lands on the same state
+    # where the descent's polish stalled by itself (a forced stall's descent found a stable
+    # state of its own, which on this lattice-trapped grid need not be the restart's: at
+    # d = 0.803 nm they differ by their contact sets)
     monkeypatch.undo()
-    full = landing.land(p, d, w0, tol=tol, max_iter=sc.max_iter)
-    assert full.converged and full.stable
-    assert np.array_equal(full.active, after.active)
-    assert np.max(np.abs(full.w - after.w)) <= 0.1 * tol
+    for d, w0, after in restored:
+        full = landing.land(p, d, w0, tol=tol, max_iter=sc.max_iter)
+        assert full.converged and full.stable
+        assert np.array_equal(full.active, after.active)
+        assert np.max(np.abs(full.w - after.w)) <= 0.1 * tol

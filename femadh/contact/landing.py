@@ -459,8 +459,9 @@ def _relax(problem, d, w, active, *, tol, max_steps=None):
         (diag(area) J_II + mu diag(S)_II) dw_I = -area_I F_I,   J = K + dP/dh,
 
     with the pseudo-time step 1/mu following the residual's progress on the current contact
-    set (switched evolution relaxation referred to the set's first residual, RELAX_MU0:
-    1/RELAX_MU0 while the surface drifts, Newton's as it converges) and the contact set updated
+    set (switched evolution relaxation referred to the largest residual seen on the set,
+    mu = RELAX_MU0 min(1, r / r_set): 1/RELAX_MU0 while the surface drifts, growing to Newton's
+    as it converges) and the contact set updated
     each step as in the corrector (a node joins at h < sigma, leaves when its contact
     pressure turns tensile). It passes the vanished root and settles on the set whose
     equilibrium exists.

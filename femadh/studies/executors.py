@@ -33,6 +33,7 @@ import numpy as np
 from .._version import code_id
 from ..errors import (DependencyError, FemadhError, Interrupted, MeshResolutionWarning,
                       OutputError)
+from ..interrupt import raise_terminated
 from ..io.atomic import write_atomic
 
 #: headline numbers a study's table carries (when the scene kind has them)
@@ -192,11 +193,23 @@ def _jsonable(o):
 
 
 def _worker_init():
-    """Set-up of a pool or Dask worker: one BLAS thread (the points are the parallelism)."""
+    """Set-up of a pool or Dask worker: one BLAS thread (the points are the parallelism).
+
+    Its SIGTERM is the default (an idle worker the driver stops dies of it, exit -15, which
+    the driver reads as its own stop, not as a death), or a run's while one runs: the
+    ``femadh`` program's own start-up handler (:mod:`femadh.cli`: one line and exit 143) is
+    never a worker's. femadh.cli does not install it in a multiprocessing child; should a
+    launcher still have left it (a worker of the ``femadh`` script imports femadh.cli), it
+    is taken out here. Any other handler (a ``dask worker`` of a cluster femadh did not
+    start closes itself on SIGTERM) is left alone."""
     global _IN_POOL
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     _IN_POOL = threading.current_thread() is threading.main_thread()
+    if _IN_POOL:
+        h = signal.getsignal(signal.SIGTERM)
+        if h is raise_terminated or getattr(h, "__module__", None) == "femadh.cli":
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _pool_init():
