@@ -1927,6 +1927,10 @@ DEFECTS = [
       (("        tr.operator = None            # run: its dense operator need not outlive it",
         "        tr.operator = None            # run: its dense operator need not outlive it\n"
         "        from .estimates import complete_estimate\n        complete_estimate(res)"),)),
+    D("pace2_trials_not_deferred", "adaptive loop: its trials run without the request to "
+      "defer (every superseded trial's whole estimate solved)", "femadh/runner/adaptive.py",
+      (("            with deferring(target if estimate is True else None):",
+        "            with deferring(None):"),)),
     D("pace2_bounded_golden", "peak search's bounded minimiser: the golden section of "
       "sqrt(4.9), not sqrt(5)", "femadh/runner/peak.py",
       (("    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))",

@@ -2,18 +2,18 @@
 (femadh.runner.estimates.estimate_errors' ``defer``; that a completed estimate is the whole
 one bit for bit: tests/test_estimate_members.py)."""
 from conftest import adaptive_scene
-from femadh.runner import adaptive
+from femadh.runner import adaptive, estimates
 from femadh.runner.result import ContactResult
 
 
 def test_the_adaptive_loop_completes_the_trial_it_keeps_only():
     """A scripted loop at 1e-2: trial 1 misses (estimate 5x the target), trial 2 meets it.
-    Each trial is asked to defer by the target; the superseded trial's rest is never made,
-    the kept trial's once (its breakdown the completed one)."""
+    Each trial is run deferring by the target (estimates.deferring); the superseded trial's
+    rest is never made, the kept trial's once (its breakdown the completed one)."""
     calls, asked = [], []
 
     def fake(trial, out_dir, **kw):
-        asked.append(kw.get("defer_estimate"))
+        asked.append(estimates.deferred_target())
         k = len(asked)
         res = ContactResult(trial.name, trial, status="converged")
         res.timings["total_s"] = 0.01

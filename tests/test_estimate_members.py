@@ -41,8 +41,6 @@ def fig4_both():
     members are compared); "deferred": with reduced members as an adaptive trial whose
     request (1e-12) its estimate misses (:func:`femadh.runner.estimates.estimate_errors`,
     ``defer``)."""
-    from femadh.runner.run import run
-
     sc = _fig4_short()
     out = {}
     with pytest.MonkeyPatch.context() as mp:
@@ -51,9 +49,8 @@ def fig4_both():
             mp.setattr(estimates, "REDUCED_MEMBERS", reduced)
             out[reduced] = _run(sc)
         mp.setattr(estimates, "REDUCED_MEMBERS", True)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", MeshResolutionWarning)
-            out["deferred"] = run(sc, progress=False, figures=False, defer_estimate=1e-12)
+        with estimates.deferring(1e-12):
+            out["deferred"] = _run(sc)
     return out
 
 

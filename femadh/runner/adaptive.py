@@ -284,7 +284,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     step builds that member (capped)."""
     from ..io.progress import phase
     from ..scene import scene_id
-    from .estimates import variant
+    from .estimates import deferring, variant
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
@@ -308,9 +308,10 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.nodes} nodes)"):
             # (a trial whose judged numbers miss the target defers the rest of its
             # estimate: completed below if the loop keeps it)
-            res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
-                      operator=tr.operator, folder_id=scene_id(scene),
-                      defer_estimate=target if estimate is True else None, **mode)
+            with deferring(target if estimate is True else None):
+                res = run(trial, out_dir, figures=False, progress=progress,
+                          estimate=estimate, operator=tr.operator,
+                          folder_id=scene_id(scene), **mode)
         tr.operator = None            # run: its dense operator need not outlive it
         mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True

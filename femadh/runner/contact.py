@@ -31,8 +31,7 @@ STIFFNESS_WARNING = 0.5
 
 
 def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overwrite=False,
-                resume=False, operator=None, estimate=True, folder_id=None, resume_from=None,
-                defer_estimate=None):
+                resume=False, operator=None, estimate=True, folder_id=None, resume_from=None):
     """Solve a contact scene (called by :func:`femadh.runner.run.run`, which documents the
     arguments, inside the run's signal handling, time limit and progress display): an
     adaptive grid or an accuracy target is refined over several runs, else one run into its
@@ -51,13 +50,13 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
                                progress=progress, overwrite=overwrite, resume=resume)
     if out_dir is None:
         return _run(scene, None, progress=progress, operator=operator, estimate=estimate,
-                    run=run, defer=defer_estimate)
+                    run=run)
     from ..io.run_folder import RunFolder
 
     mode = "resume" if resume else "overwrite" if overwrite else "new"
     with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
         res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
-                   resume_from=resume_from, run=run, defer=defer_estimate)
+                   resume_from=resume_from, run=run)
         if figures and res.status in ("converged", "failed") and any(
                 len(next(iter(b.values()))) for b in res.branches.values()):
             with phase("figures"):
@@ -96,8 +95,7 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_from=None,
-         defer=None):
+def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_from=None):
     t0 = time.perf_counter()
     res = ContactResult(scene.name, scene, out_dir=None if folder is None else str(folder.path))
     from ..io.progress import note
@@ -189,7 +187,7 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
         if folder is not None and (folder.path / CHECKPOINT).exists():
             (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
         if res.status == "running":
-            _finish(scene, res, problem, sink, estimate, run, defer)
+            _finish(scene, res, problem, sink, estimate, run)
             if folder is not None and res.instrument is not None:
                 from ..io.writers import write_instrument
 
@@ -197,10 +195,10 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
     return res
 
 
-def _finish(scene, res, problem, sink, estimate, run, defer=None):
-    """Headline numbers, their error estimates and the bound guard of a finished sweep
-    (``defer``: :func:`femadh.runner.estimates.estimate_errors`')."""
-    from .estimates import estimate_errors, guard_bounds, refine_peak
+def _finish(scene, res, problem, sink, estimate, run):
+    """Headline numbers, their error estimates and the bound guard of a finished sweep."""
+    from .estimates import (deferred_target, deferring, estimate_errors, guard_bounds,
+                            refine_peak)
     from .headline import headline
 
     problem = sink.problem          # the last grid of a band that follows the edge
@@ -217,8 +215,12 @@ def _finish(scene, res, problem, sink, estimate, run, defer=None):
             res.instrument["fresh_states"] = refine_instrument(scene, res, problem, sink)
             res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
-            res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
-                                            defer=defer)
+            # an adaptive trial's estimate may defer what its loop does not judge
+            # (estimates.deferring: set around the trial's run, not its members')
+            defer = deferred_target()
+            with deferring(None):
+                res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
+                                                defer=defer)
         guard_bounds(res, problem)      # a BoundError: its kind decides the refinement
     res.timings["estimate_s"] = time.perf_counter() - t1
 

@@ -37,6 +37,8 @@ when the tail dominates) until the estimated error of the largest adhesion and o
 the deepest separation is below the target, within a budget; it says what it chose, or that
 the target cannot be met.
 """
+from contextlib import contextmanager
+import contextvars
 import math
 
 import numpy as np
@@ -175,6 +177,27 @@ def _mesh_size_ratio(scene, coarse):
 
     (s_f, n_f), (s_c, n_c) = spec_and_count(scene), spec_and_count(coarse)
     return 1.0 if s_f == s_c else math.sqrt(n_f / n_c)
+
+
+#: the accuracy the adaptive loop judges the trial being run by (:func:`deferring`)
+_DEFER = contextvars.ContextVar("femadh_defer_estimate", default=None)
+
+
+@contextmanager
+def deferring(target):
+    """Within the block, a contact run's :func:`estimate_errors` gets ``defer`` = ``target``
+    (an adaptive loop's trial: :mod:`femadh.runner.adaptive`; None: the whole estimate at
+    once). The run reads it once (:func:`deferred_target`) and runs its members without it."""
+    token = _DEFER.set(target)
+    try:
+        yield
+    finally:
+        _DEFER.reset(token)
+
+
+def deferred_target():
+    """The ``defer`` of the run being made (:func:`deferring`), or None."""
+    return _DEFER.get()
 
 
 def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):

@@ -16,8 +16,7 @@ from .. import interrupt
 
 
 def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, resume=False,
-        estimate=True, time_limit=None, resume_from=None, operator=None, folder_id=None,
-        defer_estimate=None):
+        estimate=True, time_limit=None, resume_from=None, operator=None, folder_id=None):
     """Solve a scene.
 
     Parameters
@@ -52,11 +51,6 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     folder_id : str, optional
         The scene id the output folder is claimed under (an adaptive run's trials claim it
         under the user's scene, so that --resume and --overwrite recognise it).
-    defer_estimate : float, optional
-        The accuracy an adaptive run's loop judges this trial by: where the estimate of the
-        numbers it judges misses it, the rest of the estimate waits in
-        ``result.pending_estimate`` until the loop keeps the trial
-        (:func:`femadh.runner.estimates.estimate_errors`, ``defer``). A contact scene only.
 
     Returns
     -------
@@ -99,8 +93,7 @@ def run(scene, out_dir=None, *, figures=True, progress=None, overwrite=False, re
     with blas_threads(), interrupt.interruptible(limit), display(scene.name, progress):
         return run_contact(scene, out_dir, run=run, figures=figures, progress=progress,
                            overwrite=overwrite, resume=resume, estimate=estimate,
-                           resume_from=resume_from, operator=operator, folder_id=folder_id,
-                           defer_estimate=defer_estimate)
+                           resume_from=resume_from, operator=operator, folder_id=folder_id)
 
 
 def time_limit_s(scene, given):
