@@ -391,17 +391,17 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
     from types import SimpleNamespace
 
     from .accuracy import _relative
-    from .members import ReducedMember
 
     records = []
     for label, member in members:
-        r = None
+        r = rm = None
         with _phase(f"estimate: {label}"):
-            rm = ReducedMember(scene, member, problem, sink, res, deepest=deepest)
-            hl_m, how = rm.judged()
+            hl_m, how = reduced_member(scene, member, problem, sink, res, deepest=deepest,
+                                       rest=False)
             if hl_m is None:
-                rm = None
                 r = run(member, progress=False, estimate="peak")
+            else:
+                rm, how = how, None
         _stop_if_stopped(r)
         records.append((label, member, rm, how, r))
         if r is not None and r.status != "converged":
@@ -416,7 +416,9 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
         for i, (label, member, rm, how, r) in enumerate(records):
             if rm is not None:
                 with _phase(f"estimate: {label}"):
-                    hl_m, how = (rm.hl, rm.m.solves) if judged_only else rm.rest()
+                    hl_m, how = ((rm.hl, rm.m.solves) if judged_only else
+                                 reduced_member(scene, member, problem, sink, res,
+                                                deepest=deepest, resume=rm))
                     if hl_m is None:
                         r = run(member, progress=False, estimate="peak")
                 if hl_m is not None:

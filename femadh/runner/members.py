@@ -509,9 +509,16 @@ def _zero_force_radius(m, res, snaps, branch):
     return rc
 
 
-def reduced_member(scene, member, problem, sink, res, deepest=True):
+def reduced_member(scene, member, problem, sink, res, deepest=True, *, rest=True,
+                   resume=None):
     """The member's headline numbers from the states they are read at (see the module
     docstring), or (None, why) where the member must be traced whole.
+
+    In two parts (:class:`ReducedMember`; an adaptive trial's deferred estimate,
+    :func:`femadh.runner.estimates.estimate_errors`' ``defer``): ``rest=False`` returns the
+    judged numbers and the member's :class:`ReducedMember` in place of the solve count
+    (or None and why); ``resume=`` that member then returns what the call in one part
+    would have, bit for bit.
 
     Parameters
     ----------
@@ -533,9 +540,13 @@ def reduced_member(scene, member, problem, sink, res, deepest=True):
         The member's headline {quantity: value} (the quantities the fine run has) and the
         number of corrector solves it took; or None and the reason it cannot stand in.
     """
+    if resume is not None:
+        return resume.rest()
     rm = ReducedMember(scene, member, problem, sink, res, deepest)
     hl, why = rm.judged()
-    return (hl, why) if hl is None else rm.rest()
+    if hl is None:
+        return hl, why
+    return rm.rest() if rest else (hl, rm)
 
 
 class ReducedMember:
