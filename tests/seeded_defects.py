@@ -1903,6 +1903,45 @@ DEFECTS = [
     D("pace_single_no_law", "single products: the law's stiffness left out of GMRES's operator",
       "femadh/contact/complementarity.py",
       (("            return a * (product(v) + D_I * v)", "            return a * product(v)"),)),
+    # -- an adaptive trial's estimate deferred until the loop keeps it (branch pace2,
+    #    validation/results/seeded_defects_pace2.md)
+    D("pace2_complete_judged_only", "deferred estimate: completed with the judged numbers "
+      "only (the members' folds and zero-force radii never solved)",
+      "femadh/runner/estimates.py",
+      (("        out = assemble(copy.deepcopy(parts0), *settle(False),",
+        "        out = assemble(copy.deepcopy(parts0), *settle(True),"),)),
+    D("pace2_defer_when_met", "deferred estimate: the rest deferred where the judged numbers "
+      "meet the request, made at once where they miss it", "femadh/runner/estimates.py",
+      (("    if not grid_e + tail_e > target or all(",
+        "    if grid_e + tail_e > target or all("),)),
+    D("pace2_rest_no_zero_radius", "deferred estimate: a member's rest without its zero-force "
+      "radii", "femadh/runner/members.py",
+      (("            for branch in res.branches:\n                key = f\"r_c_at_zero_force_",
+        "            for branch in ():\n                key = f\"r_c_at_zero_force_"),)),
+    D("pace2_kept_not_completed", "adaptive loop: the kept trial's deferred estimate left "
+      "partial", "femadh/runner/adaptive.py",
+      (("            complete_estimate(res)          # the kept trial's estimate made whole",
+        "            pass"),)),
+    D("pace2_superseded_completed", "adaptive loop: every trial's deferred estimate completed "
+      "(a superseded trial's rest solved)", "femadh/runner/adaptive.py",
+      (("        tr.operator = None            # run: its dense operator need not outlive it",
+        "        tr.operator = None            # run: its dense operator need not outlive it\n"
+        "        from .estimates import complete_estimate\n        complete_estimate(res)"),)),
+    D("pace2_trials_not_deferred", "adaptive loop: its trials run without the request to "
+      "defer (every superseded trial's whole estimate solved)", "femadh/runner/adaptive.py",
+      (("            with deferring(target if estimate is True else None):",
+        "            with deferring(None):"),)),
+    D("pace2_bounded_golden", "peak search's bounded minimiser: the golden section of "
+      "sqrt(4.9), not sqrt(5)", "femadh/runner/peak.py",
+      (("    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))",
+        "    golden_mean = 0.5 * (3.0 - np.sqrt(4.9))"),)),
+    D("pace2_bounded_parabola", "peak search's bounded minimiser: the parabolic step halved",
+      "femadh/runner/peak.py",
+      (("                rat = (p + 0.0) / q", "                rat = (p + 0.0) / (2 * q)"),)),
+    D("pace2_bounded_tolerance", "peak search's bounded minimiser: its first tolerance "
+      "xatol / 2, not xatol / 3", "femadh/runner/peak.py",
+      (("    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0\n    tol2 = 2.0 * tol1\n    while",
+        "    tol1 = sqrt_eps * np.abs(xf) + xatol / 2.0\n    tol2 = 2.0 * tol1\n    while"),)),
     # -- the contact solve's hot path without scipy's wrappers (branch hotpath,
     #    seeded_defects_hotpath.md)
     D("hotpath_getrs_transposed", "direct LAPACK: the LU solve of the transposed system",

@@ -25,7 +25,8 @@ PHASES = [
     ("femadh.contact.stepping", "trace_steps", "trace"),
     ("femadh.runner.estimates", "refine_peak", "peak"),
     ("femadh.runner.estimates", "estimate_errors", "estimate"),
-    ("femadh.runner.members", "reduced_member", "member"),
+    ("femadh.runner.members", "ReducedMember.judged", "member"),
+    ("femadh.runner.members", "ReducedMember.rest", "member"),
     ("femadh.runner.members", "deepest_locked", "locked"),
     ("femadh.runner.members", "_peak", "m.peak"),
     ("femadh.runner.members", "_folds", "m.folds"),
@@ -148,7 +149,7 @@ def run(scene_name, accuracy, out=None):
     with tempfile.TemporaryDirectory() as tmp:
         path = scene_at_accuracy(scene_name, accuracy, tmp)
         t0 = time.perf_counter()
-        res = femadh_run(str(path), out and str(Path(tmp) / "out"), figures=False)
+        res = femadh_run(str(path), str(Path(tmp) / "out") if out else None, figures=False)
         return res, time.perf_counter() - t0
 
 

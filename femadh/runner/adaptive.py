@@ -284,7 +284,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     step builds that member (capped)."""
     from ..io.progress import phase
     from ..scene import scene_id
-    from .estimates import variant
+    from .estimates import deferring, variant
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
@@ -306,8 +306,12 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         trial = variant(scene, grid=tr.grid(), radius=tr.family.radius)
         ahead["trial"] = trial
         with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.nodes} nodes)"):
-            res = run(trial, out_dir, figures=False, progress=progress, estimate=estimate,
-                      operator=tr.operator, folder_id=scene_id(scene), **mode)
+            # (a trial whose judged numbers miss the target defers the rest of its
+            # estimate: completed below if the loop keeps it)
+            with deferring(target if estimate is True else None):
+                res = run(trial, out_dir, figures=False, progress=progress,
+                          estimate=estimate, operator=tr.operator,
+                          folder_id=scene_id(scene), **mode)
         tr.operator = None            # run: its dense operator need not outlive it
         mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
@@ -354,6 +358,11 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         failure = (_too_many_nodes(ahead["refused"]) if out.stop == "nodes"
                    else ahead["failure"])
     res = out.result if out is not None else None
+    if res is not None:
+        from .estimates import complete_estimate
+
+        with phase("estimate"):
+            complete_estimate(res)          # the kept trial's estimate made whole
     family = out.setting.family if out is not None else family
     met = bool(out is not None and out.met and estimate is True)
     if res is None:

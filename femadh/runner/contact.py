@@ -197,7 +197,8 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
 
 def _finish(scene, res, problem, sink, estimate, run):
     """Headline numbers, their error estimates and the bound guard of a finished sweep."""
-    from .estimates import estimate_errors, guard_bounds, refine_peak
+    from .estimates import (deferred_target, deferring, estimate_errors, guard_bounds,
+                            refine_peak)
     from .headline import headline
 
     problem = sink.problem          # the last grid of a band that follows the edge
@@ -214,7 +215,12 @@ def _finish(scene, res, problem, sink, estimate, run):
             res.instrument["fresh_states"] = refine_instrument(scene, res, problem, sink)
             res.timings["instrument_s"] = time.perf_counter() - t2
         if estimate is True:
-            res.estimates = estimate_errors(scene, res, problem, sink, half, run=run)
+            # an adaptive trial's estimate may defer what its loop does not judge
+            # (estimates.deferring: set around the trial's run, not its members')
+            defer = deferred_target()
+            with deferring(None):
+                res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
+                                                defer=defer)
         guard_bounds(res, problem)      # a BoundError: its kind decides the refinement
     res.timings["estimate_s"] = time.perf_counter() - t1
 

@@ -37,6 +37,8 @@ when the tail dominates) until the estimated error of the largest adhesion and o
 the deepest separation is below the target, within a budget; it says what it chose, or that
 the target cannot be met.
 """
+from contextlib import contextmanager
+import contextvars
 import math
 
 import numpy as np
@@ -68,6 +70,13 @@ REDUCED_MEMBERS = True
 #: family's reduced members do not solve that state (its grid part would be replaced: one
 #: solve less per member); False: they solve it anyway (as before)
 LOCKED_DEEPEST_ONLY = True
+#: a refine loop's trial (:func:`estimate_errors` with ``defer``: the adaptive grid's) solves
+#: its reduced members' folds and zero-force radii only when it is kept: where the judged
+#: numbers' estimate (the largest adhesion, the forces at the deepest separation:
+#: :func:`femadh.runner.accuracy._relative`) misses the request, the loop refines and that
+#: trial is replaced - Fig 4 at 1e-3's first trial, 0.14-0.17 s of its members' work. The
+#: kept trial's estimate is the same bit for bit. False: every trial's estimate whole
+DEFER_UNJUDGED = True
 
 
 def variant(scene, **changes):
@@ -170,11 +179,42 @@ def _mesh_size_ratio(scene, coarse):
     return 1.0 if s_f == s_c else math.sqrt(n_f / n_c)
 
 
-def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
+#: the accuracy the adaptive loop judges the trial being run by (:func:`deferring`)
+_DEFER = contextvars.ContextVar("femadh_defer_estimate", default=None)
+
+
+@contextmanager
+def deferring(target):
+    """Within the block, a contact run's :func:`estimate_errors` gets ``defer`` = ``target``
+    (an adaptive loop's trial: :mod:`femadh.runner.adaptive`; None: the whole estimate at
+    once). The run reads it once (:func:`deferred_target`) and runs its members without it."""
+    token = _DEFER.set(target)
+    try:
+        yield
+    finally:
+        _DEFER.reset(token)
+
+
+def deferred_target():
+    """The ``defer`` of the run being made (:func:`deferring`), or None."""
+    return _DEFER.get()
+
+
+def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
     """Fill ``res.headline`` with ``<quantity>_error`` entries and return the breakdown
     {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
     bracket (:func:`refine_peak`); ``run`` runs the coarser members
-    (:func:`femadh.runner.run.run`)."""
+    (:func:`femadh.runner.run.run`).
+
+    ``defer``: the relative accuracy a refine loop judges this run by
+    (:func:`femadh.runner.accuracy._relative`: the largest adhesion and the forces at the
+    deepest separation), or None. With it (and DEFER_UNJUDGED), the reduced members first
+    solve only what those numbers need (:meth:`~femadh.runner.members.ReducedMember.judged`);
+    where their estimate already misses ``defer``, the loop refines or fails, and the rest
+    (the members' folds, hysteresis and zero-force radii) is left to
+    ``res.pending_estimate``, which :func:`complete_estimate` runs for the run the loop
+    keeps: the same numbers and breakdown, bit for bit, as without ``defer``. Where the
+    estimate meets ``defer`` the rest is done at once."""
     import time
     import warnings
 
@@ -240,19 +280,88 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             res.warnings.append(f"{NOTE}the {other_run} did not converge "
                                 f"({_short(g.error)}); the FE mesh part of the error is not "
                                 "estimated: the stated errors lack it")
-    levels = []
     ratio, members, ratio2 = coarser_members(scene, problem, green)
     # the forces at the deepest separation: members placed by its contact edge (the same
     # fraction of a spacing as the fine grid's), where they can be; the family's reduced
     # members then skip that state (its grid part would be replaced)
     locked = deepest_locked(scene, problem, sink, ratio, variant) \
         if REDUCED_MEMBERS and members else None
+    deepest = locked is None or not LOCKED_DEEPEST_ONLY
+
+    def assemble(parts, levels, solved, since=t0):
+        """The breakdown from the members' headline ``levels`` (the parts above, the grid
+        part, the folds' resolution, the tail, the tolerance), ``res.grid``'s member record
+        and the headline's ``_error`` entries."""
+        res.grid["member_solves"] = solved
+        res.grid["member_ratio"] = ratio
+        if ratio2 is not None:
+            res.grid["member_ratio2"] = ratio2
+        res.grid["members"] = [lb for lb, _ in members][:len(levels)]
+        if scene.grid is not None:
+            res.grid["member_spacings_m"] = [m.grid["spacing"]
+                                             for _, m in members][:len(levels)]
+        if levels:
+            for k, v in discretisation(fine_hl, levels[0],
+                                       levels[1] if len(levels) > 1 else None,
+                                       ratio=ratio, ratio2=ratio2).items():
+                parts.setdefault(k, {})["grid"] = v
+        if locked is not None and levels:
+            (h1, h2), (lv1, lv2) = locked
+            h0 = float(problem.grid.nodes[1])
+            for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
+                                       ratio=h1 / h0, ratio2=h2 / h1).items():
+                parts.setdefault(k, {})["grid"] = v
+            if scene.grid is not None:
+                res.grid["deepest_member_spacings_m"] = [h1, h2]
+                res.grid["deepest_members"] = [lv1, lv2]
+            else:
+                # a uniform grid's record is the scene's N, state-free: the placed members
+                # follow the deepest state (a resume re-solves it to the tolerance), so only
+                # that they were used is recorded
+                res.grid["deepest_members_placed"] = True
+        # folds: located to the jump's resolution
+        for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
+            js = [j for j in res.jumps if j["branch"] == branch]
+            if js and name in hl:
+                parts.setdefault(name, {})["resolution"] = float(js[0 if branch == "approach"
+                                                                    else -1]["resolution_m"])
+        # truncation at the analysis radius and the solver tolerance, for the forces
+        for name, d_key in (("max_adhesion_N", "d_at_max_adhesion_m"),
+                            ("F_ex_deepest_N", "d_deepest_m"),
+                            ("F_LJ_deepest_N", "d_deepest_m")):
+            if name in hl and d_key in hl:
+                # the missing attraction beyond a: the exact value exceeds the truncated one
+                parts.setdefault(name, {})["tail"] = tail_force(problem, hl[d_key])
+                parts[name]["tolerance"] = float(problem.areas.sum() * scene.tolerance
+                                                 * np.max(np.abs(problem.dpressure(
+                                                     np.full(1, _contact_gap(problem))))))
+        # the instrument's readout between the computed states (femadh.instrument.readout)
+        if res.instrument is not None:
+            for name, v in res.instrument["resolution"].items():
+                if f"instrument_{name}" in hl:
+                    parts.setdefault(f"instrument_{name}", {})["resolution"] = float(v)
+        parts = {k: v for k, v in parts.items() if k in QUANTITIES and k in hl}
+        for k, comp in parts.items():
+            # the parts are signed estimates of Q_exact - Q (grid, fe_mesh, tail) or bounds
+            # (resolution, tolerance); they are added in magnitude: the grid and tail
+            # estimates can cancel where the true errors do not, so the total is an upper
+            # estimate
+            comp["total"] = float(sum(abs(v) for v in comp.values()))
+            hl[f"{k}_error"] = comp["total"]
+        # the error estimate alone (the members, the tail, ...): estimate_s also holds the
+        # peak search, which locates the headline's largest adhesion itself
+        res.timings["error_estimate_s"] = time.perf_counter() - since
+        return parts
+
+    if defer is not None and DEFER_UNJUDGED and REDUCED_MEMBERS and members:
+        return _deferred(scene, res, problem, sink, members, deepest, defer, parts, run,
+                         assemble)
+    levels = []
     solved = []
     for i, (label, member) in enumerate(members):
         with _phase(f"estimate: {label}"):
             # the member solved only where the headline numbers are read, from the fine
             # run's states (femadh.runner.members); traced whole where it cannot stand in
-            deepest = locked is None or not LOCKED_DEEPEST_ONLY
             hl_m, how = (reduced_member(scene, member, problem, sink, res, deepest=deepest)
                          if REDUCED_MEMBERS else (None, "reduced members off"))
             if hl_m is not None:
@@ -268,62 +377,115 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run):
             res.grid["failed_member"] = {"member": label, "error": r.error}
             break
         levels.append(dict(r.headline))
-    res.grid["member_solves"] = solved
-    res.grid["member_ratio"] = ratio
-    if ratio2 is not None:
-        res.grid["member_ratio2"] = ratio2
-    res.grid["members"] = [lb for lb, _ in members][:len(levels)]
-    if scene.grid is not None:
-        res.grid["member_spacings_m"] = [m.grid["spacing"] for _, m in members][:len(levels)]
-    if levels:
-        for k, v in discretisation(fine_hl, levels[0], levels[1] if len(levels) > 1 else None,
-                                   ratio=ratio, ratio2=ratio2).items():
-            parts.setdefault(k, {})["grid"] = v
-    if locked is not None and levels:
-        (h1, h2), (lv1, lv2) = locked
-        h0 = float(problem.grid.nodes[1])
-        for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
-                                   ratio=h1 / h0, ratio2=h2 / h1).items():
-            parts.setdefault(k, {})["grid"] = v
-        if scene.grid is not None:
-            res.grid["deepest_member_spacings_m"] = [h1, h2]
-            res.grid["deepest_members"] = [lv1, lv2]
-        else:
-            # a uniform grid's record is the scene's N, state-free: the placed members follow
-            # the deepest state (a resume re-solves it to the tolerance), so only that they
-            # were used is recorded
-            res.grid["deepest_members_placed"] = True
-    # folds: located to the jump's resolution
-    for name, branch in (("jump_in_d_m", "approach"), ("jump_out_d_m", "retract")):
-        js = [j for j in res.jumps if j["branch"] == branch]
-        if js and name in hl:
-            parts.setdefault(name, {})["resolution"] = float(js[0 if branch == "approach"
-                                                                else -1]["resolution_m"])
-    # truncation at the analysis radius and the solver tolerance, for the forces
-    for name, d_key in (("max_adhesion_N", "d_at_max_adhesion_m"),
-                        ("F_ex_deepest_N", "d_deepest_m"), ("F_LJ_deepest_N", "d_deepest_m")):
-        if name in hl and d_key in hl:
-            # the missing attraction beyond a: the exact value exceeds the truncated one
-            parts.setdefault(name, {})["tail"] = tail_force(problem, hl[d_key])
-            parts[name]["tolerance"] = float(problem.areas.sum() * scene.tolerance
-                                             * np.max(np.abs(problem.dpressure(
-                                                 np.full(1, _contact_gap(problem))))))
-    # the instrument's readout between the computed states (femadh.instrument.readout)
-    if res.instrument is not None:
-        for name, v in res.instrument["resolution"].items():
-            if f"instrument_{name}" in hl:
-                parts.setdefault(f"instrument_{name}", {})["resolution"] = float(v)
-    parts = {k: v for k, v in parts.items() if k in QUANTITIES and k in hl}
-    for k, comp in parts.items():
-        # the parts are signed estimates of Q_exact - Q (grid, fe_mesh, tail) or bounds
-        # (resolution, tolerance); they are added in magnitude: the grid and tail estimates
-        # can cancel where the true errors do not, so the total is an upper estimate
-        comp["total"] = float(sum(abs(v) for v in comp.values()))
-        hl[f"{k}_error"] = comp["total"]
-    # the error estimate alone (the members, the tail, ...): estimate_s also holds the peak
-    # search, which locates the headline's largest adhesion itself
-    res.timings["error_estimate_s"] = time.perf_counter() - t0
-    return parts
+    return assemble(parts, levels, solved)
+
+
+def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, assemble):
+    """:func:`estimate_errors`' members with ``defer`` = ``target``: each member's judged
+    numbers first (:meth:`~femadh.runner.members.ReducedMember.judged`; traced whole where it
+    cannot stand in, as without ``defer``), the breakdown of those, and the rest where the
+    judged estimate meets ``target``; else ``res.pending_estimate`` holds the rest (see
+    :func:`complete_estimate`). Returns the breakdown (the partial one where deferred)."""
+    import copy
+    import time
+    from types import SimpleNamespace
+
+    from .accuracy import _relative
+
+    records = []
+    for label, member in members:
+        r = rm = None
+        with _phase(f"estimate: {label}"):
+            hl_m, how = reduced_member(scene, member, problem, sink, res, deepest=deepest,
+                                       rest=False)
+            if hl_m is None:
+                r = run(member, progress=False, estimate="peak")
+            else:
+                rm, how = how, None
+        _stop_if_stopped(r)
+        records.append((label, member, rm, how, r))
+        if r is not None and r.status != "converged":
+            break                       # as without defer: no member after a failed one
+
+    def settle(judged_only):
+        """(levels, solved) as :func:`estimate_errors`' loop makes them, in its order: a
+        reduced member's rest (unless ``judged_only``), else its whole trace; a failed whole
+        trace ends the members (its note only with the rest: the judged-only breakdown
+        is a refined trial's, replaced)."""
+        levels, solved = [], []
+        for i, (label, member, rm, how, r) in enumerate(records):
+            if rm is not None:
+                with _phase(f"estimate: {label}"):
+                    hl_m, how = ((rm.hl, rm.m.solves) if judged_only else
+                                 reduced_member(scene, member, problem, sink, res,
+                                                deepest=deepest, resume=rm))
+                    if hl_m is None:
+                        r = run(member, progress=False, estimate="peak")
+                if hl_m is not None:
+                    levels.append(hl_m)
+                    solved.append({"member": label, "reduced": True, "solves": how})
+                    continue
+                _stop_if_stopped(r)
+            solved.append({"member": label, "reduced": False, "why": how})
+            if r.status != "converged":
+                if not judged_only:
+                    res.warnings.append(member_note(label, r.error,
+                                                    _fine_label(scene, problem),
+                                                    [lb for lb, _ in members[:i]]))
+                    res.grid["failed_member"] = {"member": label, "error": r.error}
+                break
+            levels.append(dict(r.headline))
+        return levels, solved
+
+    # what the rest starts from, as estimate_errors' loop would: the parts before the
+    # members, the headline without its errors, the grid record without the members'
+    start = copy.deepcopy(parts), dict(res.headline), dict(res.grid)
+
+    def complete(spent=None):
+        """The whole breakdown (the headline's and the grid record's entries replaced);
+        ``spent``: the seconds the estimate took before (None: completed at once)."""
+        t1 = time.perf_counter()
+        parts0, hl0, grid0 = start
+        res.headline.clear()
+        res.headline.update(hl0)
+        res.grid.clear()
+        res.grid.update(grid0)
+        out = assemble(copy.deepcopy(parts0), *settle(False),
+                       **({} if spent is None else {"since": t1}))
+        if spent is not None:
+            res.timings["error_estimate_s"] += spent
+        return out
+
+    partial = assemble(copy.deepcopy(parts), *settle(True))
+    grid_e, tail_e = _relative(SimpleNamespace(headline=res.headline, estimates=partial))
+    if not grid_e + tail_e > target or all(rm is None for _, _, rm, _, _ in records):
+        # met (or nothing to defer): the run may be kept, its estimate is made whole now
+        return complete()
+    spent = res.timings["error_estimate_s"]
+    res.pending_estimate = lambda: complete(spent)
+    return partial
+
+
+def complete_estimate(res):
+    """Complete ``res``'s deferred estimate (:func:`estimate_errors` with ``defer``), if it
+    has one: the run a refine loop keeps (its last) gets the estimate it would have had
+    without ``defer``, bit for bit. A stop (signal, time limit) or a solver failure while
+    completing ends ``res`` as the run's lifecycle would (:mod:`femadh.runner.lifecycle`).
+    Returns ``res``."""
+    pending = getattr(res, "pending_estimate", None)
+    if pending is None:
+        return res
+    res.pending_estimate = None
+    from ..errors import ConvergenceError, Interrupted
+    from ..estimate.guards import failure_kind
+
+    try:
+        res.estimates = pending()
+    except Interrupted as exc:
+        res.stop(exc)
+    except (ConvergenceError, GuardError) as exc:
+        res.fail(str(exc), failure_kind(exc))
+    return res
 
 
 def cohesive_edge(problem):

@@ -509,9 +509,16 @@ def _zero_force_radius(m, res, snaps, branch):
     return rc
 
 
-def reduced_member(scene, member, problem, sink, res, deepest=True):
+def reduced_member(scene, member, problem, sink, res, deepest=True, *, rest=True,
+                   resume=None):
     """The member's headline numbers from the states they are read at (see the module
     docstring), or (None, why) where the member must be traced whole.
+
+    In two parts (:class:`ReducedMember`; an adaptive trial's deferred estimate,
+    :func:`femadh.runner.estimates.estimate_errors`' ``defer``): ``rest=False`` returns the
+    judged numbers and the member's :class:`ReducedMember` in place of the solve count
+    (or None and why); ``resume=`` that member then returns what the call in one part
+    would have, bit for bit.
 
     Parameters
     ----------
@@ -533,48 +540,93 @@ def reduced_member(scene, member, problem, sink, res, deepest=True):
         The member's headline {quantity: value} (the quantities the fine run has) and the
         number of corrector solves it took; or None and the reason it cannot stand in.
     """
-    from ..errors import FemadhError
-    from ..scene import build_problem
+    if resume is not None:
+        return resume.rest()
+    rm = ReducedMember(scene, member, problem, sink, res, deepest)
+    hl, why = rm.judged()
+    if hl is None:
+        return hl, why
+    return rm.rest() if rest else (hl, rm)
 
-    why = eligible(scene, problem, sink)
-    if why:
-        return None, why
-    snaps = sink.committed
-    try:
-        m = _Member(member, problem, member, build_problem(member))
-        if m.problem.surface_force_stiffness()[0] >= TRAPPING_LIMIT:
-            # a law softening beyond a node's own stiffness: nodes snap on their own and the
-            # member's states depend on its path, which no state of the fine run shows
-            return None, "a lattice-trapped member (traced whole)"
-        hl = {}
-        fine = res.headline
-        if deepest and ("F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine):
-            from ..contact.forces import state_forces
 
-            st = m.state("approach", snaps["approach"], len(snaps["approach"]) - 1)
-            f_lj, _, f_ex = state_forces(m.problem, st)
-            hl.update(d_deepest_m=float(st.d), F_LJ_deepest_N=float(f_lj),
-                      F_ex_deepest_N=float(f_ex))
-        if "max_adhesion_N" in fine and sink.peak is not None:
-            hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = _peak(
-                m, sink, snaps, fine.get("d_at_max_adhesion_m"))
-        if res.jumps:
-            folds = _folds(m, res, sink, snaps)
-            ins = [d for b, d, _ in folds if b == "approach"]
-            outs = [d for b, d, _ in folds if b == "retract"]
-            if ins:
-                hl["jump_in_d_m"] = float(ins[0])
-            if outs:
-                hl["jump_out_d_m"] = float(outs[-1])
-            if "hysteresis_J" in fine:
-                hl["hysteresis_J"] = float(sum(e for _, _, e in folds))
-        for branch in res.branches:
-            key = f"r_c_at_zero_force_{branch}_m"
-            if math.isfinite(fine.get(key, math.nan)):
-                hl[key] = _zero_force_radius(m, res, snaps, branch)
-    except (_NotReduced, FemadhError) as exc:
-        return None, str(exc)
-    return hl, m.solves
+class ReducedMember:
+    """:func:`reduced_member` in two parts, on one member problem and one cache of its
+    states: :meth:`judged`, the numbers an accuracy loop judges a trial by (the forces at
+    the deepest separation, the largest adhesion and where it is:
+    :func:`femadh.runner.accuracy._relative`), then :meth:`rest`, the folds, the hysteresis
+    and the contact radii at zero force. :meth:`rest` continues on the same member problem
+    and state cache whenever it is called, so the two parts give the numbers of
+    :func:`reduced_member` bit for bit (each member state's Newton start - the carried state,
+    the factorisation of its nearest cached neighbour - is the same); an accuracy loop calls
+    it only for the trial it keeps (:data:`femadh.runner.estimates.DEFER_UNJUDGED`).
+
+    Parameters are :func:`reduced_member`'s.
+    """
+
+    def __init__(self, scene, member, problem, sink, res, deepest=True):
+        self.scene, self.member, self.problem = scene, member, problem
+        self.sink, self.res, self.deepest = sink, res, deepest
+        self.m = self.hl = None
+
+    def judged(self):
+        """(the member's deepest-state forces and largest adhesion as a headline dict, None)
+        or (None, why it must be traced whole)."""
+        from ..errors import FemadhError
+        from ..scene import build_problem
+
+        why = eligible(self.scene, self.problem, self.sink)
+        if why:
+            return None, why
+        snaps, sink, fine = self.sink.committed, self.sink, self.res.headline
+        try:
+            m = self.m = _Member(self.member, self.problem, self.member,
+                                 build_problem(self.member))
+            if m.problem.surface_force_stiffness()[0] >= TRAPPING_LIMIT:
+                # a law softening beyond a node's own stiffness: nodes snap on their own and
+                # the member's states depend on its path, which no state of the fine run shows
+                return None, "a lattice-trapped member (traced whole)"
+            hl = {}
+            if self.deepest and ("F_LJ_deepest_N" in fine or "F_ex_deepest_N" in fine):
+                from ..contact.forces import state_forces
+
+                st = m.state("approach", snaps["approach"], len(snaps["approach"]) - 1)
+                f_lj, _, f_ex = state_forces(m.problem, st)
+                hl.update(d_deepest_m=float(st.d), F_LJ_deepest_N=float(f_lj),
+                          F_ex_deepest_N=float(f_ex))
+            if "max_adhesion_N" in fine and sink.peak is not None:
+                hl["max_adhesion_N"], hl["d_at_max_adhesion_m"] = _peak(
+                    m, sink, snaps, fine.get("d_at_max_adhesion_m"))
+        except (_NotReduced, FemadhError) as exc:
+            return None, str(exc)
+        self.hl = hl
+        return hl, None
+
+    def rest(self):
+        """(the member's whole headline dict, its corrector solves) after :meth:`judged`
+        succeeded: its folds, hysteresis and contact radii at zero force added; or (None,
+        why) where it must be traced whole."""
+        from ..errors import FemadhError
+
+        m, res, sink, hl = self.m, self.res, self.sink, dict(self.hl)
+        snaps, fine = sink.committed, res.headline
+        try:
+            if res.jumps:
+                folds = _folds(m, res, sink, snaps)
+                ins = [d for b, d, _ in folds if b == "approach"]
+                outs = [d for b, d, _ in folds if b == "retract"]
+                if ins:
+                    hl["jump_in_d_m"] = float(ins[0])
+                if outs:
+                    hl["jump_out_d_m"] = float(outs[-1])
+                if "hysteresis_J" in fine:
+                    hl["hysteresis_J"] = float(sum(e for _, _, e in folds))
+            for branch in res.branches:
+                key = f"r_c_at_zero_force_{branch}_m"
+                if math.isfinite(fine.get(key, math.nan)):
+                    hl[key] = _zero_force_radius(m, res, snaps, branch)
+        except (_NotReduced, FemadhError) as exc:
+            return None, str(exc)
+        return hl, m.solves
 
 
 #: fewest band spacings between the centre and the contact edge of a member placed by the
