@@ -1931,17 +1931,6 @@ DEFECTS = [
       "defer (every superseded trial's whole estimate solved)", "femadh/runner/adaptive.py",
       (("            with deferring(target if estimate is True else None):",
         "            with deferring(None):"),)),
-    D("pace2_bounded_golden", "peak search's bounded minimiser: the golden section of "
-      "sqrt(4.9), not sqrt(5)", "femadh/runner/peak.py",
-      (("    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))",
-        "    golden_mean = 0.5 * (3.0 - np.sqrt(4.9))"),)),
-    D("pace2_bounded_parabola", "peak search's bounded minimiser: the parabolic step halved",
-      "femadh/runner/peak.py",
-      (("                rat = (p + 0.0) / q", "                rat = (p + 0.0) / (2 * q)"),)),
-    D("pace2_bounded_tolerance", "peak search's bounded minimiser: its first tolerance "
-      "xatol / 2, not xatol / 3", "femadh/runner/peak.py",
-      (("    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0\n    tol2 = 2.0 * tol1\n    while",
-        "    tol1 = sqrt_eps * np.abs(xf) + xatol / 2.0\n    tol2 = 2.0 * tol1\n    while"),)),
     # -- the contact solve's hot path without scipy's wrappers (branch hotpath,
     #    seeded_defects_hotpath.md)
     D("hotpath_getrs_transposed", "direct LAPACK: the LU solve of the transposed system",

@@ -1,6 +1,4 @@
-"""The corrector's Krylov products in single precision (complementarity.KRYLOV_SINGLE), and
-the peak search's bounded minimiser without scipy.optimize's package import
-(femadh.runner.peak.bounded_minimum).
+"""The corrector's Krylov products in single precision (complementarity.KRYLOV_SINGLE).
 
 GMRES's operator diag(area)(K + diag P')_II takes K_II v from a float32 copy of K; the
 residual of eq (6)/(10) that convergence is declared on stays in double. Judged against the
@@ -78,48 +76,3 @@ def test_the_single_copy_follows_the_problems_stiffness(state, monkeypatch):
     monkeypatch.setattr(p, "K", 2.0 * p.K)
     exact = p.K[m:, m:] @ v
     assert np.linalg.norm(cm._krylov_product(p, m)(v) - exact) <= 1e-6 * np.linalg.norm(exact)
-
-
-def _evaluated(search, func):
-    """The points (bit patterns) a search evaluates ``func`` at, in order."""
-    seen = []
-
-    def f(x):
-        seen.append(np.float64(x).tobytes() + bytes(type(x).__name__, "ascii"))
-        return func(x)
-    search(f)
-    return seen
-
-
-@pytest.mark.parametrize("func, lo, hi, xatol, maxiter", [
-    # a smooth peak off-centre (parabolic steps), tolerance as the peak search's
-    (lambda x: -(1.0 - ((x - 0.83e-9) / 0.2e-9) ** 2), 0.7e-9, 0.9e-9, 0.2e-9 / 1024, 40),
-    # a kink (F_ex(d) at a node's release: golden sections), the search's budget of 40
-    (lambda x: abs(x - 1.234e-9) * 1e-3 - 1e-5, 1.1e-9, 1.3e-9, 1e-18, 40),
-    # flat (a search whose fresh states all fail: -f_best everywhere), the bounds' edges
-    (lambda x: -1e-4, -1e-9, -0.8e-9, 1e-13, 40),
-    (lambda x: x * x, 0.0, 3.0, 1e-5, 500),
-    # a tolerance of half the bracket: the minimum step (tol1) decides the steps
-    (lambda x: (x - 0.3) ** 2, 0.0, 1.0, 0.5, 40),
-])
-def test_bounded_minimum_evaluates_scipys_points_bit_for_bit(func, lo, hi, xatol, maxiter):
-    """peak.bounded_minimum evaluates the same points, bit for bit and of the same type
-    (numpy float64), in the same order as scipy.optimize.minimize_scalar(method="bounded")
-    with the same xatol and maxiter - so every peak search solves the same fresh states -
-    and ends on the same minimum and count."""
-    from scipy import optimize
-
-    from femadh.runner.peak import bounded_minimum
-
-    out = {}
-
-    def ours(f):
-        out["ours"] = bounded_minimum(f, lo, hi, xatol, maxiter)
-
-    def theirs(f):
-        out["scipy"] = optimize.minimize_scalar(f, bounds=(lo, hi), method="bounded",
-                                                options={"xatol": xatol, "maxiter": maxiter})
-    a, b = _evaluated(ours, func), _evaluated(theirs, func)
-    assert a == b and len(a) >= 2
-    x, fx, num = out["ours"]
-    assert (x, fx, num) == (out["scipy"].x, out["scipy"].fun, out["scipy"].nfev)

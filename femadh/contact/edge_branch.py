@@ -35,6 +35,7 @@ import functools
 import math
 
 import numpy as np
+from scipy import optimize
 from scipy.linalg import lapack
 
 from ..errors import ConvergenceError
@@ -585,10 +586,6 @@ class BranchTrace:
                 st.dd_dc = self.branch.slope(st)
             cache[c] = st
             return st.dd_dc
-        # (imported here: scipy.optimize's package import costs ~90 ms of every run that
-        # imports this module, the route's decision included, and only a fold needs it)
-        from scipy import optimize
-
         c = optimize.brentq(slope, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
         return cache.get(c) or self.at(c)
 
@@ -600,8 +597,6 @@ class BranchTrace:
             st = self.at(c)
             cache[c] = st
             return st.d - d
-        from scipy import optimize
-
         c = optimize.brentq(f, lo, hi, xtol=C_XTOL * hi, rtol=4 * np.finfo(float).eps)
         return cache.get(c) or self.at(c)
 

@@ -10,6 +10,7 @@ reduced members (:mod:`femadh.runner.members`) and the instrument
 import math
 
 import numpy as np
+from scipy import optimize
 
 
 def state_between(problem, a, b, d, scene, reuse=False, start=None):
@@ -137,93 +138,10 @@ def peak_adhesion(problem, prev, best, nxt, scene, within=None, reuse=False, rec
             if found[top] > f_best and min(top - lo, hi - top) <= edge_stop * (hi - lo):
                 raise WindowMiss
         return -found[d]
-    bounded_minimum(neg, lo, hi, xatol, 40)
+    optimize.minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                             options={"xatol": xatol, "maxiter": 40})
     F, d = max([(f_best, best.d)] + [(v, x) for x, v in found.items()])
     return float(F), float(d), xatol
-
-
-def bounded_minimum(func, lo, hi, xatol, maxiter):
-    """Minimise ``func`` on [lo, hi] by Brent's bounded search (golden sections and parabolic
-    steps): SciPy's ``minimize_scalar(func, bounds=(lo, hi), method="bounded",
-    options={"xatol": xatol, "maxiter": maxiter})`` (its ``_minimize_scalar_bounded``,
-    fminbound, from Forsythe, Malcolm & Moler, "Computer Methods for Mathematical
-    Computations"), the same operations in the same order on the same types - so the same
-    points are evaluated, bit for bit (tests/test_pace.py) - without importing
-    ``scipy.optimize``, whose package import (linprog, HiGHS, shgo, ...) cost ~90 ms of every
-    ``femadh run`` that searches a peak (validation/results/pace.md). The callers read the
-    states ``func`` records; returns (x, f(x)) of the best point, the number of evaluations.
-    """
-    if not (np.size(lo) == 1 and np.isfinite(lo) and np.size(hi) == 1 and np.isfinite(hi)):
-        raise ValueError("Optimization bounds must be finite scalars.")
-    if lo > hi:
-        raise ValueError("The lower bound exceeds the upper bound.")
-    sqrt_eps = np.sqrt(2.2e-16)
-    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
-    a, b = lo, hi
-    fulc = a + golden_mean * (b - a)
-    nfc, xf = fulc, fulc
-    rat = e = 0.0
-    x = xf
-    fx = func(x)
-    num = 1
-    ffulc = fnfc = fx
-    xm = 0.5 * (a + b)
-    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
-    tol2 = 2.0 * tol1
-    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
-        golden = 1
-        # a parabola through the three best points
-        if np.abs(e) > tol1:
-            golden = 0
-            r = (xf - nfc) * (fx - ffulc)
-            q = (xf - fulc) * (fx - fnfc)
-            p = (xf - fulc) * q - (xf - nfc) * r
-            q = 2.0 * (q - r)
-            if q > 0.0:
-                p = -p
-            q = np.abs(q)
-            r = e
-            e = rat
-            if ((np.abs(p) < np.abs(0.5 * q * r)) and (p > q * (a - xf))
-                    and (p < q * (b - xf))):
-                rat = (p + 0.0) / q
-                x = xf + rat
-                if ((x - a) < tol2) or ((b - x) < tol2):
-                    si = np.sign(xm - xf) + ((xm - xf) == 0)
-                    rat = tol1 * si
-            else:
-                golden = 1
-        if golden:              # a golden-section step
-            e = a - xf if xf >= xm else b - xf
-            rat = golden_mean * e
-        si = np.sign(rat) + (rat == 0)
-        x = xf + si * np.maximum(np.abs(rat), tol1)
-        fu = func(x)
-        num += 1
-        if fu <= fx:
-            if x >= xf:
-                a = xf
-            else:
-                b = xf
-            fulc, ffulc = nfc, fnfc
-            nfc, fnfc = xf, fx
-            xf, fx = x, fu
-        else:
-            if x < xf:
-                a = x
-            else:
-                b = x
-            if (fu <= fnfc) or (nfc == xf):
-                fulc, ffulc = nfc, fnfc
-                nfc, fnfc = x, fu
-            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
-                fulc, ffulc = x, fu
-        xm = 0.5 * (a + b)
-        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
-        tol2 = 2.0 * tol1
-        if num >= maxiter:
-            break
-    return xf, fx, num
 
 
 #: fresh states a peak search starts Newton from once it has them (False: every evaluation
