@@ -2,8 +2,6 @@
 fingerprint of the code that computes: a study reuses a point's record only when it was
 computed by the same code (a version string alone does not change while the code does)."""
 from functools import lru_cache
-import hashlib
-from pathlib import Path
 
 __version__ = "0.2.0"
 
@@ -11,7 +9,12 @@ __version__ = "0.2.0"
 @lru_cache(maxsize=1)
 def code_id():
     """``"<version>+<12 hex>"``: the version and a SHA-256 of every .py file of the package
-    (relative path and bytes, in sorted order; ~10 ms, once per process)."""
+    (relative path and bytes, in sorted order; ~10 ms, once per process). Its imports are
+    here, not at the top: ``import femadh`` runs before the program's start-up signal
+    handlers are in place (femadh.cli), and hashlib's ~2 ms were part of that window."""
+    import hashlib
+    from pathlib import Path
+
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
