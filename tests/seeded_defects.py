@@ -1157,7 +1157,7 @@ DEFECTS = [
       "femadh/estimate/richardson.py",
       (("(ratio**p - 1) / (ratio**p * (ratio2**p - 1)) if uneven", "ratio2**-p if uneven"),)),
     D("relative_nan_met", "accuracy: a NaN error part dropped by max() (an unknown error "
-      "called met)", "femadh/runner/accuracy.py",
+      "called met)", "femadh/runner/estimates.py",
       (("        if not all(math.isfinite(comp.get(part, 0.0)) for part in (\"total\", \"tail\")):",
         "        if False:"),)),
     D("headline_scan_nodal", "headline: the contact-gap scan read as a nodal field",

@@ -10,6 +10,7 @@ import math
 from ..scene import scene_id
 from ..estimate.refine import Budget, refine_until_met
 from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
+from .estimates import judged_errors as _relative  # (the loop's criterion)
 
 #: the failure kind (``result.failure_kind``) a larger disk resolves: the contact reached
 #: the analysis radius (a doubles, N doubles: the spacing stays)
@@ -17,24 +18,6 @@ REFINE_RADIUS = "analysis_radius"
 #: the failure kinds more nodes resolve: a node snapping on its own (lattice trapping), a
 #: largest adhesion beyond Derjaguin-Bradley's bound (too coarse for the surface forces)
 REFINE_NODES = ("trapping", "bound")
-
-
-def _relative(res):
-    """(grid-like relative error, tail relative error) of the headline forces."""
-    hl, est = res.headline, res.estimates
-    scale = max(abs(hl.get("max_adhesion_N", 0.0)), abs(hl.get("F_ex_deepest_N", 0.0)),
-                abs(hl.get("F_LJ_deepest_N", 0.0)), 1e-300)
-    grid, tail = 0.0, 0.0
-    for q in ("max_adhesion_N", "F_ex_deepest_N", "F_LJ_deepest_N"):
-        comp = est.get(q, {})
-        if not all(math.isfinite(comp.get(part, 0.0)) for part in ("total", "tail")):
-            # a part that could not be estimated: the error is unknown, never "met" (max()
-            # would drop a NaN silently)
-            return math.inf, math.inf
-        ref = max(abs(hl.get(q, 0.0)), 1e-3 * scale)
-        grid = max(grid, (comp.get("total", 0.0) - comp.get("tail", 0.0)) / ref)
-        tail = max(tail, comp.get("tail", 0.0) / ref)
-    return grid, tail
 
 
 def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwrite=False,

@@ -73,7 +73,7 @@ LOCKED_DEEPEST_ONLY = True
 #: a refine loop's trial (:func:`estimate_errors` with ``defer``: the adaptive grid's) solves
 #: its reduced members' folds and zero-force radii only when it is kept: where the judged
 #: numbers' estimate (the largest adhesion, the forces at the deepest separation:
-#: :func:`femadh.runner.accuracy._relative`) misses the request, the loop refines and that
+#: :func:`judged_errors`) misses the request, the loop refines and that
 #: trial is replaced - Fig 4 at 1e-3's first trial, 0.14-0.17 s of its members' work. The
 #: kept trial's estimate is the same bit for bit. False: every trial's estimate whole
 DEFER_UNJUDGED = True
@@ -200,6 +200,28 @@ def deferred_target():
     return _DEFER.get()
 
 
+def judged_errors(res):
+    """(grid-like relative error, tail relative error) of the headline forces an adaptive
+    trial is judged by - the largest adhesion and the forces at the deepest separation -
+    relative to each (floored at 1e-3 of the largest); (inf, inf) where a part could not be
+    estimated. The refine loop's criterion (femadh.runner.accuracy, .adaptive) and the
+    deferred estimate's (:func:`estimate_errors`) - one home, here."""
+    hl, est = res.headline, res.estimates
+    scale = max(abs(hl.get("max_adhesion_N", 0.0)), abs(hl.get("F_ex_deepest_N", 0.0)),
+                abs(hl.get("F_LJ_deepest_N", 0.0)), 1e-300)
+    grid, tail = 0.0, 0.0
+    for q in ("max_adhesion_N", "F_ex_deepest_N", "F_LJ_deepest_N"):
+        comp = est.get(q, {})
+        if not all(math.isfinite(comp.get(part, 0.0)) for part in ("total", "tail")):
+            # a part that could not be estimated: the error is unknown, never "met" (max()
+            # would drop a NaN silently)
+            return math.inf, math.inf
+        ref = max(abs(hl.get(q, 0.0)), 1e-3 * scale)
+        grid = max(grid, (comp.get("total", 0.0) - comp.get("tail", 0.0)) / ref)
+        tail = max(tail, comp.get("tail", 0.0) / ref)
+    return grid, tail
+
+
 def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
     """Fill ``res.headline`` with ``<quantity>_error`` entries and return the breakdown
     {quantity: {component: value}} (see the module docstring); ``half`` is the peak's d
@@ -207,7 +229,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
     (:func:`femadh.runner.run.run`).
 
     ``defer``: the relative accuracy a refine loop judges this run by
-    (:func:`femadh.runner.accuracy._relative`: the largest adhesion and the forces at the
+    (:func:`judged_errors`: the largest adhesion and the forces at the
     deepest separation), or None. With it (and DEFER_UNJUDGED), the reduced members first
     solve only what those numbers need (:meth:`~femadh.runner.members.ReducedMember.judged`);
     where their estimate already misses ``defer``, the loop refines or fails, and the rest
@@ -390,8 +412,6 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
     import time
     from types import SimpleNamespace
 
-    from .accuracy import _relative
-
     records = []
     for label, member in members:
         r = rm = None
@@ -457,7 +477,7 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
         return out
 
     partial = assemble(copy.deepcopy(parts), *settle(True))
-    grid_e, tail_e = _relative(SimpleNamespace(headline=res.headline, estimates=partial))
+    grid_e, tail_e = judged_errors(SimpleNamespace(headline=res.headline, estimates=partial))
     if not grid_e + tail_e > target or all(rm is None for _, _, rm, _, _ in records):
         # met (or nothing to defer): the run may be kept, its estimate is made whole now
         return complete()

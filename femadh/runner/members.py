@@ -553,7 +553,7 @@ class ReducedMember:
     """:func:`reduced_member` in two parts, on one member problem and one cache of its
     states: :meth:`judged`, the numbers an accuracy loop judges a trial by (the forces at
     the deepest separation, the largest adhesion and where it is:
-    :func:`femadh.runner.accuracy._relative`), then :meth:`rest`, the folds, the hysteresis
+    :func:`femadh.runner.estimates.judged_errors`), then :meth:`rest`, the folds, the hysteresis
     and the contact radii at zero force. :meth:`rest` continues on the same member problem
     and state cache whenever it is called, so the two parts give the numbers of
     :func:`reduced_member` bit for bit (each member state's Newton start - the carried state,
