@@ -34,7 +34,8 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
 #: what the ``femadh`` script pip writes does (``from femadh.cli import main``: no __main__
 #: module), with an audit hook that sends this process SIGINT (FEMADH_TEST_SIGNAL: another)
 #: when the module named in FEMADH_TEST_SIGINT_AT starts to be imported (forgotten first if a
-#: site hook imported it) or, for "open:TEXT", when a path holding TEXT is opened,
+#: site hook imported it) or, for "open:TEXT" / "rename:TEXT", when a path holding TEXT is
+#: opened / renamed (a temporary file about to become the whole file),
 #: or writes one byte to the fd in FEMADH_TEST_READY_FD when femadh.cli starts to be imported
 CHILD = r"""
 import os, signal, sys
@@ -42,10 +43,11 @@ at, ready = os.environ.get("FEMADH_TEST_SIGINT_AT"), os.environ.get("FEMADH_TEST
 sig = getattr(signal, os.environ.get("FEMADH_TEST_SIGNAL", "SIGINT"))
 fired = []
 def hook(event, args):
-    if fired or event not in ("import", "open"):
+    if fired or event not in ("import", "open", "os.rename"):
         return
-    if event == "open":
-        if at and at.startswith("open:") and at[5:] in str(args[0]):
+    if event in ("open", "os.rename"):
+        kind = "open:" if event == "open" else "rename:"
+        if at and at.startswith(kind) and at[len(kind):] in str(args[0]):
             fired.append(1)
             os.kill(os.getpid(), sig)
         return
@@ -118,16 +120,18 @@ def test_sigint_while_starting_is_one_line_and_exit_130(tmp_path, launcher, modu
 
 
 # the moments: argparse (the script's; before main's guard: femadh.cli's handler ends the
-# process at once) and a study's study.json being written (inside the guard: Terminated,
-# taken as a KeyboardInterrupt; the study's folder claimed: the claim is undone on the way
-# out, which an exit at once would not do: its lock file stayed). Each child ends at the
+# process at once) and a study's study.json about to be renamed into place (inside the guard:
+# Terminated, taken as a KeyboardInterrupt; the study's folder claimed and the temporary file
+# written: both undone on the way out, which an exit at once would not do - its lock file
+# stayed; the signal used to land at the temporary file's open, before it existed, so its
+# removal was never tested: without it this case fails). Each child ends at the
 # signal: 0.03 and 0.40 CPU-s (medians of 5 on CI's Python; the study loads its scene
 # first); before, each died of the default action (exit -15, no line). And the moment
 # femadh.cli starts to be imported by python -m femadh, before any of femadh.cli runs
 # (femadh.__main__'s own handler: it died of the default action too; 0.03 CPU-s).
 @pytest.mark.parametrize("launcher, moment, command", [
     ("script", "argparse", "run"), ("-m", "femadh.cli", "run"),
-    ("-m", "open:.study.json.", "study")])
+    ("-m", "rename:.study.json.", "study")])
 def test_sigterm_while_starting_is_one_line_and_exit_143(tmp_path, launcher, moment,
                                                          command):
     out = tmp_path / "out"
