@@ -2198,6 +2198,10 @@ DEFECTS = [
       "leaves its lock file", "femadh/io/run_folder.py",
       (("        except BaseException:\n            # a refusal, or a signal",
         "        except OutputError:\n            # a refusal, or a signal"),)),
+    D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
+      "estimate's members traced whole: estimates differ from the uninterrupted run's)",
+      "femadh/runner/sink.py",
+      (("            self.committed.setdefault(b, []).append(snap)\n", ""),)),
     D("folder_lock_signal_keeps_file", "run folder: a signal at the lock leaves the lock file "
       "it created", "femadh/io/run_folder.py",
       (("                _drop_unheld(fd, lock)\n", "                os.close(fd)\n"),)),

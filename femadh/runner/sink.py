@@ -290,10 +290,11 @@ class Sink:
                 [v == "True" if c in ("converged", "stable") else float(v)
                  for c, v in zip(self.columns, vals)])
             per_branch.setdefault(b, []).append(k)
-            self._track_peak(b, Committed(d, None, None,
-                                          float(vals[self.columns.index("r_c_m")]), float(
-                                              vals[self.columns.index("F_ex_N")])))
-            self.last[b].w = k           # (the state number, replaced below)
+            snap = Committed(d, None, None, float(vals[self.columns.index("r_c_m")]),
+                             float(vals[self.columns.index("F_ex_N")]))
+            self._track_peak(b, snap)
+            self.committed.setdefault(b, []).append(snap)
+            snap.w = k                   # (the state number, replaced below)
         for b in self.rows:
             self._publish(b)
         # the profiles the uninterrupted run kept: the picks of each branch's full length
@@ -304,11 +305,15 @@ class Sink:
                  if s is not None]
         at_fold = [s for s in {id(s): s for s in snaps}.values() if s.w is None]
         snaps = [s for s in snaps if s.w is not None]
-        wanted = {s.w for s in snaps} | {k for ks in picks.values() for k in ks} | {
-            s.near for s in at_fold}
+        # every committed state, as the uninterrupted run held them: the estimate's coarser
+        # members start from them (femadh.runner.members.eligible; without them a resumed
+        # adaptive run traced its members whole and its estimates differed from the
+        # uninterrupted run's - Fig 3's F_LJ at the deepest state 4.79e-8 -> 5.49e-8 N)
+        wanted = set(range(len(rows))) | {s.near for s in at_fold}
         fields = field_states(folder, wanted)
         self.last_k = {b: s.w for b, s in self.last.items()}
-        for s in {id(s): s for s in snaps}.values():
+        for s in {id(s): s for s in snaps + [c for cs in self.committed.values()
+                                             for c in cs]}.values():
             d, w, _, p_el = fields[s.w]
             s.w, s.active = w, p_el != 0
         self._fold_fields(folder, at_fold, fields)
