@@ -474,6 +474,9 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
                        **({} if spent is None else {"since": t1}))
         if spent is not None:
             res.timings["error_estimate_s"] += spent
+            # the loop judged this trial on its judged numbers' breakdown (DEFER_UNJUDGED:
+            # where a member's rest is traced whole, not as main's estimate)
+            res.grid["judged_deferred"] = True
         return out
 
     partial = assemble(copy.deepcopy(parts), *settle(True))
