@@ -370,7 +370,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
         try:
             with phase("estimate"):
-                complete_estimate(res)      # the kept trial's estimate made whole
+                complete_estimate(res)          # the kept trial's estimate made whole
         except BaseException as exc:
             # a bug while completing: res is "failed" with its error (complete_estimate);
             # the summary is written below, then the exception raised again, as a run's

@@ -75,7 +75,13 @@ LOCKED_DEEPEST_ONLY = True
 #: numbers' estimate (the largest adhesion, the forces at the deepest separation:
 #: :func:`judged_errors`) misses the request, the loop refines and that
 #: trial is replaced - Fig 4 at 1e-3's first trial, 0.14-0.17 s of its members' work. The
-#: kept trial's estimate is the same bit for bit. False: every trial's estimate whole
+#: kept trial's estimate, once completed, is the same bit for bit (its grid record adds
+#: ``judged_deferred``: the loop judged it on its judged numbers' breakdown). The loop's
+#: decisions are main's but for one case: a member whose judged part reduces and whose rest
+#: does not (the rest fails and the member is traced whole) - main traced it whole before
+#: judging, the trial is then judged on the reduced member's numbers instead (counted 0 of
+#: 16 reducing judged parts on the bundled scenes, validation/results/pace.md). False:
+#: every trial's estimate whole
 DEFER_UNJUDGED = True
 
 
@@ -235,8 +241,12 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
     where their estimate already misses ``defer``, the loop refines or fails, and the rest
     (the members' folds, hysteresis and zero-force radii) is left to
     ``res.pending_estimate``, which :func:`complete_estimate` runs for the run the loop
-    keeps: the same numbers and breakdown, bit for bit, as without ``defer``. Where the
-    estimate meets ``defer`` the rest is done at once."""
+    keeps: the same numbers and breakdown, bit for bit, as without ``defer`` (and
+    ``res.grid["judged_deferred"]``). The loop's judgement of such a trial can differ from
+    one without ``defer`` only where a member's judged part reduces and its rest does not
+    (traced whole on completion, where without ``defer`` the trial is judged on the whole
+    trace: see :data:`DEFER_UNJUDGED`). Where the estimate meets ``defer`` the rest is done
+    at once."""
     import time
     import warnings
 
