@@ -134,7 +134,8 @@ def _comparable(o):
     times, paths."""
     if isinstance(o, dict):
         return {k: _comparable(v) for k, v in o.items()
-                if not any(s in k for s in ("time", "_s", "wall", "path", "out_dir"))}
+                if not (k.endswith("_s") or any(s in k for s in ("time", "wall", "path",
+                                                                   "out_dir")))}
     if isinstance(o, list):
         return [_comparable(v) for v in o]
     if isinstance(o, str):
