@@ -2205,6 +2205,41 @@ DEFECTS = [
     D("folder_lock_signal_keeps_file", "run folder: a signal at the lock leaves the lock file "
       "it created", "femadh/io/run_folder.py",
       (("                _drop_unheld(fd, lock)\n", "                os.close(fd)\n"),)),
+    # -- the adaptive loop's deferred estimate completed (review of pace2)
+    D("defer_stop_keeps_partial", "adaptive: a stop while the kept trial's deferred estimate "
+      "is completed leaves the judged numbers' partial breakdown", "femadh/runner/estimates.py",
+      (("        res.stop(exc)\n        abandon(res.error)\n", "        res.stop(exc)\n"),)),
+    D("defer_stopped_trial_completed", "adaptive: a kept trial stopped after its estimate has "
+      "its deferred rest solved", "femadh/runner/estimates.py",
+      (('    if res.status not in ("converged", "failed"):\n        abandon(',
+        '    if False:\n        abandon('),)),
+    D("defer_bug_unwritten", "adaptive: a bug while completing the kept trial's estimate is "
+      "raised before the summary says failed", "femadh/runner/adaptive.py",
+      (("            raised = exc\n", "            raise\n"),)),
+    D("defer_bug_not_failed", "adaptive: a bug while completing leaves the result converged",
+      "femadh/runner/estimates.py",
+      (('        res.fail(f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__)\n'
+        '        abandon(res.error)\n        raise\n', "        raise\n"),)),
+    D("defer_superseded_held", "adaptive: a superseded trial's pending rest (its problem, sink "
+      "and member problems) held through the next trial", "femadh/runner/adaptive.py",
+      (('            ahead["res"].pending_estimate = None\n', "            pass\n"),)),
+    D("defer_completion_untimed", "adaptive: the completion's seconds not in the trial's "
+      "estimate_s", "femadh/runner/estimates.py",
+      (('        for key in ("estimate_s", "total_s"):\n', '        for key in ():\n'),)),
+    D("defer_complete_only_if_met", "adaptive: the deferred estimate completed only where the "
+      "kept trial met (a kept missed trial states the partial one)", "femadh/runner/adaptive.py",
+      (("    if res is not None:\n        from .estimates import complete_estimate",
+        "    if res is not None and out.met:\n        from .estimates import complete_estimate"),)),
+    D("defer_met_keeps_partial", "estimate: a deferred estimate that meets its request returns "
+      "the judged numbers' breakdown", "femadh/runner/estimates.py",
+      (("        return complete()\n    spent", "        return partial\n    spent"),)),
+    D("defer_stop_swallowed", "adaptive: a stop while completing the kept trial's estimate "
+      "swallowed (the run ends converged)", "femadh/runner/estimates.py",
+      (("        res.stop(exc)\n        abandon(res.error)\n", "        pass\n"),)),
+    D("defer_rest_fail_uses_judged", "estimate: a member's failed rest falls back on its judged "
+      "numbers instead of its whole trace", "femadh/runner/estimates.py",
+      (('                    if hl_m is None:\n                        r = run(member, progress=False, estimate="peak")\n                if hl_m is not None:',
+        '                    if hl_m is None:\n                        hl_m, how = rm.hl, rm.m.solves\n                if hl_m is not None:'),)),
 ]
 
 

@@ -41,7 +41,8 @@ def fig4_both():
     members are compared); "deferred": the reduced run's estimate made again on a copy of
     its result as an adaptive trial's whose request (1e-12) it misses
     (:func:`femadh.runner.estimates.estimate_errors`, ``defer``: the sweep is not traced
-    twice)."""
+    twice), "met" as one whose request (1.0) it meets, "unrested" a second copy of
+    "deferred"."""
     import copy
 
     sc = _fig4_short()
@@ -49,11 +50,13 @@ def fig4_both():
     estimate = estimates.estimate_errors
 
     def twice(scene, res, *a, **kw):
-        twin = copy.deepcopy(res)
+        twins = {name: copy.deepcopy(res) for name in ("deferred", "met", "unrested")}
         done = estimate(scene, res, *a, **kw)
         if estimates.REDUCED_MEMBERS:
-            twin.estimates = estimate(scene, twin, *a, **{**kw, "defer": 1e-12})
-            out["deferred"] = twin
+            for name, defer in (("met", 1.0), ("unrested", 1e-12), ("deferred", 1e-12)):
+                twin = twins[name]
+                twin.estimates = estimate(scene, twin, *a, **{**kw, "defer": defer})
+                out[name] = twin
         return done
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(estimates, "deepest_locked", lambda *a, **k: None)
@@ -62,7 +65,8 @@ def fig4_both():
             mp.setattr(estimates, "REDUCED_MEMBERS", reduced)
             out[reduced] = _run(sc)
     # the run's life after its estimate, as the copy's
-    out["deferred"].status = out[True].status
+    for name in ("deferred", "met", "unrested"):
+        out[name].status = out[True].status
     return out
 
 
@@ -100,9 +104,45 @@ def test_a_deferred_estimate_completed_is_the_whole_estimate_bit_for_bit(fig4_bo
     assert len(full) == 2 and all(p < f for p, f in zip(part, full)), (part, full)
     estimates.complete_estimate(deferred)
     assert deferred.pending_estimate is None
+    # (the one difference: the record that the loop judged it on the partial breakdown)
+    assert deferred.grid.pop("judged_deferred") is True
     assert _record(deferred) == _record(whole)
     estimates.complete_estimate(deferred)          # nothing left: the result stays
     assert _record(deferred) == _record(whole)
+
+
+def test_a_deferred_estimate_that_meets_its_request_is_whole_at_once(fig4_both):
+    """The judged numbers' breakdown meets the request (1.0): the rest is solved at once,
+    nothing is left pending, and the estimate is the whole one (hysteresis and zero-force
+    radii included), record for record and bit for bit."""
+    met, whole = fig4_both["met"], fig4_both[True]
+    assert getattr(met, "pending_estimate", None) is None
+    assert "grid" in met.estimates["hysteresis_J"]
+    assert _record(met) == _record(whole)
+
+
+def test_a_members_rest_that_fails_traces_the_member_whole(fig4_both, monkeypatch):
+    """A reduced member whose rest cannot be solved (a FemadhError in
+    :meth:`~femadh.runner.members.ReducedMember.rest`) when the deferred estimate is
+    completed: the member is traced whole, as :func:`estimate_errors` without ``defer``
+    does - the breakdown equals the one of members traced whole (the rest never falls back
+    on the member's judged numbers: its folds and radii would be missing or the fine run's)."""
+    from femadh.errors import ConvergenceError
+
+    def rest(self):
+        raise ConvergenceError("no rest here")
+
+    def failing(self):
+        try:
+            rest(self)
+        except ConvergenceError as exc:
+            return None, str(exc)
+    unrested, traced = fig4_both["unrested"], fig4_both[False]
+    monkeypatch.setattr(members.ReducedMember, "rest", failing)
+    estimates.complete_estimate(unrested)
+    assert [m["reduced"] for m in unrested.grid["member_solves"]] == [False, False]
+    assert [m["why"] for m in unrested.grid["member_solves"]] == ["no rest here"] * 2
+    assert list(unrested.estimates.items()) == list(traced.estimates.items())
 
 
 def test_reduced_members_give_the_whole_trace_estimate(fig4_both):

@@ -303,6 +303,10 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
     def attempt(tr):
         i = len(steps)
+        if ahead.get("res") is not None:
+            # the last trial is superseded: its deferred rest is never made, and its closure
+            # would hold its problem, sink and member problems alive through this one
+            ahead["res"].pending_estimate = None
         trial = variant(scene, grid=tr.grid(), radius=tr.family.radius)
         ahead["trial"] = trial
         with phase(f"{'refinement ' + str(i) if i else 'grid'} ({tr.nodes} nodes)"):
@@ -313,6 +317,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                           estimate=estimate, operator=tr.operator,
                           folder_id=scene_id(scene), **mode)
         tr.operator = None            # run: its dense operator need not outlive it
+        ahead["res"] = res
         mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
         grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
                           else (math.nan, math.nan))
@@ -358,11 +363,19 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         failure = (_too_many_nodes(ahead["refused"]) if out.stop == "nodes"
                    else ahead["failure"])
     res = out.result if out is not None else None
+    ahead["res"] = None
+    raised = None
     if res is not None:
         from .estimates import complete_estimate
 
-        with phase("estimate"):
-            complete_estimate(res)          # the kept trial's estimate made whole
+        try:
+            with phase("estimate"):
+                complete_estimate(res)          # the kept trial's estimate made whole
+        except BaseException as exc:
+            # a bug while completing: res is "failed" with its error (complete_estimate);
+            # the summary is written below, then the exception raised again, as a run's
+            # lifecycle does
+            raised = exc
     family = out.setting.family if out is not None else family
     met = bool(out is not None and out.met and estimate is True)
     if res is None:
@@ -410,7 +423,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
         # the last trial's outputs stay; its summary gains the accuracy record, its figures
         with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
-            if figures and res.status in ("converged", "failed") and res.branches and any(
+            if figures and raised is None and res.status in ("converged", "failed") \
+                    and res.branches and any(
                     len(next(iter(b.values()))) for b in res.branches.values()):
                 from .figures import draw_figures
 
@@ -418,6 +432,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
                 with phase("figures"):
                     draw_figures(res, folder)
             folder.write_summary(summary(res))
+    if raised is not None:
+        raise raised
     return res
 
 

@@ -558,7 +558,11 @@ class ReducedMember:
     and state cache whenever it is called, so the two parts give the numbers of
     :func:`reduced_member` bit for bit (each member state's Newton start - the carried state,
     the factorisation of its nearest cached neighbour - is the same); an accuracy loop calls
-    it only for the trial it keeps (:data:`femadh.runner.estimates.DEFER_UNJUDGED`).
+    it only for the trial it keeps (:data:`femadh.runner.estimates.DEFER_UNJUDGED`). Where
+    :meth:`judged` reduces but :meth:`rest` does not, the member is traced whole when the
+    estimate is completed, while a loop without deferral would have judged the trial on that
+    whole trace: then (only) the loop's judgement of the trial can differ (counted 0 of 16
+    reducing judged parts on the bundled scenes, validation/results/pace.md).
 
     Parameters are :func:`reduced_member`'s.
     """
