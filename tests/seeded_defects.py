@@ -2198,6 +2198,16 @@ DEFECTS = [
       "leaves its lock file", "femadh/io/run_folder.py",
       (("        except BaseException:\n            # a refusal, or a signal",
         "        except OutputError:\n            # a refusal, or a signal"),)),
+    D("defer_late_signal_lost", "deferred estimate: a signal after the completion's last "
+      "safe point is lost (the run ends as if unsent)", "femadh/runner/estimates.py",
+      (("        interrupt.check()\n    except Interrupted as exc:\n        res.stop(exc)\n"
+        "        if not done:",
+        "        pass\n    except Interrupted as exc:\n        res.stop(exc)\n"
+        "        if not done:"),)),
+    D("defer_abandon_keeps_grid", "deferred estimate abandoned: the judged part's member "
+      "record left in a stopped run's grid record", "femadh/runner/estimates.py",
+      (("        res.grid.clear()\n        res.grid.update(grid0)\n        res.estimates = {}\n",
+        "        res.estimates = {}\n"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

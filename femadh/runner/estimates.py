@@ -529,7 +529,9 @@ def complete_estimate(res):
 
     - ``res`` not "converged" or "failed" (stopped after its estimate): nothing is solved;
     - a stop (signal, time limit: :class:`~femadh.errors.Interrupted`) while completing:
-      ``res`` is stopped (status, error, exit code as the lifecycle sets them);
+      ``res`` is stopped (status, error, exit code as the lifecycle sets them); one that
+      arrived after the completion's last safe point stops it too, its estimate kept (as
+      the lifecycle's last check leaves a run's);
     - any other exception: ``res`` "failed", ``error`` "Type: message", and the exception
       is raised again (the caller writes the summary first).
 
@@ -558,12 +560,21 @@ def complete_estimate(res):
     if res.status not in ("converged", "failed"):
         abandon(f"the run was {res.status} before it")
         return res
+    from .. import interrupt
+
     t0 = time.perf_counter()
+    done = False
     try:
         res.estimates = pending()
+        done = True
+        # a signal that arrived after the completion's last safe point is still a stop
+        # (as the lifecycle's last check: never "converged" once the user asked to stop;
+        # it was lost - a Ctrl-C after the last member's rest ended the run as if unsent)
+        interrupt.check()
     except Interrupted as exc:
         res.stop(exc)
-        abandon(res.error)
+        if not done:
+            abandon(res.error)
     except BaseException as exc:
         # a bug, a full disk: the summary must not say "converged" (as the lifecycle's)
         res.fail(f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__)
