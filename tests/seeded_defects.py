@@ -2208,6 +2208,10 @@ DEFECTS = [
       "record left in a stopped run's grid record", "femadh/runner/estimates.py",
       (("        res.grid.clear()\n        res.grid.update(grid0)\n        res.estimates = {}\n",
         "        res.estimates = {}\n"),)),
+    D("study_late_signal_lost", "study: a signal whose stop found every point finished is "
+      "lost (exit 0)", "femadh/studies/sweep.py",
+      (("                if stop:\n                    # a signal whose stop found",
+        "                if False:\n                    # a signal whose stop found"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

@@ -118,6 +118,27 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     assert _table(tmp_path / "here") == rows
 
 
+def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, monkeypatch):
+    """A SIGINT whose stop flag is raised as the last point's record comes in (every point
+    finished, nothing left to stop): the study still ends Interrupted, with every point
+    kept and its table written - it ended as if the signal had not been sent (exit 0; found
+    by a review), where a run ends "interrupted" at its last check."""
+    from femadh.errors import Interrupted
+    from femadh.studies import sweep
+
+    real = sweep.execute
+
+    def execute(todo, out, workers, scheduler, estimate, stop, notes):
+        yield from real(todo, out, workers, scheduler, estimate, stop, notes)
+        stop.append(signal.SIGINT)          # as driver_signals' handler records it
+    monkeypatch.setattr(sweep, "execute", execute)
+    vary = {"effects.asperity_gap.sigma": "0.5 nm,1 nm"}
+    with pytest.raises(Interrupted) as info:
+        run_study(small(), vary, tmp_path / "s", workers=1, estimate=False)
+    assert {r["status"] for r in info.value.study.records.values()} == {"converged"}
+    assert len(info.value.study.records) == 2 and len(_table(tmp_path / "s")) == 3
+
+
 def test_killed_study_loses_no_completed_point(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text(study_text())

@@ -240,6 +240,11 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
                     if bar is not None:
                         bar.point(rec)
                     write_table(points, result.records, out)
+                if stop:
+                    # a signal whose stop found every point finished (the last one as it
+                    # came): still a stop, every point kept - it was lost (exit 0, as if
+                    # unsent), where a run ends "interrupted" at its last check
+                    raise Interrupted(stop[0])
         except (Interrupted, KeyboardInterrupt) as exc:
             # what finished is on disk (records are written by the workers): the table too
             result.records.update({k: r for k, r in _load_records(out).items() if k in ids})
