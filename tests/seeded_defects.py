@@ -2212,6 +2212,9 @@ DEFECTS = [
       "lost (exit 0)", "femadh/studies/sweep.py",
       (("                if stop:\n                    # a signal whose stop found",
         "                if False:\n                    # a signal whose stop found"),)),
+    D("study_stale_tmp_kept", "study: a killed worker's temporary file left in its point's "
+      "folder for good", "femadh/studies/sweep.py",
+      (("        _remove_stale_temporaries(out)\n", ""),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

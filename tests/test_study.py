@@ -110,7 +110,12 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     assert rec["femadh"] == code_id()
     rec["femadh"] = "0.2.0+000000000000"
     f.write_text(json.dumps(rec))
+    # a temporary file a killed worker left beside a record (written then renamed into
+    # place: a kill -9 between the two) is removed by the next run of the study
+    stale = f.parent / ".record.json.abc123.tmp"
+    stale.write_text("{")
     again = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    assert not stale.exists()
     timing = json.loads((tmp_path / "here" / "timing.json").read_text())
     assert timing["computed"] == 1 and timing["reused"] == 3
     assert any("computed by other femadh code run again" in n for n in again.notes)

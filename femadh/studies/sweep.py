@@ -201,6 +201,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
     # keyed by the points' content hashes, so a folder reused by another study reuses only
     # identical points
     with RunFolder(out, "study", scene.name, "new"):
+        _remove_stale_temporaries(out)
         old = _load_records(out)
         ids = {p.id for p in points}
         done = {k: r for k, r in old.items() if finished(r) and k in ids}
@@ -284,6 +285,20 @@ def _timing(out, result, t0):
         {"points": len(result.points), "computed": result.redone + result.new,
          "reused": result.reused, "redone": result.redone, "new": result.new,
          "wall_time_s": result.wall_time_s}) + "\n")
+
+
+def _remove_stale_temporaries(out):
+    """Remove the temporary files a killed worker left in the points' folders (each file is
+    written to ``.NAME.XXXX.tmp`` and renamed into place, femadh.io.atomic; a kill -9 between
+    the two leaves it). Called with the study's lock held and before any worker starts: no
+    writer of this study can own one."""
+    pts = Path(out) / "points"
+    if pts.exists():
+        for f in pts.glob("*/.*.tmp"):
+            try:
+                f.unlink()
+            except OSError:
+                pass                # (gone already, or not ours to remove: left as it is)
 
 
 def _load_records(out):
