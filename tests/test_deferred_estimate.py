@@ -166,6 +166,15 @@ def test_a_real_kept_trial_that_missed_states_the_whole_estimate(monkeypatch, tm
     assert "grid" in est["jump_out_d_m"] and "grid" in est["hysteresis_J"]
 
 
+def _interrupted_fig4(tmp_path):
+    """summary.json of Fig 4 at 1e-3 (the loop cut to one run by the caller) run until the
+    SIGINT the caller arranges stops it (KeyboardInterrupt to a script)."""
+    with pytest.raises(KeyboardInterrupt):
+        femadh.run(adaptive_scene(FIG4, accuracy=1e-3), tmp_path, progress=False,
+                   figures=False)
+    return json.loads((tmp_path / "summary.json").read_text())
+
+
 def test_a_signal_in_a_members_rest_stops_the_run_without_an_estimate(monkeypatch, tmp_path):
     """SIGINT while the kept trial's members' rest is solved (Fig 4 at 1e-3, one run): the
     run is interrupted (KeyboardInterrupt to a script), its summary.json says so, states no
@@ -178,11 +187,8 @@ def test_a_signal_in_a_members_rest_stops_the_run_without_an_estimate(monkeypatc
         seen.append(self.member.name)
         raise Interrupted(signal.SIGINT)
     monkeypatch.setattr(members.ReducedMember, "rest", rest)
-    with pytest.raises(KeyboardInterrupt):
-        femadh.run(adaptive_scene(FIG4, accuracy=1e-3), tmp_path, progress=False,
-                   figures=False)
+    s = _interrupted_fig4(tmp_path)
     assert len(seen) == 1
-    s = json.loads((tmp_path / "summary.json").read_text())
     assert s["status"] == "interrupted" and s["error"] == "interrupted by SIGINT"
     assert not s["error_estimates"]
     assert not [k for k in s["headline"] if k.endswith("_error")]
@@ -210,11 +216,8 @@ def test_a_signal_after_the_last_rest_stops_the_run_with_its_whole_estimate(monk
             os.kill(os.getpid(), signal.SIGINT)     # recorded by the run's handler: pending
         return out
     monkeypatch.setattr(members.ReducedMember, "rest", rest)
-    with pytest.raises(KeyboardInterrupt):
-        femadh.run(adaptive_scene(FIG4, accuracy=1e-3), tmp_path, progress=False,
-                   figures=False)
+    s = _interrupted_fig4(tmp_path)
     assert len(seen) == 2
-    s = json.loads((tmp_path / "summary.json").read_text())
     assert s["status"] == "interrupted" and s["error"] == "interrupted by SIGINT"
     assert "hysteresis_J" in s["error_estimates"] and "hysteresis_J_error" in s["headline"]
 
@@ -236,10 +239,7 @@ def test_a_trial_stopped_after_its_deferred_estimate_states_no_member_record(mon
         os.kill(os.getpid(), signal.SIGINT)
         return out
     monkeypatch.setattr(estimates, "guard_bounds", guard)
-    with pytest.raises(KeyboardInterrupt):
-        femadh.run(adaptive_scene(FIG4, accuracy=1e-3), tmp_path, progress=False,
-                   figures=False)
-    s = json.loads((tmp_path / "summary.json").read_text())
+    s = _interrupted_fig4(tmp_path)
     assert s["status"] == "interrupted"
     assert not s["error_estimates"]
     assert "member_solves" not in s["grid"] and "members" not in s["grid"]
