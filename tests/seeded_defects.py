@@ -2215,6 +2215,9 @@ DEFECTS = [
     D("study_stale_tmp_kept", "study: a killed worker's temporary file left in its point's "
       "folder for good", "femadh/studies/sweep.py",
       (("        _remove_stale_temporaries(out)\n", ""),)),
+    D("defer_bug_draws_figures", "adaptive loop: a run whose deferred completion hit a bug "
+      "still draws its figures", "femadh/runner/adaptive.py",
+      (("            if figures and raised is None and ", "            if figures and "),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

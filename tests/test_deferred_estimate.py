@@ -244,3 +244,19 @@ def test_a_trial_stopped_after_its_deferred_estimate_states_no_member_record(mon
     assert not s["error_estimates"]
     assert "member_solves" not in s["grid"] and "members" not in s["grid"]
     assert any(w.startswith("error estimate not completed") for w in s["warnings"])
+
+
+def test_a_bug_while_completing_a_real_run_draws_no_figures(monkeypatch, tmp_path):
+    """A real Fig 4 trial (1e-3, one run) whose members' rest hits a bug: the exception
+    reaches the caller, summary.json says "failed", and no figure of the failed run is
+    drawn (the scripted case above has no curve to draw, so it cannot tell)."""
+    monkeypatch.setattr(adaptive, "MAX_TRIALS", 1)
+
+    def rest(self):
+        raise RuntimeError("boom in rest")
+    monkeypatch.setattr(members.ReducedMember, "rest", rest)
+    with pytest.raises(RuntimeError, match="boom in rest"):
+        femadh.run(adaptive_scene(FIG4, accuracy=1e-3), tmp_path, progress=False,
+                   figures=True)
+    assert json.loads((tmp_path / "summary.json").read_text())["status"] == "failed"
+    assert not list(tmp_path.glob("*.png"))
