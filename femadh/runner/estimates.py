@@ -74,12 +74,13 @@ LOCKED_DEEPEST_ONLY = True
 #: its reduced members' folds and zero-force radii only when it is kept: where the judged
 #: numbers' estimate (the largest adhesion, the forces at the deepest separation:
 #: :func:`judged_errors`) misses the request, the loop refines and that
-#: trial is replaced - Fig 4 at 1e-3's first trial, 0.14-0.17 s of its members' work. The
+#: trial is replaced - Fig 4 at 1e-3's first trial: its estimate 0.19 -> 0.06 s. The
 #: kept trial's estimate, once completed, is the same bit for bit (its grid record adds
 #: ``judged_deferred``: the loop judged it on its judged numbers' breakdown). The loop's
-#: decisions are main's but for one case: a member whose judged part reduces and whose rest
-#: does not (the rest fails and the member is traced whole) - main traced it whole before
-#: judging, the trial is then judged on the reduced member's numbers instead (counted 0 of
+#: decisions are those of the undeferred loop but for one case: a member whose judged part
+#: reduces and whose rest does not (the rest fails and the member is traced whole) - the
+#: undeferred loop traced it whole before judging, this one judges the trial on the reduced
+#: member's numbers instead (counted 0 of
 #: 16 reducing judged parts on the bundled scenes, validation/results/pace.md). False:
 #: every trial's estimate whole
 DEFER_UNJUDGED = True
@@ -485,7 +486,7 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
         if spent is not None:
             res.timings["error_estimate_s"] += spent
             # the loop judged this trial on its judged numbers' breakdown (DEFER_UNJUDGED:
-            # where a member's rest is traced whole, not as main's estimate)
+            # where a member's rest is traced whole, not as the undeferred loop judges it)
             res.grid["judged_deferred"] = True
         return out
 
