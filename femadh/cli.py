@@ -168,6 +168,7 @@ def _parser():
                          "a later run with estimates runs such points again")
     sw.add_argument("--quantity", default="max_adhesion_N",
                     help="the number the figure shows (default max_adhesion_N)")
+    sw.add_argument("--no-figures", action="store_true", help="skip study.png")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     cv = ss.add_parser("convergence", help="FE mesh ladder vs Green, Green in N",
                        description="The FE mesh ladder against the Green function on the "
@@ -493,7 +494,8 @@ def _sweep(scene, args):
                           scheduler=args.scheduler,
                           progress=not args.quiet and sys.stderr.isatty(),
                           quantity=args.quantity,
-                          estimate="peak" if args.no_estimate else True)
+                          estimate="peak" if args.no_estimate else True,
+                          figures=not args.no_figures)
     except Interrupted as exc:
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())
@@ -511,7 +513,7 @@ def _sweep(scene, args):
         for reason, idx in failure_reasons(failed):
             _error(f"  {len(idx)} point{'s' if len(idx) > 1 else ''} ({_indices(idx)}): "
                    f"{reason}")
-        if study.figure is None and len(failed) == n:
+        if study.figure is None and len(failed) == n and not args.no_figures:
             _error("no figure: every point failed (study.csv has each point's reason)")
         return EXIT_SOLVE
     return 0

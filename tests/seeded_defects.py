@@ -2218,6 +2218,10 @@ DEFECTS = [
     D("defer_bug_draws_figures", "adaptive loop: a run whose deferred completion hit a bug "
       "still draws its figures", "femadh/runner/adaptive.py",
       (("            if figures and raised is None and ", "            if figures and "),)),
+    D("study_no_figures_ignored", "study: --no-figures ignored (study.png drawn anyway)",
+      "femadh/studies/sweep.py",
+      (("        result.figure = (study_figure(points, result.records, out, quantity) if figures\n",
+        "        result.figure = (study_figure(points, result.records, out, quantity) if True\n"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

@@ -88,10 +88,12 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     of its own for it.)"""
     sc, vary = small(), {"effects.asperity_gap.sigma": "0.5 nm,1 nm",
                          "sphere.radius": "1 mm,2 mm"}
-    _, here = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    _, here = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False,
+                        figures=False)
     assert len(here) == 4 and {r["status"] for r in here.values()} == {"converged"}
+    assert not (tmp_path / "here" / "study.png").exists()      # (--no-figures)
     t0 = time.perf_counter()
-    run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    run_study(sc, vary, tmp_path / "here", workers=1, estimate=False, figures=False)
     assert json.loads((tmp_path / "here" / "timing.json").read_text())["computed"] == 0
     assert time.perf_counter() - t0 < 5
     rows = _table(tmp_path / "here")
@@ -115,7 +117,7 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     stale = f.parent / ".record.json.abc123.tmp"
     stale.write_text("{")
     again = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
-    assert not stale.exists()
+    assert not stale.exists() and (tmp_path / "here" / "study.png").exists()
     timing = json.loads((tmp_path / "here" / "timing.json").read_text())
     assert timing["computed"] == 1 and timing["reused"] == 3
     assert any("computed by other femadh code run again" in n for n in again.notes)
@@ -139,7 +141,7 @@ def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, mon
     monkeypatch.setattr(sweep, "execute", execute)
     vary = {"effects.asperity_gap.sigma": "0.5 nm,1 nm"}
     with pytest.raises(Interrupted) as info:
-        run_study(small(), vary, tmp_path / "s", workers=1, estimate=False)
+        run_study(small(), vary, tmp_path / "s", workers=1, estimate=False, figures=False)
     assert {r["status"] for r in info.value.study.records.values()} == {"converged"}
     assert len(info.value.study.records) == 2 and len(_table(tmp_path / "s")) == 3
 
@@ -257,9 +259,10 @@ def study_scene(tmp_path_factory):
 
 
 def _cmd(scene, out, *extra):
-    # (no error estimates: what is kept and redone is the point, not its accuracy)
+    # (no error estimates: what is kept and redone is the point, not its accuracy; no
+    # study.png: the tables are compared)
     return [sys.executable, "-m", "femadh", "study", "sweep", str(scene), "--vary", SIGMAS,
-            "--out", str(out), "--quiet", "--no-estimate", *extra]
+            "--out", str(out), "--quiet", "--no-estimate", "--no-figures", *extra]
 
 
 def _table(out):

@@ -158,7 +158,7 @@ def _label(changes):
 
 
 def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
-              progress=None, quantity="max_adhesion_N", estimate=True):
+              progress=None, quantity="max_adhesion_N", estimate=True, figures=True):
     """Run a study.
 
     Parameters
@@ -180,6 +180,9 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         What each point's run estimates (``femadh.run``'s ``estimate``; "peak" is the command
         line's --no-estimate). Each point's record says it; a finished point is reused only
         when it estimated at least as much (:func:`serves`), else it is run again.
+    figures : bool
+        Draw study.png (False: the command line's --no-figures; its points draw none either
+        way).
 
     Returns
     -------
@@ -266,7 +269,8 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
                 write_record(out / "points" / p.id, rec)
                 result.records[p.id] = rec
         write_table(points, result.records, out)
-        result.figure = study_figure(points, result.records, out, quantity)
+        result.figure = (study_figure(points, result.records, out, quantity) if figures
+                         else None)
         result.failed = [result.records[p.id] for p in points
                          if result.records.get(p.id, {}).get("status") != "converged"]
         _timing(out, result, t0)
