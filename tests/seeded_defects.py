@@ -2222,6 +2222,10 @@ DEFECTS = [
       "femadh/studies/sweep.py",
       (("        result.figure = (study_figure(points, result.records, out, quantity) if figures\n",
         "        result.figure = (study_figure(points, result.records, out, quantity) if True\n"),)),
+    D("resume_folds_not_loaded", "resume: the fold records not restored from the checkpoint "
+      "(the members trace the grid steps for their folds: the jump and hysteresis errors "
+      "move)", "femadh/runner/sink.py",
+      (("                      if (b, df, dl) in kept]\n", "                      if False]\n"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

@@ -60,6 +60,7 @@ def save_checkpoint(folder, sink):
     data.update(_rhythm_data(st.snap_rhythm))
     data.update({f"pe_{name}": v for name, v in st.p_effects.items()})
     data.update(_fold_data(sink))
+    data.update(_fold_records(sink))
     lu = st.lu
     if lu is None:
         data["lu_kind"] = np.array("none")
@@ -162,6 +163,45 @@ def _fold_data(sink):
             "fold_w": np.array([s.w for s in held]),
             "fold_active": np.array([s.active for s in held]),
             "fold_r_c": np.array([s.r_c for s in held], dtype=float)}
+
+
+def _fold_records(sink):
+    """Every fold of the sweep so far (``sink.folds``: branch, d_fold, d_land, its last state
+    and its landing, each (d, w, active, r_c)): the estimate's reduced members start their
+    fold searches from them (femadh.runner.members._folds); without them a resumed run's
+    members traced the fine run's grid steps instead - more solves, and the jump and
+    hysteresis errors moved in their last digits. Empty where a state is off the grid (an
+    exchanged grid: not resumed mid-sweep)."""
+    folds = getattr(sink, "folds", [])
+    n = sink.problem.grid.n
+    states = [s for f in folds for s in f[3:5]]
+    if not folds or any(np.ndim(s.w) != 1 or np.size(s.w) != n for s in states):
+        return {}
+    return {"folds_branch": np.array([f[0] for f in folds]),
+            "folds_d": np.array([[f[1], f[2]] for f in folds], dtype=float),
+            "folds_state_d": np.array([[f[3].d, f[4].d] for f in folds], dtype=float),
+            "folds_w": np.array([[f[3].w, f[4].w] for f in folds]),
+            "folds_active": np.array([[f[3].active, f[4].active] for f in folds]),
+            "folds_r_c": np.array([[f[3].r_c, f[4].r_c] for f in folds], dtype=float)}
+
+
+def load_fold_records(folder):
+    """[(branch, d_fold, d_land, (d, w, active, r_c) before, ... after)] of the folds the
+    checkpoint holds (empty: none, no checkpoint, unreadable)."""
+    path = folder / CHECKPOINT
+    if not path.exists():
+        return []
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if "folds_d" not in z.files:
+                return []
+            return [(str(b), float(dd[0]), float(dd[1]),
+                     *((float(sd[i]), w[i], a[i], float(rc[i])) for i in (0, 1)))
+                    for b, dd, sd, w, a, rc in zip(z["folds_branch"], z["folds_d"],
+                                                  z["folds_state_d"], z["folds_w"],
+                                                  z["folds_active"], z["folds_r_c"])]
+    except (OSError, ValueError, KeyError):
+        return []
 
 
 def load_fold_states(folder):

@@ -317,6 +317,15 @@ class Sink:
             d, w, _, p_el = fields[s.w]
             s.w, s.active = w, p_el != 0
         self._fold_fields(folder, at_fold, fields)
+        # the fold records of the jumps kept (the members' fold searches start from them),
+        # from the checkpoint: a run stopped by a signal or its time limit resumes with them;
+        # a killed one (no checkpoint) without, its members tracing those grid steps instead
+        from .checkpoint import load_fold_records
+
+        kept = {(j["branch"], j["d_fold_m"], j["d_land_m"]) for j in jumps}
+        self.folds = [(b, df, dl, *(Committed(d, w, a, rc, math.nan) for d, w, a, rc in st))
+                      for b, df, dl, *st in load_fold_records(folder)
+                      if (b, df, dl) in kept]
         for b, ks in picks.items():
             for k in ks:
                 d, w, p_lj, p_el = fields[k]
