@@ -2226,6 +2226,10 @@ DEFECTS = [
       "(the members trace the grid steps for their folds: the jump and hysteresis errors "
       "move)", "femadh/runner/sink.py",
       (("                      if (b, df, dl) in kept]\n", "                      if False]\n"),)),
+    D("report_stopped_not_met", "report: a stopped run's accuracy printed as NOT met (a "
+      "verdict it has not made)", "femadh/runner/report.py",
+      (("        return (f\"not assessed ({res.status})\" if stopped and not a[\"met\"]",
+        "        return (f\"not assessed ({res.status})\" if False and not a[\"met\"]"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

@@ -454,6 +454,11 @@ def test_a_resumed_adaptive_run_ends_with_the_uninterrupted_runs_estimates(tmp_p
         cut = femadh.run(sc, tmp_path / "cut", progress=False, figures=False,
                          time_limit=400.0)
     assert cut.status == "time limit" and len(cut.jumps) >= 1
+    # what it prints: its accuracy not assessed, never "NOT met" (a verdict it has not made)
+    from femadh.runner.report import headline_lines
+
+    acc = [ln for ln in headline_lines(cut) if ln.startswith("accuracy ")]
+    assert acc and all("not assessed (time limit)" in ln for ln in acc), acc
     assert femadh.run(sc, tmp_path / "cut", progress=False, figures=False,
                       resume=True).status == "converged"
     a, b = summary(tmp_path / "fresh"), summary(tmp_path / "cut")

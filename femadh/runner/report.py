@@ -36,6 +36,13 @@ def headline_lines(res):
         out.append(f"F_ex(d = {hl['d_deepest_m'] * 1e9:.4g} nm) = "
                    f"{_force(hl['F_ex_deepest_N'], hl.get('F_ex_deepest_N_error'))}, F_LJ = "
                    f"{_force(hl['F_LJ_deepest_N'], hl.get('F_LJ_deepest_N_error'))}")
+    # a run stopped by a signal or its time limit has not judged its accuracy: it says so
+    # (a newcomer read "NOT met" after a Ctrl-C as a verdict on the numbers)
+    stopped = getattr(res, "status", None) in ("interrupted", "time limit")
+
+    def verdict(a):
+        return (f"not assessed ({res.status})" if stopped and not a["met"]
+                else "met" if a["met"] else "NOT met")
     if res.accuracy and res.accuracy.get("steps"):
         a = res.accuracy
         grid = (f"{a['nodes']} nodes, band spacing {a['spacing_m'] * 1e9:.3g} nm to "
@@ -44,11 +51,11 @@ def headline_lines(res):
         # a request refused before any grid ran has no radius: say so, not crash on None
         radius = (f", analysis radius {a['analysis_radius_m'] * 1e6:.4g} µm"
                   if a.get("analysis_radius_m") is not None else "")
-        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'}: {grid}"
+        out.append(f"accuracy {a['target']:g} {verdict(a)}: {grid}"
                    f"{radius} after {len(a.get('steps', ()))} run(s)")
     if res.accuracy and res.accuracy.get("route") == "edge-branch":
         a = res.accuracy
-        out.append(f"accuracy {a['target']:g} {'met' if a['met'] else 'NOT met'} on the edge "
+        out.append(f"accuracy {a['target']:g} {verdict(a)} on the edge "
                    f"route: {a['members']} grids, the finest {a['nodes']} nodes, estimated "
                    f"relative error {a['estimated_rel_error']:.1g} of the max adhesion")
     for j in res.jumps:
