@@ -165,9 +165,15 @@ def check_cost(scene, force=False):
                              "to run it anyway")
         return
     if scene.accuracy is not None and scene.accuracy < MIN_REACHABLE_ACCURACY:
+        from ..estimate.refine import BANDED_MAX_NODES, UNIFORM_MAX_NODES
+
+        # the budget of the grid the request runs on: the adaptive (banded) family's, or the
+        # uniform accuracy mode's where the scene gives its nodes (it said 3200 for both)
+        budget = BANDED_MAX_NODES if getattr(scene, "adaptive", False) else UNIFORM_MAX_NODES
         raise SceneError(scene.path, "solver.accuracy", scene.accuracy,
                          f"a relative accuracy >= {MIN_REACHABLE_ACCURACY:g}: finer targets "
-                         "need more nodes than the budget (3200) allows (use --force to try)")
+                         f"need more nodes than the budget ({budget}) allows (use --force to "
+                         "try)")
     t, what = time_estimate(scene)
     if t > MAX_REASONABLE_S:
         key, value = ("solver.nodes", scene.nodes) if scene.grid is None else (
