@@ -78,6 +78,10 @@ def test_values_and_points_are_validated_before_anything_runs(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "point 1" in err and "effects.asperity_gap.sigma" in err and "-2 nm" in err
     assert not (tmp_path / "s" / "points").exists()
+    # nothing to vary (no --vary, no [study] table): the line says how to give it
+    assert main(["study", "sweep", str(FIG3), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "study.vary" in err and "--vary KEY=VALUES" in err and err.count("\n") == 1
 
 
 def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_path):

@@ -83,7 +83,10 @@ def study_points(scene, vary, *, zip_=False):
         naming the key, the value, what was expected and how many points it concerns).
     """
     if not vary:
-        raise SceneError(scene.path, "study.vary", vary, "at least one key to vary")
+        raise SceneError(scene.path, "study.vary", vary, "at least one key to vary: "
+                         "--vary KEY=VALUES on the command line (e.g. --vary "
+                         "effects.asperity_gap.sigma='0.5 nm,1 nm') or a [study] table with "
+                         "vary in the scene")
     keys = list(vary)
     lists = [parse_values(vary[k], k) for k in keys]
     if zip_:
