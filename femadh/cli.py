@@ -500,7 +500,10 @@ def _sweep(scene, args):
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())
         _error(f"study {exc}: {kept} of {len(st.points)} points finished and kept in {out} "
-               "(study.csv); run the same command again to compute the others")
+               "(study.csv); " + ("run the same command again to compute the others"
+                                  if kept < len(st.points) else
+                                  "none is left to compute (the same command again draws "
+                                  "study.png)"))
         return exc.exit_code
     n, failed = len(study.points), study.failed
     for note in study.notes:

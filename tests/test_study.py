@@ -129,7 +129,8 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     assert _table(tmp_path / "here") == rows
 
 
-def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, monkeypatch):
+def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, monkeypatch,
+                                                                   capsys):
     """A SIGINT whose stop flag is raised as the last point's record comes in (every point
     finished, nothing left to stop): the study still ends Interrupted, with every point
     kept and its table written - it ended as if the signal had not been sent (exit 0; found
@@ -148,6 +149,12 @@ def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, mon
         run_study(small(), vary, tmp_path / "s", workers=1, estimate=False, figures=False)
     assert {r["status"] for r in info.value.study.records.values()} == {"converged"}
     assert len(info.value.study.records) == 2 and len(_table(tmp_path / "s")) == 3
+    # the command's line then says nothing is left to compute (not "compute the others")
+    assert main(["study", "sweep", str(FIG3), "--vary", "effects.asperity_gap.sigma=0.5 nm,1 nm",
+                 "--out", str(tmp_path / "c"), "--workers", "1", "--no-estimate",
+                 "--no-figures", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert "2 of 2 points finished" in err and "none is left to compute" in err
 
 
 def test_killed_study_loses_no_completed_point(tmp_path):
