@@ -119,7 +119,10 @@ def _parser():
     c.add_argument("scene", help="scene file (TOML)")
     c.add_argument("--force", action="store_true",
                    help="pass a scene whose estimated time is beyond reason")
-    sub.add_parser("keys", help="print every scene key (markdown reference page)")
+    sub.add_parser("keys", help="print every scene key (markdown reference page)",
+                   description="Print every scene key - its unit, range, default and "
+                               "meaning - as a markdown page (the scene file's reference; "
+                               "`femadh keys > keys.md`).")
     m = sub.add_parser("mesh", help="build (or fetch from cache) the FE mesh of a scene",
                        description="Mesh the half-space of a scene with gmsh (cached by a hash "
                                    "of its parameters) and write it as .msh and .vtu.")
