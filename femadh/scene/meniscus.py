@@ -111,7 +111,8 @@ MENISCUS = Table("meniscus", "Capillary meniscus with an adsorbed film between a
 ))
 
 OUTPUT = Table("output", "Outputs.", (
-    Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
+    Key("dir", "string", "Output folder (default out/<scene name>; a relative path is taken "
+        "from the current folder, as --out is, not from the scene file's).", default=None),
     Key("vtk", "bool", "VTK surfaces of revolution of the FE menisci.", default=True),
 ))
 

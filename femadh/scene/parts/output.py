@@ -4,7 +4,8 @@ from dataclasses import dataclass
 from ...schema import Key, Table
 
 OUTPUT = Table("output", "Outputs.", (
-    Key("dir", "string", "Output folder (default out/<scene name>).", default=None),
+    Key("dir", "string", "Output folder (default out/<scene name>; a relative path is taken "
+        "from the current folder, as --out is, not from the scene file's).", default=None),
     Key("vtk", "bool", "VTK volume and surface files of every state as it converges (FE only; "
         "default false: `femadh render RUN_DIR --state K` writes and draws the states you ask "
         "for from fields.csv).", default=None),
