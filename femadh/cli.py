@@ -498,7 +498,8 @@ def _sweep(scene, args):
                           progress=not args.quiet and sys.stderr.isatty(),
                           quantity=args.quantity,
                           estimate="peak" if args.no_estimate else True,
-                          figures=not args.no_figures)
+                          figures=not args.no_figures,
+                          source="--vary" if args.vary else None)
     except Interrupted as exc:
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())

@@ -2230,6 +2230,9 @@ DEFECTS = [
       "verdict it has not made)", "femadh/runner/report.py",
       (("        return (f\"not assessed ({res.status})\" if stopped and not a[\"met\"]",
         "        return (f\"not assessed ({res.status})\" if False and not a[\"met\"]"),)),
+    D("study_vary_error_on_file", "study: a --vary value's error named against the scene "
+      "file", "femadh/studies/sweep.py",
+      (("                if source and e.key in keys:", "                if False:"),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

@@ -77,6 +77,9 @@ def test_values_and_points_are_validated_before_anything_runs(tmp_path, capsys):
                  "effects.asperity_gap.sigma=1 nm,-2 nm", "--out", str(tmp_path / "s")]) == 2
     err = capsys.readouterr().err
     assert "point 1" in err and "effects.asperity_gap.sigma" in err and "-2 nm" in err
+    # ... and where the value came from: the command line, not the scene file (which holds
+    # no such value: the newcomer trial was sent to look for it there)
+    assert err.startswith("femadh: error: --vary effects.asperity_gap.sigma: ")
     assert not (tmp_path / "s" / "points").exists()
     # nothing to vary (no --vary, no [study] table): the line says how to give it
     assert main(["study", "sweep", str(FIG3), "--out", str(tmp_path / "s")]) == 2

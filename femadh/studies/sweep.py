@@ -72,7 +72,7 @@ class StudyRun:
         return iter((self.points, self.records))
 
 
-def study_points(scene, vary, *, zip_=False):
+def study_points(scene, vary, *, zip_=False, source=None):
     """Every point of a study, validated. ``vary`` maps dotted keys to value specs.
 
     Raises
@@ -80,7 +80,9 @@ def study_points(scene, vary, *, zip_=False):
     SceneError
         After checking every point: one line per distinct reason (the same reason at many
         points, e.g. a bare number for a length at every value of a range, is one line
-        naming the key, the value, what was expected and how many points it concerns).
+        naming the key, the value, what was expected and how many points it concerns). A
+        varied key's error names where its values came from, ``source`` (e.g. the command
+        line's "--vary"; default: the scene file, whose [study] table gave them).
     """
     if not vary:
         raise SceneError(scene.path, "study.vary", vary, "at least one key to vary: "
@@ -105,6 +107,9 @@ def study_points(scene, vary, *, zip_=False):
             sc = scene.replace(changes)
         except SceneError as exc:
             for e in getattr(exc, "errors", [exc]):
+                if source and e.key in keys:
+                    # the value is the varied one: it came from ``source``, not the file
+                    e = SceneError(f"{source} {e.key}", e.key, e.value, e.expected)
                 groups.setdefault((e.key, mask_numbers(e.expected)), []).append((i, e))
             continue
         points.append(Point(i, changes, sc, scene_id(sc)))
@@ -161,7 +166,8 @@ def _label(changes):
 
 
 def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
-              progress=None, quantity="max_adhesion_N", estimate=True, figures=True):
+              progress=None, quantity="max_adhesion_N", estimate=True, figures=True,
+              source=None):
     """Run a study.
 
     Parameters
@@ -186,6 +192,8 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
     figures : bool
         Draw study.png (False: the command line's --no-figures; its points draw none either
         way).
+    source : str, optional
+        Where ``vary`` came from, for its values' errors (:func:`study_points`).
 
     Returns
     -------
@@ -199,7 +207,7 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
         SIGINT/SIGTERM to this process: the workers are stopped, every finished point is
         kept (and in study.csv); running the study again computes the rest.
     """
-    points = study_points(scene, vary, zip_=zip_)
+    points = study_points(scene, vary, zip_=zip_, source=source)
     out = Path(out_dir)
     from ..io.run_folder import RunFolder
 
