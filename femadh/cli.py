@@ -503,11 +503,12 @@ def _sweep(scene, args):
     except Interrupted as exc:
         st = exc.study
         kept = sum(finished(r) for r in st.records.values())
-        _error(f"study {exc}: {kept} of {len(st.points)} points finished and kept in {out} "
-               "(study.csv); " + ("run the same command again to compute the others"
-                                  if kept < len(st.points) else
-                                  "none is left to compute (the same command again draws "
-                                  "study.png)"))
+        left = getattr(st, "remaining", len(st.points) - kept)
+        _error(f"study {exc}: {len(st.points) - left} of {len(st.points)} points finished and "
+               f"kept in {out} (study.csv); "
+               + (f"run the same command again to compute the other {left}" if left else
+                  "none is left to compute" + ("" if args.no_figures else
+                                               " (the same command again draws study.png)")))
         return exc.exit_code
     n, failed = len(study.points), study.failed
     for note in study.notes:

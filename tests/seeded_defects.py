@@ -2233,6 +2233,21 @@ DEFECTS = [
     D("study_vary_error_on_file", "study: a --vary value's error named against the scene "
       "file", "femadh/studies/sweep.py",
       (("                if source and e.key in keys:", "                if False:"),)),
+    D("resume_estimate_stop_no_checkpoint", "run: a stop in the peak search or the estimate "
+      "leaves no checkpoint (the resumed members re-search their folds)",
+      "femadh/runner/contact.py",
+      (("        except Interrupted:\n            raise\n        except BaseException:\n"
+        "            done()\n            raise\n        done()\n",
+        "        except BaseException:\n            done()\n            raise\n        done()\n"),
+       ("        res.timings[\"solve_s\"] = time.perf_counter() - t1\n\n",
+        "        res.timings[\"solve_s\"] = time.perf_counter() - t1\n        life.on_stop = None\n\n"))),
+    D("study_kept_counts_redone", "study stopped: points the next run computes again counted "
+      "as kept", "femadh/studies/sweep.py",
+      (("                not (finished(r) and r.get(\"femadh\") == code_id() and serves(r, estimate))",
+        "                not finished(r)"),)),
+    D("study_tmp_under_live_lock", "study: a stale temporary file removed from a point's "
+      "folder whose run lock a live worker holds", "femadh/studies/sweep.py",
+      (("                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)\n", ""),)),
     D("resume_committed_not_loaded", "resume: the committed states not held in memory (the "
       "estimate's members traced whole: estimates differ from the uninterrupted run's)",
       "femadh/runner/sink.py",

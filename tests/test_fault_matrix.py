@@ -435,35 +435,57 @@ def test_a_signal_while_a_folder_is_claimed_leaves_no_lock(tmp_path, monkeypatch
     rf.RunFolder(tmp_path, "id", "x", "new").release()
 
 
-def test_a_resumed_adaptive_run_ends_with_the_uninterrupted_runs_estimates(tmp_path,
-                                                                         monkeypatch):
-    """The Fig 4 scene at its defaults (one adaptive trial, 285 nodes, a jump each way),
-    stopped by its time limit inside the sweep after its jump-in (the run's clock advanced 1 s
-    a reading, a 400-s limit) and resumed from its checkpoint: the summary equals the
-    uninterrupted run's, estimates and member records included, but for wall times. Before,
-    a resumed run held only a few committed states in memory, so its estimate's members
-    were traced whole ("the approach branch's states are not all in memory": Fig 3's F_LJ
-    at the deepest state's error 4.79e-8 -> 5.49e-8 N), and it held no fold records, so the
-    members traced the fine run's grid steps for their folds (44 solves where 27; the
-    hysteresis and jump-out errors moved in their last digits) - both found by reviews.
-    (Without a checkpoint - a kill -9 - the restarted branch differs at the solver's
-    tolerance: a review measured up to 1.1e-11 relative on Fig 3, 4.9e-10 on Fig 4, 1.9e-9
-    on the slider meniscus.)"""
-    import types
+class _Clock:
+    """The run's clock (femadh.interrupt.time) advanced 1 s at each reading: a time limit
+    then falls after a fixed number of safe points, on any host and at any load."""
 
+    def __init__(self):
+        self.t = 0.0
+
+    def monotonic(self):
+        self.t += 1.0
+        return self.t
+
+
+@pytest.fixture(scope="module")
+def fig4_fresh(tmp_path_factory):
+    """Fig 4 at its defaults run whole on the counting clock: (scene, folder, readings)."""
     import femadh.interrupt
 
+    out = tmp_path_factory.mktemp("fig4") / "fresh"
     sc = femadh.load_scene("validation/scenes/paper1_fig4.toml")
-    femadh.run(sc, tmp_path / "fresh", progress=False, figures=False)
-    ticks = [0.0]
+    clock = _Clock()
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(femadh.interrupt, "time", clock)
+        # (a limit it never reaches: the clock is read only where a limit is armed)
+        assert femadh.run(sc, out, progress=False, figures=False,
+                          time_limit=1e12).status == "converged"
+    return sc, out, clock.t
 
-    def monotonic():
-        ticks[0] += 1.0
-        return ticks[0]
+
+@pytest.mark.parametrize("at", [0.24, 0.85])
+def test_a_resumed_adaptive_run_ends_with_the_uninterrupted_runs_estimates(fig4_fresh, tmp_path,
+                                                                         monkeypatch, at):
+    """The Fig 4 scene at its defaults (one adaptive trial, 285 nodes, a jump each way),
+    stopped by its time limit on the counting clock at 24 % of its readings (inside the sweep,
+    after its jump-in; 1691 readings in all, the sweep's last at 1132) or at 85 % (in its
+    error estimate) and resumed from its checkpoint: the summary equals the uninterrupted
+    run's, estimates and member records included, but for wall times. Before, a resumed run
+    held only a few committed states in memory, so its estimate's members were traced whole
+    ("the approach branch's states are not all in memory": Fig 3's F_LJ at the deepest
+    state's error 4.79e-8 -> 5.49e-8 N), and it held no fold records, so the members traced
+    the fine run's grid steps for their folds (44 or 68-92 solves where 27; the hysteresis and
+    jump-out errors moved in their last digits; a stop in the estimate left no checkpoint at
+    all) - found by reviews and a newcomer trial. (Without a checkpoint - a kill -9 - the
+    restarted branch differs at the solver's tolerance: a review measured up to 1.1e-11
+    relative on Fig 3, 4.9e-10 on Fig 4, 1.9e-9 on the slider meniscus.)"""
+    import femadh.interrupt
+
+    sc, fresh, readings = fig4_fresh
     with monkeypatch.context() as m:
-        m.setattr(femadh.interrupt, "time", types.SimpleNamespace(monotonic=monotonic))
+        m.setattr(femadh.interrupt, "time", _Clock())
         cut = femadh.run(sc, tmp_path / "cut", progress=False, figures=False,
-                         time_limit=400.0)
+                         time_limit=float(int(at * readings)))
     assert cut.status == "time limit" and len(cut.jumps) >= 1
     # what it prints: its accuracy not assessed, never "NOT met" (a verdict it has not made)
     from femadh.runner.report import headline_lines
@@ -472,7 +494,7 @@ def test_a_resumed_adaptive_run_ends_with_the_uninterrupted_runs_estimates(tmp_p
     assert acc and all("not assessed (time limit)" in ln for ln in acc), acc
     assert femadh.run(sc, tmp_path / "cut", progress=False, figures=False,
                       resume=True).status == "converged"
-    a, b = summary(tmp_path / "fresh"), summary(tmp_path / "cut")
+    a, b = summary(fresh), summary(tmp_path / "cut")
     for s in (a, b):
         for step in s["accuracy"]["steps"]:
             step.pop("wall_time_s")

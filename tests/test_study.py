@@ -123,8 +123,20 @@ def test_two_varied_keys_make_one_point_each_and_a_rerun_computes_nothing(tmp_pa
     # place: a kill -9 between the two) is removed by the next run of the study
     stale = f.parent / ".record.json.abc123.tmp"
     stale.write_text("{")
-    again = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    # ... but not in a point's folder whose run lock is held (a worker orphaned by a killed
+    # driver, still writing there)
+    import fcntl
+
+    busy = sorted((tmp_path / "here").glob("points/*/record.json"))[1].parent
+    (busy / ".summary.json.xyz.tmp").write_text("{")
+    fd = os.open(busy / ".femadh.lock", os.O_RDWR | os.O_CREAT)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    try:
+        again = run_study(sc, vary, tmp_path / "here", workers=1, estimate=False)
+    finally:
+        os.close(fd)
     assert not stale.exists() and (tmp_path / "here" / "study.png").exists()
+    assert (busy / ".summary.json.xyz.tmp").exists()
     timing = json.loads((tmp_path / "here" / "timing.json").read_text())
     assert timing["computed"] == 1 and timing["reused"] == 3
     assert any("computed by other femadh code run again" in n for n in again.notes)
@@ -158,6 +170,16 @@ def test_a_signal_as_the_last_point_finishes_still_stops_the_study(tmp_path, mon
                  "--no-figures", "--quiet"]) == 130
     err = capsys.readouterr().err
     assert "2 of 2 points finished" in err and "none is left to compute" in err
+    # points finished without the estimates now asked for are run again: not counted kept
+    # (a review: "2 of 2 ... none is left" was said of points the next run computes)
+    def stopped(todo, out, workers, scheduler, estimate, stop, notes):
+        stop.append(signal.SIGINT)
+        yield from ()
+    monkeypatch.setattr(sweep, "execute", stopped)
+    assert main(["study", "sweep", str(FIG3), "--vary", "effects.asperity_gap.sigma=0.5 nm,1 nm",
+                 "--out", str(tmp_path / "c"), "--workers", "1", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert "0 of 2 points finished" in err and "compute the other 2" in err
 
 
 def test_killed_study_loses_no_completed_point(tmp_path):

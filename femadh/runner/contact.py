@@ -14,7 +14,8 @@ import warnings
 
 from .._threads import blas_threads
 from ..contact import trace
-from ..errors import ConvergenceError, MeshResolutionWarning, OutputError  # noqa: F401
+from ..errors import (ConvergenceError, Interrupted, MeshResolutionWarning,  # noqa: F401
+                      OutputError)
 from ..scene import build_problem, scene_id
 from .. import interrupt
 from .estimates import GuardError
@@ -183,15 +184,28 @@ def _run(scene, folder, *, progress, run, operator=None, estimate=True, resume_f
         else:
             trace_steps(scene, problem, sink, resume)
         res.timings["solve_s"] = time.perf_counter() - t1
-        life.on_stop = None
-        if folder is not None and (folder.path / CHECKPOINT).exists():
-            (folder.path / CHECKPOINT).unlink()     # the sweep is complete: not needed
-        if res.status == "running":
-            _finish(scene, res, problem, sink, estimate, run)
-            if folder is not None and res.instrument is not None:
-                from ..io.writers import write_instrument
 
-                write_instrument(folder.path, res)
+        def done():
+            life.on_stop = None
+            if folder is not None and (folder.path / CHECKPOINT).exists():
+                (folder.path / CHECKPOINT).unlink()     # the run is complete: not needed
+        # a stop in the peak search or the estimate still saves the checkpoint: its fold
+        # records are where the resumed run's members start their fold searches (without
+        # them a run stopped there resumed with the jump and hysteresis errors moved in
+        # their last digits - found by a review)
+        try:
+            if res.status == "running":
+                _finish(scene, res, problem, sink, estimate, run)
+                if folder is not None and res.instrument is not None:
+                    from ..io.writers import write_instrument
+
+                    write_instrument(folder.path, res)
+        except Interrupted:
+            raise
+        except BaseException:
+            done()
+            raise
+        done()
     return res
 
 

@@ -265,7 +265,13 @@ def run_study(scene, vary, out_dir, *, zip_=False, workers=None, scheduler=None,
             result.records.update({k: r for k, r in _load_records(out).items() if k in ids})
             write_table(points, result.records, out)
             _timing(out, result, t0)
-            exc.study = result          # the CLI says how many points are kept
+            # the CLI says how many points are kept and how many the next run computes (a
+            # finished record of other code, or without the estimates asked for, is run
+            # again: not kept)
+            result.remaining = sum(
+                not (finished(r) and r.get("femadh") == code_id() and serves(r, estimate))
+                for r in (result.records.get(p.id, {}) for p in points))
+            exc.study = result
             raise
         finally:
             if bar is not None:
@@ -305,15 +311,32 @@ def _timing(out, result, t0):
 def _remove_stale_temporaries(out):
     """Remove the temporary files a killed worker left in the points' folders (each file is
     written to ``.NAME.XXXX.tmp`` and renamed into place, femadh.io.atomic; a kill -9 between
-    the two leaves it). Called with the study's lock held and before any worker starts: no
-    writer of this study can own one."""
+    the two leaves it). Called with the study's lock held and before any worker starts; a
+    point's folder whose run lock is held (a worker orphaned by a killed driver, still
+    running its point - found by a review) is left alone."""
+    import fcntl
+    import os
+
+    from ..io.run_folder import LOCK
+
     pts = Path(out) / "points"
-    if pts.exists():
-        for f in pts.glob("*/.*.tmp"):
-            try:
+    if not pts.exists():
+        return
+    for folder in sorted({f.parent for f in pts.glob("*/.*.tmp")}):
+        # a worker orphaned by a killed driver may still be writing in its point's folder:
+        # it holds that folder's run lock, and its files are left alone
+        fd = None
+        try:
+            if (folder / LOCK).exists():
+                fd = os.open(folder / LOCK, os.O_RDONLY)
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            for f in folder.glob(".*.tmp"):
                 f.unlink()
-            except OSError:
-                pass                # (gone already, or not ours to remove: left as it is)
+        except OSError:
+            pass                # (held by a live writer, or gone already: left as it is)
+        finally:
+            if fd is not None:
+                os.close(fd)
 
 
 def _load_records(out):
