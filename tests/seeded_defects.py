@@ -554,8 +554,8 @@ DEFECTS = [
       (("if not (d1 * d2 > 0 and abs(d2) > abs(d1)):", "if not d1 * d2 > 0:"),)),
     D("est_grid_part_half", "the grid part halved on its way into the breakdown",
       "femadh/runner/estimates.py",
-      (('ratio=ratio, ratio2=ratio2).items():\n            parts.setdefault(k, {})["grid"] = v',
-        'ratio=ratio, ratio2=ratio2).items():\n            parts.setdefault(k, {})["grid"] = '
+      (('ratio=ratio, ratio2=ratio2).items():\n                parts.setdefault(k, {})["grid"] = v',
+        'ratio=ratio, ratio2=ratio2).items():\n                parts.setdefault(k, {})["grid"] = '
         '0.5 * v'),)),
     D("est_total_signed", "total: |sum of the signed parts| (grid and tail cancel)",
       "femadh/runner/estimates.py",
@@ -1249,8 +1249,8 @@ DEFECTS = [
         "        if True:\n            return rc"),)),
     D("est_deepest_always_skipped", "family members skip the deepest state even without "
       "edge-placed members", "femadh/runner/estimates.py",
-      (("            deepest = locked is None or not LOCKED_DEEPEST_ONLY",
-        "            deepest = False"),)),
+      (("    deepest = locked is None or not LOCKED_DEEPEST_ONLY\n",
+        "    deepest = False\n"),)),
     D("est_locked_not_applied", "edge-placed members solved but their grid part not applied",
       "femadh/runner/estimates.py",
       (("    if locked is not None and levels:", "    if locked is not None and not levels:"),)),
@@ -2015,8 +2015,8 @@ DEFECTS = [
         '           "estimate": "errors", "femadh": code_id(), "pid": os.getpid()}'),)),
     D("ui_study_no_estimate_ignored", "study sweep --no-estimate still estimates",
       "femadh/cli.py",
-      (('                          estimate="peak" if args.no_estimate else True)',
-        '                          estimate=True)'),)),
+      (('                          estimate="peak" if args.no_estimate else True,',
+        '                          estimate=True,'),)),
     # -- the Green operator assembled in blocks of rows, a non-finite stiffness refused
     #    (branch greenop, seeded_defects_greenop.md)
     D("greenop_block_edge_side", "block assembly: a node on its annulus' inner edge taken "
@@ -2258,7 +2258,8 @@ DEFECTS = [
     # -- the adaptive loop's deferred estimate completed (review of pace2)
     D("defer_stop_keeps_partial", "adaptive: a stop while the kept trial's deferred estimate "
       "is completed leaves the judged numbers' partial breakdown", "femadh/runner/estimates.py",
-      (("        res.stop(exc)\n        abandon(res.error)\n", "        res.stop(exc)\n"),)),
+      (("        res.stop(exc)\n        if not done:\n            abandon(res.error)\n",
+        "        res.stop(exc)\n"),)),
     D("defer_stopped_trial_completed", "adaptive: a kept trial stopped after its estimate has "
       "its deferred rest solved", "femadh/runner/estimates.py",
       (('    if res.status not in ("converged", "failed"):\n        abandon(',
@@ -2285,7 +2286,8 @@ DEFECTS = [
       (("        return complete()\n    spent", "        return partial\n    spent"),)),
     D("defer_stop_swallowed", "adaptive: a stop while completing the kept trial's estimate "
       "swallowed (the run ends converged)", "femadh/runner/estimates.py",
-      (("        res.stop(exc)\n        abandon(res.error)\n", "        pass\n"),)),
+      (("        res.stop(exc)\n        if not done:\n            abandon(res.error)\n",
+        "        pass\n"),)),
     D("defer_rest_fail_uses_judged", "estimate: a member's failed rest falls back on its judged "
       "numbers instead of its whole trace", "femadh/runner/estimates.py",
       (('                    if hl_m is None:\n                        r = run(member, progress=False, estimate="peak")\n                if hl_m is not None:',

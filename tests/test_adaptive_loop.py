@@ -17,7 +17,7 @@ from femadh.discretisation import family as family_mod
 from femadh.errors import ConvergenceError, Interrupted, MeshResolutionWarning, TimeLimitReached
 from femadh.estimate import (AnalysisRadiusError, BoundError, GuardError, TrappingError,
                              check_state, failure_kind)
-from femadh.runner import accuracy, adaptive
+from femadh.runner import accuracy, adaptive, estimates
 from femadh.runner.result import ContactResult
 
 FIG3 = "validation/scenes/paper1_fig3.toml"
@@ -319,9 +319,9 @@ def test_an_error_part_that_is_not_finite_is_never_met():
     hl = {"max_adhesion_N": 1e-5, "F_ex_deepest_N": -1e-3, "F_LJ_deepest_N": 2e-4}
     good = {"max_adhesion_N": {"total": 1e-9, "tail": 0.0},
             "F_ex_deepest_N": {"total": 1e-9, "tail": 0.0}}
-    grid, tail = accuracy._relative(SimpleNamespace(headline=hl, estimates=good))
+    grid, tail = estimates.judged_errors(SimpleNamespace(headline=hl, estimates=good))
     assert grid == pytest.approx(1e-4, rel=1e-12, abs=0) and tail == 0.0
     for part in ("total", "tail"):
         bad = {**good, "F_LJ_deepest_N": {"total": 1e-9, "tail": 0.0, part: math.nan}}
-        assert accuracy._relative(SimpleNamespace(headline=hl, estimates=bad)) == \
+        assert estimates.judged_errors(SimpleNamespace(headline=hl, estimates=bad)) == \
             (math.inf, math.inf)

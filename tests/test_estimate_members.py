@@ -70,7 +70,7 @@ def fig4_both():
     return out
 
 
-#: the numbers femadh.runner.accuracy._relative judges a trial by (and where the peak is)
+#: the numbers femadh.runner.estimates.judged_errors judges a trial by (and where the peak is)
 JUDGED = ("max_adhesion_N", "F_ex_deepest_N", "F_LJ_deepest_N", "d_at_max_adhesion_m")
 
 

@@ -9,8 +9,7 @@ import math
 
 from ..scene import scene_id
 from ..estimate.refine import Budget, refine_until_met
-from .estimates import MAX_NODES, MAX_REFINEMENTS, variant
-from .estimates import judged_errors as _relative  # (the loop's criterion)
+from .estimates import MAX_NODES, MAX_REFINEMENTS, judged_errors, variant
 
 #: the failure kind (``result.failure_kind``) a larger disk resolves: the contact reached
 #: the analysis radius (a doubles, N doubles: the spacing stays)
@@ -42,7 +41,7 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
             res = run(trial, out_dir, figures=figures, progress=progress, estimate=True,
                       folder_id=scene_id(scene), **mode)
         mode.update(overwrite=True, resume=False)    # later trials replace earlier ones
-        grid, tail = _relative(res) if res.status == "converged" else (math.inf, 0.0)
+        grid, tail = judged_errors(res) if res.status == "converged" else (math.inf, 0.0)
         records.append({"nodes": nodes, "analysis_radius_m": trial.analysis_radius,
                         "status": res.status, "grid_rel_error": grid,
                         "tail_rel_error": tail, "wall_time_s": res.wall_time})

@@ -109,12 +109,6 @@ FOLLOW_HALF_SPACINGS, FOLLOW_GRADING_SPACINGS = 24, 8
 FOLLOW_HALF = 1 / 6
 
 
-def _relative(res):
-    from .accuracy import _relative as rel
-
-    return rel(res)
-
-
 def _feature_radius(res, problem_shape, gap):
     """Largest radius (m) where a kept surface profile's gap is at most ``gap``."""
     out = 0.0
@@ -284,7 +278,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
     step builds that member (capped)."""
     from ..io.progress import phase
     from ..scene import scene_id
-    from .estimates import deferring, variant
+    from .estimates import deferring, judged_errors, variant
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
@@ -319,7 +313,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         tr.operator = None            # run: its dense operator need not outlive it
         ahead["res"] = res
         mode.update(overwrite=True, resume=False)     # later trials replace earlier ones
-        grid_e, tail_e = (_relative(res) if res.status == "converged" and estimate is True
+        grid_e, tail_e = (judged_errors(res) if res.status == "converged" and estimate is True
                           else (math.nan, math.nan))
         steps.append({"nodes": tr.nodes, "spacing_m": tr.spacing,
                       "band_m": tr.family.band, "analysis_radius_m": tr.family.radius,
