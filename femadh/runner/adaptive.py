@@ -39,6 +39,7 @@ on a band that follows the edge instead (:func:`_follow_trial`, validation/resul
 sigma03_follow.md).
 """
 from dataclasses import dataclass
+import contextlib
 import math
 import time
 
@@ -363,7 +364,9 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         from .estimates import complete_estimate
 
         try:
-            with phase("estimate"):
+            # (a phase of the display only where there is a deferred rest to make)
+            with phase("estimate") if getattr(res, "pending_estimate", None) is not None \
+                    else contextlib.nullcontext():
                 complete_estimate(res)          # the kept trial's estimate made whole
         except BaseException as exc:
             # a bug while completing: res is "failed" with its error (complete_estimate);
