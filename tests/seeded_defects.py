@@ -2292,6 +2292,18 @@ DEFECTS = [
       "numbers instead of its whole trace", "femadh/runner/estimates.py",
       (('                    if hl_m is None:\n                        r = run(member, progress=False, estimate="peak")\n                if hl_m is not None:',
         '                    if hl_m is None:\n                        hl_m, how = rm.hl, rm.m.solves\n                if hl_m is not None:'),)),
+    D("first_from_plan", "adaptive: a finer request's first member scaled from the plan's "
+      "spacing where the trapping cap binds (the old rule)", "femadh/runner/adaptive.py",
+      (("            h = min(ref.spacing * scale, family.band / MIN_BAND_NODES)\n",
+        "            h = min(plan.spacing * scale, family.band / MIN_BAND_NODES)\n"),)),
+    D("first_cap_inverted", "adaptive: the capped 1e-3 member's spacing used only where the cap "
+      "does not bind", "femadh/runner/adaptive.py",
+      (("ref.follow is None and ref.spacing < ref.asked:",
+        "ref.follow is None and ref.spacing >= ref.asked:"),)),
+    D("first_scale_squared", "adaptive: the first member's scaling (target / 1e-3)^(2/ORDER)",
+      "femadh/runner/adaptive.py",
+      (("    scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)\n",
+        "    scale = (target / REFERENCE_ACCURACY) ** (2.0 / ORDER)\n"),)),
 ]
 
 

@@ -19,6 +19,7 @@ from femadh.errors import MeshResolutionWarning
 from femadh.runner import adaptive
 from femadh.runner.result import ContactResult
 
+FIG3, FIG4 = "validation/scenes/paper1_fig3.toml", "validation/scenes/paper1_fig4.toml"
 
 
 
@@ -152,3 +153,30 @@ def test_a_real_run_sizes_its_second_member_by_the_rule():
     p = math.log(e0 / e1) / math.log(steps[0]["spacing_m"] / steps[1]["spacing_m"])
     assert adaptive._order(steps[1], steps[:1]) == pytest.approx(
         min(adaptive.ORDER_BOUNDS[1], max(adaptive.ORDER_BOUNDS[0], p)), rel=1e-12, abs=0)
+
+
+def test_a_finer_request_starts_from_the_capped_member():
+    """The first member of a request finer than 1e-3 is the 1e-3 member scaled by
+    (target / 1e-3)^(1/ORDER); where the trapping cap binds on that member (the Fig 4 scene,
+    sigma = 0.5 nm: the plan's 39.3 nm capped to 25.6 nm) the scaling starts from the capped
+    spacing (at 3e-4: 11.45 nm, 624 nodes; from the plan's it was 17.6 nm, and at 1e-4 the
+    loop then refined 871 -> 2791 nodes: validation/results/first_member.md). Where the cap
+    does not bind (Fig 3: 43.75 nm) the plan's spacing is scaled as before, and at 1e-3 the
+    first member is the capped one itself. Exact identities of the rule (no solve)."""
+    from femadh.discretisation import plan_grid
+
+    def first(path, target):
+        sc = femadh.load_scene(path).replace({"solver.accuracy": target})
+        plan = plan_grid(sc.effects, sc.gap.sigma, sc.sphere, sc.analysis_radius,
+                         sc.d_values, target)
+        return sc, plan, adaptive.first_trial(sc, plan, target)
+
+    scale = 0.3 ** (1 / adaptive.ORDER)
+    sc, plan, at_ref = first(FIG4, 1e-3)
+    assert at_ref.spacing < 0.7 * plan.spacing           # the cap binds (25.6 / 39.3 nm)
+    _, plan4, tr = first(FIG4, 3e-4)
+    assert tr.follow is None and tr.spacing == pytest.approx(at_ref.spacing * scale,
+                                                             rel=1e-12, abs=0)
+    assert tr.spacing < plan4.spacing * scale            # not the plan's scaled spacing
+    sc3, plan3, tr3 = first(FIG3, 3e-4)
+    assert tr3.spacing == pytest.approx(plan3.spacing * scale, rel=1e-12, abs=0)

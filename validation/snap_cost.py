@@ -130,9 +130,7 @@ def first_trial_problem(sigma="0.488888888889 nm", rel=0.15, start="4 nm"):
     target = scene.target_accuracy
     plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
                      scene.d_values, target)
-    h = min(plan.spacing * (target / adaptive.REFERENCE_ACCURACY) ** (1.0 / adaptive.ORDER),
-            plan.family.band / adaptive.MIN_BAND_NODES)
-    tr = adaptive._trial(scene, plan.family, h)
+    tr = adaptive.first_trial(scene, plan, target)
     trial = variant(scene, grid=tr.grid(), radius=tr.family.radius)
     return trial, build_problem(trial, operator=tr.operator)
 
