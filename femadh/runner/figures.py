@@ -156,13 +156,15 @@ def _read_result(scene, path, prev):
     folder: the curves from curve.csv (repr floats: the same bits), the surface profiles the
     run kept (the same picks as :class:`~femadh.runner.sink.Sink`) and the nodes from
     fields.csv, the rest (headline numbers, estimates, jumps, accuracy, grid, warnings,
-    timings) from summary.json. None where the files do not hold what the summary records
-    (a curve.csv of other length or numbers, a missing state in fields.csv)."""
+    timings) from summary.json. None where the files do not hold what the summary records:
+    a curve.csv row that does not match its checksum (seeded with the run's scene id,
+    :func:`~femadh.io.writers.row_crc`) or the summary's record of its branches, a state
+    missing from fields.csv."""
     import csv
 
     import numpy as np
 
-    from ..io.writers import CRC
+    from ..io.writers import CRC, row_crc
     from .result import ContactResult, contact_summary
     from .sink import _picks
     from .tracing import branch_plan
@@ -170,11 +172,13 @@ def _read_result(scene, path, prev):
     try:
         with open(path / "curve.csv", newline="") as f:
             head, *rows = list(csv.reader(f))
+        n_crc, run_id = head.index(CRC), prev["run_id"]
         cols = [c for c in head if c not in ("state", "branch", CRC)]
         where = [head.index(c) for c in cols]
         per_branch, table = {}, {}
         for k, r in enumerate(rows):
-            if len(r) != len(head) or int(r[0]) != k:
+            if len(r) != len(head) or int(r[0]) != k or \
+                    row_crc(r[:n_crc], run_id) != r[n_crc]:
                 return None
             per_branch.setdefault(r[1], []).append(k)
             table.setdefault(r[1], []).append([r[j] for j in where])
