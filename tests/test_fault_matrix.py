@@ -538,7 +538,6 @@ def _stop_in_figures_then_resume(sc, out, tmp_path):
     import femadh.runner.contact as contact
     from femadh.io.atomic import write_atomic
     from femadh.runner.run import run
-    from validation.fault_matrix import _change_digit
 
     drawn = []
 
@@ -568,7 +567,7 @@ def _stop_in_figures_then_resume(sc, out, tmp_path):
                                              "failure_kind": None}
     # a changed digit in curve.csv: not the run the summary records, resumed by solving
     shutil.copytree(out, tmp_path / "damaged")
-    _change_digit(tmp_path / "damaged" / "curve.csv", 4)
+    DAMAGES["a changed digit in curve.csv"](tmp_path / "damaged")
     with pytest.MonkeyPatch.context() as m:
         m.setattr(contact, "_run", no_solve)
         with pytest.raises(Solved):
