@@ -86,8 +86,9 @@ def resume_figures(scene, out_dir, folder_id, figures=True):
     or a run this reader does not rebuild: an arclength trace, an [instrument], the edge
     route, an accuracy loop on uniform grids whose trial may not have been its last, files
     that do not hold what the summary records): the caller resumes as any stopped run.
-    A stop while drawing again leaves the folder as it was (status "interrupted", the
-    outcome kept); the summary is written only once the figures are on disk.
+    summary.json is rewritten once, at the end: with the outcome once the figures are on
+    disk, else (stopped again while drawing) as the first stop left it, the outcome kept; a
+    kill while drawing leaves it as it was (each state on disk consistent: resumed alike).
     """
     from pathlib import Path
 
@@ -156,7 +157,9 @@ def _read_result(scene, path, prev):
     folder: the curves from curve.csv (repr floats: the same bits), the surface profiles the
     run kept (the same picks as :class:`~femadh.runner.sink.Sink`) and the nodes from
     fields.csv, the rest (headline numbers, estimates, jumps, accuracy, grid, warnings,
-    timings) from summary.json. None where the files do not hold what the summary records:
+    timings) from summary.json; its scene is the one given (an adaptive run's kept trial
+    differs from it in its grid alone, which neither reads). None where the files do not
+    hold what the summary records:
     a curve.csv row that does not match its checksum (seeded with the run's scene id,
     :func:`~femadh.io.writers.row_crc`) or the summary's record of its branches, a state
     missing from fields.csv."""
