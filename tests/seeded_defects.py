@@ -2304,8 +2304,49 @@ DEFECTS = [
       "femadh/runner/adaptive.py",
       (("    scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)\n",
         "    scale = (target / REFERENCE_ACCURACY) ** (2.0 / ORDER)\n"),)),
+    # -- resume after a stop while the figures are drawn (femadh/runner/figures.py)
+    D("figres_outcome_not_kept", "figures: a run stopped while drawing them keeps no record "
+      "of the outcome it had reached (--resume solves it again)", "femadh/runner/figures.py",
+      (("    if res.stopped_in_figures is None:\n        res.stopped_in_figures = {",
+        "    if False:\n        res.stopped_in_figures = {"),)),
+    D("figres_outcome_unwritten", "figures: summary.json of a run stopped in its figures "
+      "leaves out the outcome it had reached", "femadh/runner/result.py",
+      (('               if getattr(res, "stopped_in_figures", None) is not None else {}),',
+        '               if False else {}),'),)),
+    D("figres_redraws_all", "figures resume: every figure drawn again, the ones on disk too",
+      "femadh/runner/figures.py",
+      (("            missing = [n for n in figure_names(res) if not (folder.path / n).exists()]",
+        "            missing = figure_names(res)"),)),
+    D("figres_status_not_restored", "figures resume: the run's outcome not restored (the "
+      "summary keeps the read-back result's own status)", "femadh/runner/figures.py",
+      (('        res.status, res.error, res.failure_kind = (outcome.get("status"),\n'
+        '                                                   outcome.get("error"),\n'
+        '                                                   outcome.get("failure_kind"))\n',
+        ''),)),
+    D("figres_marker_left", "figures resume: the finished run's summary still names an "
+      "outcome pending its figures", "femadh/runner/figures.py",
+      (("            data.pop(STOPPED_IN_FIGURES, None)\n        else:",
+        "            pass\n        else:"),)),
+    D("figres_restop_drops_outcome", "figures resume stopped again: the outcome dropped from "
+      "the summary (the next resume solves the run again)", "femadh/runner/figures.py",
+      (("            data[STOPPED_IN_FIGURES] = res.stopped_in_figures\n",
+        "            data.pop(STOPPED_IN_FIGURES, None)\n"),)),
+    D("figres_unchecked_rows", "figures resume: curve.csv rows taken without their checksum "
+      "(a changed digit drawn and reported)", "femadh/runner/figures.py",
+      (("                    row_crc(r[:n_crc], run_id) != r[n_crc]:",
+        "                    False:"),)),
+    D("figres_iters_float", "figures resume: the iteration counts read back as floats",
+      "femadh/runner/figures.py",
+      (('np.array([int(v) for v in x], dtype=int) if c == "n_iter"',
+        'np.array([float(v) for v in x], dtype=float) if c == "n_iter"'),)),
+    D("figres_profile_picks", "figures resume: the kept profiles picked over one state less "
+      "than the branch's plan", "femadh/runner/figures.py",
+      (("[ks[j] for j in sorted(_picks(total.get(b, len(ks)))) if j < len(ks)]",
+        "[ks[j] for j in sorted(_picks(total.get(b, len(ks)) - 1)) if j < len(ks)]"),)),
+    D("figres_nodes_last_state", "figures resume: the nodes read from a kept profile's state "
+      "after the first", "femadh/runner/figures.py",
+      (("    res.nodes = fields[0][1]\n", "    res.nodes = fields[max(fields)][1][::-1]\n"),)),
 ]
-
 
 def _copy_repo(dst):
     for name in ("femadh", "tests", "validation", "meshes"):

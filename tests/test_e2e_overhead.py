@@ -138,8 +138,8 @@ def _program(tmp_path, args, spy=""):
 SPY = """
 from femadh.runner import figures
 real = figures.FigureWorker.draw
-def spy(self, res, folder):
-    left = real(self, res, folder)
+def spy(self, res, folder, *only):
+    left = real(self, res, folder, *only)
     print("WORKER LEFT", left, file=sys.stderr)
     return left
 figures.FigureWorker.draw = spy

@@ -39,6 +39,15 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
     claimed folder, then its figures. ``run``: the run of every kind
     (:func:`femadh.runner.run.run`), which the trials and the estimate's members go through
     (handed in: this module does not import its caller)."""
+    if resume and out_dir is not None and resume_from is None:
+        from .figures import resume_figures
+
+        # a run stopped while its figures were drawn: its numbers are complete on disk
+        # (every kind of run, before the adaptive or accuracy loop would start its trials
+        # over): only the missing figures are drawn
+        res = resume_figures(scene, out_dir, folder_id or scene_id(scene), figures=figures)
+        if res is not None:
+            return res
     if getattr(scene, "adaptive", False):
         from .adaptive import run_adaptive
 

@@ -14,8 +14,9 @@ when it draws them itself.
 
 Nothing is lost to the worker: each figure is written whole or not at all
 (:func:`~femadh.io.atomic.save_atomic`); a signal while the figures are drawn stops the
-worker (SIGTERM: its temporary files are removed) and the run ends "interrupted" as before
-(--resume draws them); a worker that died, could not be reached, or reported an error leaves
+worker (SIGTERM: its temporary files are removed) and the run ends "interrupted" as before,
+its numbers complete (--resume draws the missing figures and solves nothing again:
+:func:`resume_figures`); a worker that died, could not be reached, or reported an error leaves
 its figures to the run itself, drawn in-process as without a worker (an error then reaches
 the run as it always did). Without a worker (the Python API, other platforms, one core,
 ``--no-figures``) the figures are drawn in-process.
@@ -35,23 +36,221 @@ from .. import interrupt
 _WORKER = [None]
 
 
-def draw_figures(res, folder):
-    """The run's figures into its folder (:func:`femadh.io.plots.contact_figures`), by the
-    figure worker when the command started one; a signal stops them at once (each file is
-    written whole or not at all) and the run ends "interrupted" (--resume draws them).
-    Their time goes to ``res.timings["figures_s"]``."""
+def draw_figures(res, folder, only=None):
+    """The run's figures into its folder (:func:`femadh.io.plots.contact_figures`; ``only``:
+    those of these file names), by the figure worker when the command started one; a signal
+    stops them at once (each file is written whole or not at all) and the run ends
+    "interrupted", the outcome it had reached kept in ``res.stopped_in_figures``
+    (--resume draws the missing figures: :func:`resume_figures`). Their time goes to
+    ``res.timings["figures_s"]``."""
     t0 = time.perf_counter()
     try:
         with interrupt.immediate():
             worker = _WORKER[0]
-            left = worker.draw(res, folder.path) if worker is not None else None
+            left = worker.draw(res, folder.path, only) if worker is not None else None
             if left is None or left:
                 from ..io.plots import contact_figures
 
-                contact_figures(res, folder.path, only=left)
+                contact_figures(res, folder.path, only=only if left is None else left)
         res.timings["figures_s"] = time.perf_counter() - t0
     except Interrupted as exc:
-        res.stop(exc, " while drawing the figures")
+        _stopped(res, exc)
+
+
+def _stopped(res, exc):
+    """``res`` stopped by ``exc`` while its figures were drawn: the outcome it had reached
+    (its numbers are complete) is kept for --resume, then the stop is recorded."""
+    if res.stopped_in_figures is None:
+        res.stopped_in_figures = {"status": res.status, "error": res.error,
+                                  "failure_kind": res.failure_kind}
+    res.stop(exc, " while drawing the figures")
+
+
+#: summary.json of a run stopped in its figures names the outcome it had reached under this
+#: key (:attr:`~femadh.runner.result.ContactResult.stopped_in_figures`)
+STOPPED_IN_FIGURES = "stopped_in_figures"
+
+
+def resume_figures(scene, out_dir, folder_id, figures=True):
+    """``--resume`` of a run stopped while its figures were drawn: its sweep, peak search
+    and error estimate are complete in its folder (summary.json, curve.csv, fields.csv), so
+    nothing is solved again - the result is read back (:func:`_read_result`), the figures
+    not on disk are drawn (each file is whole or absent: the ones written before the stop
+    are kept), and summary.json ends with the outcome the run had reached, equal to the
+    uninterrupted run's but for its timings. Re-solving instead (the checkpoint and the fold
+    records are gone once the sweep is complete) made the estimate again: its jump and
+    hysteresis errors moved in their last digits (adaptive Fig 4: the jump-out and
+    hysteresis grid parts and the members' solve counts).
+
+    Returns the result, or None where this does not apply (the folder holds no such run,
+    or a run this reader does not rebuild: an arclength trace, an [instrument], the edge
+    route, an accuracy loop on uniform grids whose trial may not have been its last, files
+    that do not hold what the summary records): the caller resumes as any stopped run.
+    summary.json is rewritten once, at the end: with the outcome once the figures are on
+    disk, else (stopped again while drawing) as the first stop left it, the outcome kept; a
+    kill while drawing leaves it as it was (each state on disk consistent: resumed alike).
+    """
+    from pathlib import Path
+
+    from ..io.run_folder import RunFolder, previous_run
+    from ..io.progress import phase
+
+    if _pending_outcome(previous_run(Path(out_dir)), scene) is None:
+        return None
+    t0 = time.perf_counter()
+    with RunFolder(out_dir, folder_id, scene.name, "resume") as folder:
+        prev = folder.previous          # (read again under the folder's lock)
+        outcome = _pending_outcome(prev, scene)
+        res = None if outcome is None else _read_result(scene, folder.path, prev)
+        if res is None:
+            return None
+        res.status, res.error, res.failure_kind = (outcome.get("status"),
+                                                   outcome.get("error"),
+                                                   outcome.get("failure_kind"))
+        if figures:
+            from ..io.plots import figure_names
+
+            missing = [n for n in figure_names(res) if not (folder.path / n).exists()]
+            if missing:
+                with phase("figures"):
+                    draw_figures(res, folder, only=missing)
+        if res.stopped_in_figures is None:
+            try:
+                # a signal after the last figure is still a stop (as a run's lifecycle)
+                interrupt.check()
+            except Interrupted as exc:
+                _stopped(res, exc)
+        res.timings["total_s"] = float(prev.get("wall_time_s") or 0.0) + (
+            time.perf_counter() - t0)
+        data = {**prev, "status": res.status, "error": res.error,
+                "failure_kind": res.failure_kind, "timings_s": res.timings,
+                "wall_time_s": res.wall_time}
+        if res.stopped_in_figures is None:
+            data.pop(STOPPED_IN_FIGURES, None)
+        else:
+            data[STOPPED_IN_FIGURES] = res.stopped_in_figures
+        folder.write_summary(data)
+    return res
+
+
+def _pending_outcome(prev, scene):
+    """The outcome (dict) recorded by a run stopped in its figures whose result
+    :func:`_read_result` can read back, else None."""
+    from .result import STOPPED
+
+    out = (prev or {}).get(STOPPED_IN_FIGURES)
+    if not isinstance(out, dict) or prev.get("status") not in STOPPED \
+            or out.get("status") not in ("converged", "failed"):
+        return None
+    if (scene.continuation == "arclength" or getattr(scene, "instrument", None) is not None
+            or (prev.get("grid") or {}).get("route") == "edge-branch"
+            or (getattr(scene, "accuracy", None) and not getattr(scene, "adaptive", False))):
+        # (an arclength curve, an instrument's paths: not in the files read here; the edge
+        # route starts over; an accuracy loop on uniform grids draws each trial's figures,
+        # and one stopped there may have had trials to go)
+        return None
+    return out
+
+
+def _read_result(scene, path, prev):
+    """The result of a finished contact run as its figures and its report read it, from its
+    folder: the curves from curve.csv (repr floats: the same bits), the surface profiles the
+    run kept (the same picks as :class:`~femadh.runner.sink.Sink`) and the nodes from
+    fields.csv, the rest (headline numbers, estimates, jumps, accuracy, grid, warnings,
+    timings) from summary.json; its scene is the one given (an adaptive run's kept trial
+    differs from it in its grid alone, which neither reads). None where the files do not
+    hold what the summary records:
+    a curve.csv row that does not match its checksum (seeded with the run's scene id,
+    :func:`~femadh.io.writers.row_crc`) or the summary's record of its branches, a state
+    missing from fields.csv."""
+    import csv
+
+    import numpy as np
+
+    from ..io.writers import CRC, row_crc
+    from .result import ContactResult, contact_summary
+    from .sink import _picks
+    from .tracing import branch_plan
+
+    try:
+        with open(path / "curve.csv", newline="") as f:
+            head, *rows = list(csv.reader(f))
+        n_crc, run_id = head.index(CRC), prev["run_id"]
+        cols = [c for c in head if c not in ("state", "branch", CRC)]
+        where = [head.index(c) for c in cols]
+        per_branch, table = {}, {}
+        for k, r in enumerate(rows):
+            if len(r) != len(head) or int(r[0]) != k or \
+                    row_crc(r[:n_crc], run_id) != r[n_crc]:
+                return None
+            per_branch.setdefault(r[1], []).append(k)
+            table.setdefault(r[1], []).append([r[j] for j in where])
+        res = ContactResult(scene.name, scene, out_dir=str(path))
+        for b, vals in table.items():
+            res.branches[b] = {c: np.array([v == "True" for v in x], dtype=bool)
+                               if c in ("converged", "stable") else
+                               np.array([int(v) for v in x], dtype=int) if c == "n_iter"
+                               else np.array([float(v) for v in x], dtype=float)
+                               for c, x in zip(cols, zip(*vals))}
+        # the profiles the run kept: the picks of each branch's planned length
+        total = {b: len(d) for b, d in branch_plan(scene)}
+        picks = {b: [ks[j] for j in sorted(_picks(total.get(b, len(ks)))) if j < len(ks)]
+                 for b, ks in per_branch.items()}
+        fields = _field_states(path, {0} | {k for ks in picks.values() for k in ks})
+    except (OSError, ValueError, IndexError, KeyError):
+        return None
+    if fields is None or 0 not in fields:
+        return None
+    res.nodes = fields[0][1]
+    for b, ks in picks.items():
+        prof = res.profiles.setdefault(b, {"d_m": [], "w_m": [], "P_LJ_Pa": [],
+                                           "P_el_Pa": [], "r_m": []})
+        for k in ks:
+            d, r, w, p_lj, p_el = fields[k]
+            for name, v in zip(("d_m", "r_m", "w_m", "P_LJ_Pa", "P_el_Pa"),
+                               (d, r, w, p_lj, p_el)):
+                prof[name].append(v)
+        for name in list(prof):
+            # (profiles on exchanged grids - a band following the edge - differ in length)
+            same = len({np.size(x) for x in prof[name]}) <= 1
+            prof[name] = np.array(prof[name]) if same else np.array(prof[name], dtype=object)
+    res.jumps = list(prev.get("jumps") or [])
+    res.headline = dict(prev.get("headline") or {})
+    res.estimates = dict(prev.get("error_estimates") or {})
+    res.accuracy = dict(prev.get("accuracy") or {})
+    res.grid = dict(prev.get("grid") or {})
+    res.warnings = list(prev.get("warnings") or [])
+    res.timings = dict(prev.get("timings_s") or {})
+    # the curves read back are the ones the summary records (a folder changed since: None)
+    if contact_summary(res)["branches"] != prev.get("branches"):
+        return None
+    return res
+
+
+def _field_states(path, wanted):
+    """{state number: (d, r, w, P_LJ, P_el)} of the wanted states from fields.csv, or None
+    where one is missing or its rows are torn."""
+    import csv
+
+    import numpy as np
+
+    out = {}
+    top = max(wanted)
+    with open(path / "fields.csv", newline="") as f:
+        rd = csv.reader(f)
+        head = next(rd)
+        cols = [head.index(c) for c in ("r_m", "w_m", "P_LJ_Pa", "P_el_Pa")]
+        for cells in rd:
+            k = int(cells[0])
+            if k > top:
+                break
+            if k in wanted:
+                out.setdefault(k, (float(cells[2]), [], [], [], []))
+                for lst, j in zip(out[k][1:], cols):
+                    lst.append(float(cells[j]))
+    if set(out) != set(wanted):
+        return None
+    return {k: (d, *(np.array(x) for x in v)) for k, (d, *v) in out.items()}
 
 
 @contextmanager
@@ -138,20 +337,18 @@ class FigureWorker:
         self.pid, self._job, self._ans = pid, job_w, ans_r
         self.sent = False
 
-    def draw(self, res, folder):
-        """Have the worker draw ``res``'s figures into ``folder``; returns the names of the
-        figures it did not write (to be drawn in-process: empty when it wrote them all),
-        None when it could not take the job. A signal (Interrupted) stops the worker and
-        is raised again."""
+    def draw(self, res, folder, only=None):
+        """Have the worker draw ``res``'s figures into ``folder`` (``only``: those of these
+        file names); returns the names of the figures it did not write (to be drawn
+        in-process: empty when it wrote them all), None when it could not take the job. A
+        signal (Interrupted) stops the worker and is raised again."""
         if self.sent or self.pid is None:
             return None
         try:
-            job = pickle.dumps((res, str(folder)), protocol=pickle.HIGHEST_PROTOCOL)
+            job = pickle.dumps((res, str(folder), only), protocol=pickle.HIGHEST_PROTOCOL)
         except Exception:                 # (a result that does not pickle: drawn here)
             return None
-        from ..io.plots import figure_names
-
-        names = figure_names(res)
+        names = _names(res, only)
         done = set()
         self.sent = True
         try:
@@ -222,10 +419,13 @@ def _serve(job_r, ans_w):
     plots.warm_up()
     plots.prepare()         # (the six panels' axes and ticks: ~0.1 s less for the run to wait)
     try:
-        res, folder = _recv(job_r)
+        res, folder, only = _recv(job_r)
     except EOFError:
         return
-    names = plots.figure_names(res)
+    names = _names(res, only)
+    if not names:
+        _send(ans_w, ("end",))
+        return
     kids = {}
     for name in names[1:]:
         # the others, each in its own process (a fork of a warmed worker costs ~ms); a
@@ -261,6 +461,13 @@ def _serve(job_r, ans_w):
                 pass
             os.waitpid(pid, 0)
     _send(ans_w, ("end",))
+
+
+def _names(res, only):
+    """The file names of ``res``'s figures to draw (``only``: those of these names)."""
+    from ..io.plots import figure_names
+
+    return [n for n in figure_names(res) if only is None or n in only]
 
 
 def _draw_one(plots, res, folder, name, fd):

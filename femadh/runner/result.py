@@ -141,6 +141,12 @@ class ContactResult(RunResult):
         The discretisation used: kind (uniform/banded), nodes, analysis radius, band and
         spacing (banded), the spacing ratio of the estimate's coarser members and their labels.
     warnings : list of str
+    stopped_in_figures : dict or None
+        A run stopped while its figures were drawn (status "interrupted" or "time limit"):
+        the outcome it had reached before them ({"status", "error", "failure_kind"}; its
+        numbers are complete). summary.json keeps it, and ``--resume`` ends the run with that
+        outcome, drawing only the figures not yet on disk
+        (:func:`femadh.runner.figures.resume_figures`). None otherwise.
     """
 
     branches: dict = field(default_factory=dict)
@@ -153,6 +159,7 @@ class ContactResult(RunResult):
     accuracy: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
     instrument: dict | None = None
+    stopped_in_figures: dict | None = None
 
     kind = "contact"
 
@@ -280,6 +287,9 @@ def contact_summary(res, status=None):
             "jumps": res.jumps, "headline": res.headline, "error_estimates": res.estimates,
             "instrument": instrument_summary(res),
             "accuracy": res.accuracy, "grid": res.grid, "warnings": res.warnings,
+            # (only a run stopped in its figures: what --resume ends it with)
+            **({"stopped_in_figures": res.stopped_in_figures}
+               if getattr(res, "stopped_in_figures", None) is not None else {}),
             "timings_s": res.timings, "wall_time_s": res.wall_time}
 
 
