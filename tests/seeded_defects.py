@@ -2346,7 +2346,34 @@ DEFECTS = [
     D("figres_nodes_last_state", "figures resume: the nodes read from a kept profile's state "
       "after the first", "femadh/runner/figures.py",
       (("    res.nodes = fields[0][1]\n", "    res.nodes = fields[max(fields)][1][::-1]\n"),)),
+    D("cz_width_no_m1", "adaptive: the cohesive zone's width m a instead of (m - 1) a",
+      "femadh/runner/adaptive.py",
+      (("    return lam, (m - 1.0) * a * maugis_length_units(",
+        "    return lam, m * a * maugis_length_units("),)),
+    D("cz_lambda_no_2", "adaptive: Maugis' lambda without its factor 2",
+      "femadh/runner/adaptive.py",
+      (("    lam = 2.0 * sigma0 * (scene.sphere.radius / (math.pi * w_lj * k * k)) ** (1.0 / 3.0)",
+        "    lam = sigma0 * (scene.sphere.radius / (math.pi * w_lj * k * k)) ** (1.0 / 3.0)"),)),
+    D("cz_k_estar", "adaptive: the zone's K = E* instead of 4 E* / 3",
+      "femadh/runner/adaptive.py",
+      (("    k = 4.0 * scene.e_star / 3.0\n    lam = 2.0", "    k = scene.e_star\n    lam = 2.0"),)),
+    D("cz_share_ignored", "adaptive: the cohesive zone's spacing not scaled by the LJ share "
+      "of the work of adhesion", "femadh/runner/adaptive.py",
+      (("(target / (REFERENCE_ACCURACY * share))", "(target / REFERENCE_ACCURACY)"),)),
+    D("cz_target_unscaled", "adaptive: the cohesive zone's spacing the same for every request",
+      "femadh/runner/adaptive.py",
+      (("    return zone[1] / CZ_NODES * (target / (REFERENCE_ACCURACY * share)) ** (1 / FIRST_ORDER)",
+        "    return zone[1] / CZ_NODES * (1 / share) ** (1 / FIRST_ORDER)"),)),
+    D("cz_also_loose", "adaptive: the cohesive zone's start applied to looser requests too",
+      "femadh/runner/adaptive.py",
+      (("    if target <= REFERENCE_ACCURACY and tr.follow is None and tr.operator is not None:",
+        "    if tr.follow is None and tr.operator is not None:"),)),
+    D("cz_pulloff_state_max", "maugis: the pull-off state at the largest P, not the least",
+      "femadh/reference/maugis.py",
+      (("    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))\n",
+        "    x, P = _refined_min(lambda x: -P_of_logm(x), _LOG_M1, -P_of_logm(_LOG_M1))\n    P = -P\n"),)),
 ]
+
 
 def _copy_repo(dst):
     for name in ("femadh", "tests", "validation", "meshes"):

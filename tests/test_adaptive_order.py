@@ -155,28 +155,78 @@ def test_a_real_run_sizes_its_second_member_by_the_rule():
         min(adaptive.ORDER_BOUNDS[1], max(adaptive.ORDER_BOUNDS[0], p)), rel=1e-12, abs=0)
 
 
-def test_a_finer_request_starts_from_the_capped_member():
+def _first(path, target):
+    from femadh.discretisation import plan_grid
+
+    sc = femadh.load_scene(path).replace({"solver.accuracy": target})
+    plan = plan_grid(sc.effects, sc.gap.sigma, sc.sphere, sc.analysis_radius, sc.d_values,
+                     target)
+    return sc, plan, adaptive.first_trial(sc, plan, target)
+
+
+def test_a_finer_request_starts_from_the_capped_member(monkeypatch):
     """The first member of a request finer than 1e-3 is the 1e-3 member scaled by
     (target / 1e-3)^(1/ORDER); where the trapping cap binds on that member (the Fig 4 scene,
     sigma = 0.5 nm: the plan's 39.3 nm capped to 25.6 nm) the scaling starts from the capped
     spacing (at 3e-4: 11.45 nm, 624 nodes; from the plan's it was 17.6 nm, and at 1e-4 the
     loop then refined 871 -> 2791 nodes: validation/results/first_member.md). Where the cap
     does not bind (Fig 3: 43.75 nm) the plan's spacing is scaled as before, and at 1e-3 the
-    first member is the capped one itself. Exact identities of the rule (no solve)."""
-    from femadh.discretisation import plan_grid
-
-    def first(path, target):
-        sc = femadh.load_scene(path).replace({"solver.accuracy": target})
-        plan = plan_grid(sc.effects, sc.gap.sigma, sc.sphere, sc.analysis_radius,
-                         sc.d_values, target)
-        return sc, plan, adaptive.first_trial(sc, plan, target)
-
+    first member is the capped one itself. The cohesive zone's start is switched off here
+    (tested below). Exact identities of the rule (no solve)."""
+    monkeypatch.setattr(adaptive, "cohesive_spacing", lambda scene, target: None)
     scale = 0.3 ** (1 / adaptive.ORDER)
-    sc, plan, at_ref = first(FIG4, 1e-3)
+    sc, plan, at_ref = _first(FIG4, 1e-3)
     assert at_ref.spacing < 0.7 * plan.spacing           # the cap binds (25.6 / 39.3 nm)
-    _, plan4, tr = first(FIG4, 3e-4)
+    _, plan4, tr = _first(FIG4, 3e-4)
     assert tr.follow is None and tr.spacing == pytest.approx(at_ref.spacing * scale,
                                                              rel=1e-12, abs=0)
     assert tr.spacing < plan4.spacing * scale            # not the plan's scaled spacing
-    sc3, plan3, tr3 = first(FIG3, 3e-4)
+    sc3, plan3, tr3 = _first(FIG3, 3e-4)
     assert tr3.spacing == pytest.approx(plan3.spacing * scale, rel=1e-12, abs=0)
+
+
+def test_a_sigma_gap_request_starts_across_its_cohesive_zone():
+    """A sigma-gap LJ request at or below 1e-3 starts no coarser than CZ_NODES spacings across
+    the Maugis-Dugdale cohesive zone at pull-off, scaled by (target / 1e-3)^(1/2): the Fig 4
+    scene's zone is 212 nm (lambda 1.82), its 1e-3 start 13.2 nm (the capped rule's 25.6 nm
+    estimated 2.0e-3: validation/results/first_member.md). The zone is re-derived here from
+    the LJ law in closed form (sigma > 3^(1/6) z0: sigma0 = P(sigma), W = -U(sigma)). A looser
+    request keeps the capped member; Fig 3 (zone 985 nm, 61.5 nm > the plan's 43.75 nm) is
+    not refined by it."""
+    import math
+
+    from femadh.reference.maugis import (maugis_curve, maugis_length_units,
+                                         maugis_pull_off, maugis_pull_off_state)
+
+    sc, plan, tr = _first(FIG4, 1e-3)
+    lj = sc.effects["lj"]
+    sig = sc.gap.sigma
+    assert sig > 3 ** (1 / 6) * lj.z0
+    s0 = lj.hamaker / (6 * math.pi * sig**3) * (1 - (lj.z0 / sig) ** 6)
+    w = lj.hamaker / (12 * math.pi * sig**2) * (1 - 0.25 * (lj.z0 / sig) ** 6)
+    k = 4 * sc.e_star / 3
+    lam = 2 * s0 * (sc.sphere.radius / (math.pi * w * k * k)) ** (1 / 3)
+    m, a, p = maugis_pull_off_state(lam)
+    assert p == -maugis_pull_off(lam)
+    # the load-controlled pull-off: P is least at m (both neighbours higher)
+    assert all(maugis_curve(lam, m * f)[1] > p for f in (1 - 1e-4, 1 + 1e-4))
+    width = (m - 1) * a * maugis_length_units(sc.sphere.radius, sc.e_star, w)[0]
+    assert adaptive.cohesive_zone(sc) == pytest.approx((lam, width), rel=1e-12, abs=0)
+    assert tr.spacing == pytest.approx(width / adaptive.CZ_NODES, rel=1e-12, abs=0)
+    _, _, tr4 = _first(FIG4, 3e-4)
+    assert tr4.spacing == pytest.approx(width / adaptive.CZ_NODES * 0.3 ** 0.5, rel=1e-12,
+                                        abs=0)
+    _, _, loose = _first(FIG4, 3e-3)
+    # (the capped member, 25.1 nm: the zone's rule would ask for 22.9 nm)
+    assert loose.spacing > width / adaptive.CZ_NODES * 3 ** 0.5
+    sc3, plan3, tr3 = _first(FIG3, 1e-3)
+    assert tr3.spacing == plan3.spacing < adaptive.cohesive_spacing(sc3, 1e-3)
+    # a condensed meniscus takes its share of the adhesion: the LJ zone's error is that
+    # share of the whole (the slider at sigma 0.489 nm, p/psat 0.35: W_LJ / W = 0.33)
+    sl = femadh.load_scene("validation/scenes/paper1_slider_meniscus.toml").replace(
+        {"effects.asperity_gap.sigma": "0.489 nm", "effects.capillary.relative_pressure": 0.35})
+    w = {k: -float(e.energy(np.array([sl.gap.sigma]))[0]) for k, e in sl.effects.items()}
+    share = w["lj"] / sum(w.values())
+    assert 0.2 < share < 0.5
+    assert adaptive.cohesive_spacing(sl, 1e-3) == pytest.approx(
+        adaptive.cohesive_zone(sl)[1] / adaptive.CZ_NODES / share**0.5, rel=1e-12, abs=0)

@@ -57,10 +57,19 @@ def _refined_min(f, xs, values):
 def maugis_pull_off(lam):
     """Load-controlled pull-off -min P (in units of pi dg R): 2 (DMT) at lam -> 0, 1.5 (JKR)
     at lam -> inf."""
+    return -maugis_pull_off_state(lam)[2]
+
+
+def maugis_pull_off_state(lam):
+    """The load-controlled pull-off state (m, A, P): m = c/a the cohesive zone's outer radius
+    over the contact radius, A and P in Maugis units (P the most negative load). The cohesive
+    zone's width there is (m - 1) A a_unit (:func:`maugis_length_units`)."""
     def P_of_logm(x):
         return maugis_curve(lam, 1.0 + np.exp(x))[1]
 
-    return -_refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))[1]
+    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))
+    m = 1.0 + float(np.exp(x))
+    return m, float(maugis_curve(lam, m)[0]), float(P)
 
 
 def maugis_fixed_grip_pull_off(lam):

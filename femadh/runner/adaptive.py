@@ -262,6 +262,70 @@ def _trial(scene, family, spacing):
     return Trial(family, h, spacing, op.grid.n, op, follow)
 
 
+#: nodes across the Lennard-Jones cohesive zone (its Maugis-Dugdale width at pull-off) that
+#: the first member of a sigma-gap request at or below 1e-3 gets (:func:`cohesive_spacing`).
+#: Measured on the Fig 4 family (sigma 0.42-0.7 nm, R 1-4 mm, lambda 0.83-2.73): the band
+#: spacing that meets 1e-3 (the estimate's power law between the last two runs of each
+#: request) puts 7.6-15.5 spacings across the zone, 10.9-13.5 on six of the eight
+#: (validation/results/first_member.md); the largest is taken with a margin. The estimate
+#: itself jitters by up to 2x between neighbouring members (the slider at sigma 0.489 nm,
+#: p/psat 0.45: 1.3e-3 on 289 nodes, 2.1e-3 on 299), so no start this close to the target
+#: can be sharper than that
+CZ_NODES = 16
+
+
+def cohesive_zone(scene):
+    """(lambda, width in m) of the Lennard-Jones cohesive zone of a sigma-gap contact at its
+    pull-off, or None (no such law or no gap; see :func:`cohesive_spacing`)."""
+    from ..discretisation.plan import work_of_adhesion
+    from ..laws.lj import LennardJones
+    from ..reference.maugis import maugis_length_units, maugis_pull_off_state
+
+    gap = scene.gap
+    if gap is None or getattr(gap, "contact_model", "complementarity") != "complementarity":
+        return None
+    lj = {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
+    if not lj:
+        return None
+    w_lj = work_of_adhesion(lj, gap.sigma)
+    h = gap.sigma * np.logspace(0.0, 2.0, 2000)
+    sigma0 = float(np.max(sum(e.pressure(h) for e in lj.values())))
+    if not (w_lj > 0 and sigma0 > 0):
+        return None
+    k = 4.0 * scene.e_star / 3.0
+    lam = 2.0 * sigma0 * (scene.sphere.radius / (math.pi * w_lj * k * k)) ** (1.0 / 3.0)
+    m, a, _ = maugis_pull_off_state(lam)
+    return lam, (m - 1.0) * a * maugis_length_units(scene.sphere.radius, scene.e_star, w_lj)[0]
+
+
+def cohesive_spacing(scene, target):
+    """Band spacing (m) that resolves the Lennard-Jones cohesive zone of a sigma-gap contact
+    for ``target`` (relative, <= REFERENCE_ACCURACY), or None (no such law or no gap).
+
+    The zone is Maugis-Dugdale's at the load-controlled pull-off (the largest adhesion):
+    lambda = 2 sigma0 (R / (pi W K^2))^(1/3), K = 4 E* / 3, with W = -U_LJ(sigma) and sigma0
+    the law's largest pressure at h >= sigma, its width (m - 1) a
+    (:func:`cohesive_zone`, :func:`femadh.reference.maugis.maugis_pull_off_state`). CZ_NODES
+    spacings across it put the LJ part of the largest adhesion at ~1e-3; its share of the
+    whole adhesion, W / W_all (a condensed meniscus adds to W_all), and the order 2 of the
+    estimate's fall (FIRST_ORDER) scale that to the request:
+    h = width / CZ_NODES (target / (1e-3 share))^(1/2). The width also sets the
+    trapping-safe spacing (both scale as E* delta / sigma0), so where that cap binds the
+    plan's spacing says nothing of the accuracy, this does."""
+    from ..discretisation.plan import work_of_adhesion
+    from ..laws.lj import LennardJones
+
+    zone = cohesive_zone(scene)
+    if zone is None:
+        return None
+    lj = {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
+    share = work_of_adhesion(lj, scene.gap.sigma) / work_of_adhesion(scene.effects,
+                                                                      scene.gap.sigma)
+    if not 0 < share <= 1:
+        return None
+    return zone[1] / CZ_NODES * (target / (REFERENCE_ACCURACY * share)) ** (1 / FIRST_ORDER)
+
+
 def first_trial(scene, plan, target):
     """The :class:`Trial` the adaptive loop starts from: the member for REFERENCE_ACCURACY
     (BAND_NODES across the band, at least MIN_BAND_NODES, capped below the trapping-safe
@@ -271,11 +335,17 @@ def first_trial(scene, plan, target):
     For a finer request the scaling starts from the capped 1e-3 member: where the trapping
     cap binds, the cohesive zone is narrower than BAND_NODES resolve (its width and the safe
     spacing both scale as E* / max|P'|), so the plan's spacing says nothing about the
-    accuracy there. Measured on the Fig 4 scene (sigma = 0.5 nm) at 1e-4: scaled from the
-    plan's 39.3 nm, the first member (8.47 nm, 871 nodes) estimated 6.2e-4 and the loop
-    refined to 2791 nodes (estimate 2.6e-5, 67.5 s); scaled from the capped 25.6 nm
-    (validation/results/first_member.md). A band following the edge keeps its own cap
-    (:func:`_follow_trial`): its spacing is scaled from the plan's as before."""
+    accuracy there. And a sigma-gap Lennard-Jones request at or below 1e-3 starts no coarser
+    than :func:`cohesive_spacing` (CZ_NODES spacings across the law's cohesive zone). Measured
+    (validation/results/first_member.md, CPU seconds at load ~5): the Fig 4 scene
+    (sigma = 0.5 nm) at 1e-4 went 871 + 2791 nodes, 73.0 s (the plan's 39.3 nm scaled) ->
+    1341 + 1765, 32.1 s (the capped 25.6 nm scaled) -> 1765 in one run, 21.3 s (the zone);
+    at 1e-3 279 + 493 -> 540 nodes, 1.8 -> 1.6 s; over the ten 1e-3 and 3e-4 requests
+    measured (Fig 4 and sigma variants, six stiction-map points) 73.4 -> 48.7 s, with the
+    estimate's jitter deciding single requests either way (Fig 4 at 3e-4: 2.5 -> 6.9 s, 624
+    -> 986 nodes; the slider at sigma 0.489 nm, p/psat 0.35: 22.8 -> 4.8 s). A band following
+    the edge keeps its own cap (:func:`_follow_trial`): its spacing is scaled from the
+    plan's."""
     family = plan.family
     scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)
     h = min(plan.spacing * scale, family.band / MIN_BAND_NODES)
@@ -284,7 +354,14 @@ def first_trial(scene, plan, target):
         if ref.operator is not None and ref.follow is None and ref.spacing < ref.asked:
             # (the probe's operator is dropped: the member is built at its own spacing)
             h = min(ref.spacing * scale, family.band / MIN_BAND_NODES)
-    return _trial(scene, family, h)
+    tr = _trial(scene, family, h)
+    if target <= REFERENCE_ACCURACY and tr.follow is None and tr.operator is not None:
+        # (a looser request keeps the trapping cap, which already over-resolves it: the Fig 4
+        # scene at 3e-3 estimates 2.2e-3 on the capped member)
+        hz = cohesive_spacing(scene, target)
+        if hz is not None and hz < tr.spacing:
+            tr = _trial(scene, family, hz)
+    return tr
 
 
 def _too_many_nodes(trial):
