@@ -228,9 +228,10 @@ def _jumps_limit(path, rows):
     return len(rows), why
 
 
-def field_states(folder, wanted):
-    """{state number: (d, w, P_LJ, P_el)} of the wanted committed states, from fields.csv
-    (the repr floats the run wrote: the same bits as the states it held)."""
+def field_states(folder, wanted, columns=("w_m", "P_LJ_Pa", "P_el_Pa")):
+    """{state number: (d, *arrays)} of the wanted committed states from fields.csv, one
+    array per name in ``columns`` (default: w, P_LJ, P_el; the repr floats the run wrote:
+    the same bits as the states it held)."""
     import numpy as np
 
     out = {}
@@ -241,17 +242,16 @@ def field_states(folder, wanted):
     with open(folder / "fields.csv", newline="") as f:
         rd = csv.reader(f)
         head = next(rd)
-        iw, ilj, iel = head.index("w_m"), head.index("P_LJ_Pa"), head.index("P_el_Pa")
+        cols = [head.index(c) for c in columns]
         for cells in rd:
             k = int(cells[0])
             if k > top:
                 break
             if k in wanted:
-                out.setdefault(k, (float(cells[2]), [], [], []))
-                for lst, j in zip(out[k][1:], (iw, ilj, iel)):
+                out.setdefault(k, (float(cells[2]), *([] for _ in cols)))
+                for lst, j in zip(out[k][1:], cols):
                     lst.append(float(cells[j]))
-    return {k: (d, np.array(w), np.array(lj), np.array(el)) for k, (d, w, lj, el)
-            in out.items()}
+    return {k: (d, *(np.array(x) for x in v)) for k, (d, *v) in out.items()}
 
 
 def kept_jumps(folder, rows):

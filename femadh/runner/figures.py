@@ -229,28 +229,11 @@ def _read_result(scene, path, prev):
 
 def _field_states(path, wanted):
     """{state number: (d, r, w, P_LJ, P_el)} of the wanted states from fields.csv, or None
-    where one is missing or its rows are torn."""
-    import csv
+    where one is missing."""
+    from ..io.resume_check import field_states
 
-    import numpy as np
-
-    out = {}
-    top = max(wanted)
-    with open(path / "fields.csv", newline="") as f:
-        rd = csv.reader(f)
-        head = next(rd)
-        cols = [head.index(c) for c in ("r_m", "w_m", "P_LJ_Pa", "P_el_Pa")]
-        for cells in rd:
-            k = int(cells[0])
-            if k > top:
-                break
-            if k in wanted:
-                out.setdefault(k, (float(cells[2]), [], [], [], []))
-                for lst, j in zip(out[k][1:], cols):
-                    lst.append(float(cells[j]))
-    if set(out) != set(wanted):
-        return None
-    return {k: (d, *(np.array(x) for x in v)) for k, (d, *v) in out.items()}
+    out = field_states(path, wanted, ("r_m", "w_m", "P_LJ_Pa", "P_el_Pa"))
+    return out if set(out) == set(wanted) else None
 
 
 @contextmanager
