@@ -2322,8 +2322,8 @@ DEFECTS = [
         "single = H.shape[0] >= SINGLE_MIN_NODES"),)),
     D("landfast_factor_diagonal", "single factor: the damped diagonal not written (the "
       "factor of H + its own diagonal again)", "femadh/contact/linalg.py",
-      (("    d[...] = diag                           # the damped diagonal, formed in double",
-        "    d += diag"),)),
+      (("        d[...] = diag                       # the damped diagonal, formed in double",
+        "        d += diag"),)),
 ]
 
 

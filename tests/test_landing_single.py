@@ -131,7 +131,7 @@ def test_the_single_factor_is_the_matrix_to_single_precision():
     """U^T U = H + the damped diagonal to single precision's round-off (measured 1.26e-7 of
     its largest entry on 60 nodes; tolerance 4 ulps of float32: 4.8e-7); its solve to the
     single factor's accuracy (measured 4.8e-7 - 6.0e-7, cond 3.5: tolerance 1e-5); None where
-    the matrix is not positive definite."""
+    the matrix is not positive definite; FloatingPointError where it is beyond float32."""
     H = _spd(60, 1)
     d = np.diagonal(H) + 0.5
     u = cho_factor_single(H, d)
@@ -141,6 +141,8 @@ def test_the_single_factor_is_the_matrix_to_single_precision():
     x = cho_solve_single(u, M @ np.ones(60))
     assert np.max(np.abs(x - 1)) <= 1e-5
     assert cho_factor_single(H, np.diagonal(H) - 5.0) is None
+    with pytest.raises(FloatingPointError):     # beyond float32: the double path decides
+        cho_factor_single(H * 1e39, np.diagonal(H) * 1e39)
 
 
 def test_pcg_solves_and_refuses_what_it_must():

@@ -215,7 +215,10 @@ class _Damped:
                 return x
             if status == "curvature":
                 return self.NOT_PD
-        u = cho_factor_single(H[::-1, ::-1], (np.diagonal(H) + damp)[::-1])
+        try:
+            u = cho_factor_single(H[::-1, ::-1], (np.diagonal(H) + damp)[::-1])
+        except FloatingPointError:
+            return None         # (beyond single precision's range, or not a number)
         if u is None:
             return self.NOT_PD
         self.kept, self._block = (u, self.free, self.m), None

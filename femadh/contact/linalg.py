@@ -98,6 +98,8 @@ def cho_factor_single(H, diag):
     precision, D the diagonal matrix that makes the diagonal ``diag`` (the damped diagonal,
     formed in double by the caller); None where LAPACK spotrf finds a leading minor not
     positive definite in single precision, or a pivot is not a finite positive number there.
+    Raises FloatingPointError where an entry is beyond single precision's range (a question
+    for the double factorisation, not an answer "not positive definite").
 
     Parameters
     ----------
@@ -112,11 +114,12 @@ def cho_factor_single(H, diag):
     the double-precision conjugate gradients (:func:`pcg`) that make the solution exact to
     the double system's own round-off in a few iterations (the landing's damped descent,
     :func:`femadh.contact.landing._lm_descent`)."""
-    M = np.array(H, dtype=np.float32)       # C order: M.T is the Fortran-ordered matrix
-    d = diagonal(M)
-    d[...] = diag                           # the damped diagonal, formed in double
+    with np.errstate(over="ignore", invalid="ignore"):      # (checked just below)
+        M = np.array(H, dtype=np.float32)   # C order: M.T is the Fortran-ordered matrix
+        d = diagonal(M)
+        d[...] = diag                       # the damped diagonal, formed in double
     if not np.all(np.isfinite(M)):
-        return None                         # beyond single precision's range
+        raise FloatingPointError("an entry beyond single precision's range")
     u, info = _SPOTRF(M.T, lower=False, overwrite_a=True, clean=False)
     if info != 0:
         return None
