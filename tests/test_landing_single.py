@@ -150,7 +150,8 @@ def test_pcg_solves_and_refuses_what_it_must():
     (preconditioned by the single factor of a matrix 30 % off its diagonal: 11 iterations;
     the solution measured 6.2e-15 - 6.5e-15 off relative, cond(A) 4.9 with rtol 1e-13:
     tolerance 1e-12); meets non-positive curvature on an indefinite one (first direction: the
-    right-hand side along the negative eigenvector); and stops at its budget."""
+    right-hand side along the negative eigenvector); stops at its budget; and takes a zero
+    right-hand side as solved (not as a direction of zero curvature)."""
     A, P = _spd(80, 2), _spd(80, 2, shift=1.3)
     u = cho_factor_single(P, np.diagonal(P))
     b = np.arange(1.0, 81.0)
@@ -164,3 +165,5 @@ def test_pcg_solves_and_refuses_what_it_must():
     assert status == "curvature"
     _, k, status = pcg(lambda v: A @ v, lambda r: r, b, 1e-13, 3)
     assert (k, status) == (3, "budget")
+    x, k, status = pcg(lambda v: A @ v, lambda r: r, 0 * b, 1e-13, 3)
+    assert (k, status) == (0, "converged") and not x.any()

@@ -146,7 +146,7 @@ def pcg(apply_a, apply_m, b, rtol, maxiter):
     apply_a, apply_m : callable(ndarray) -> ndarray
         The product with A and the preconditioner's solve M^-1 (symmetric positive definite).
     b : ndarray
-        Right-hand side (not zero).
+        Right-hand side (zero: x = 0, converged at once).
     rtol : float
         Relative residual |r| / |b| (2-norms, r the recurred residual) to reach.
     maxiter : int
@@ -162,6 +162,8 @@ def pcg(apply_a, apply_m, b, rtol, maxiter):
     x = np.zeros_like(b)
     r = np.array(b, dtype=float)
     bnorm = math.sqrt(r @ r)
+    if bnorm == 0.0:
+        return x, 0, "converged"        # (not a direction of zero curvature)
     z = apply_m(r)
     p = z.copy()
     rz = r @ z
