@@ -139,7 +139,7 @@ class _Damped:
     ones in a few iterations. The step stays the damped Newton step of the double system,
     and its energy is checked in double as before.
 
-    Each trial first tries the kept factor (REUSE_ITER iterations): if an iteration meets a
+    Each trial first tries the kept factor (REUSE_NODES, REUSE_MIN): if an iteration meets a
     direction of non-positive curvature (p . A p <= 0 in double), the damped Hessian is not
     positive definite - the trial is refused as the double factorisation's failure refused it
     (:meth:`solve` returns NOT_PD: raise the damping), without a factorisation. Else a fresh
@@ -152,7 +152,8 @@ class _Damped:
 
     The factor is kept in reversed node order: where the free nodes are the trailing block
     m..n-1 (a disk-shaped contact), each smaller trailing block is a leading block of it,
-    whose factor is the leading part of the factor (as :class:`TrailingCholesky`'s), so a
+    whose factor is the leading part of the factor (as
+    :class:`femadh.contact.linalg.TrailingCholesky`'s), so a
     contact that grows by a node keeps its preconditioner.
     """
 
