@@ -2372,6 +2372,38 @@ DEFECTS = [
       "femadh/reference/maugis.py",
       (("    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))\n",
         "    x, P = _refined_min(lambda x: -P_of_logm(x), _LOG_M1, -P_of_logm(_LOG_M1))\n    P = -P\n"),)),
+    # -- the landing descent's single-precision factor and double conjugate gradients
+    # (femadh/contact/landing.py _Damped, femadh/contact/linalg.py pcg, cho_factor_single)
+    D("landfast_cg_undamped", "landing descent: the iterations solve the undamped Hessian "
+      "(the damping left out of the product)", "femadh/contact/landing.py",
+      (("return (blas.dsymv(1.0, H.T, v[::-1], lower=1) + damp * v[::-1])[::-1]",
+        "return blas.dsymv(1.0, H.T, v[::-1], lower=1)[::-1]"),)),
+    D("landfast_rtol_loose", "landing descent: the iterations stop at a relative residual "
+      "of 1e-3", "femadh/contact/landing.py", (("SINGLE_RTOL = 1e-13", "SINGLE_RTOL = 1e-3"),)),
+    D("landfast_factor_undamped", "landing descent: the single factor (and its positive-"
+      "definiteness test) of the undamped Hessian", "femadh/contact/landing.py",
+      (("u = cho_factor_single(H[::-1, ::-1], (np.diagonal(H) + damp)[::-1])",
+        "u = cho_factor_single(H[::-1, ::-1], np.diagonal(H)[::-1])"),)),
+    D("landfast_curvature_ignored", "pcg: a direction of negative curvature taken as any other "
+      "(an indefinite damped Hessian solved as if positive definite)",
+      "femadh/contact/linalg.py",
+      (("if not (pq > 0 and rz > 0):     # (NaN fails this too)",
+        "if not (pq != 0 and rz != 0):"),)),
+    D("landfast_descent_check", "landing descent: the descent-direction check inverted "
+      "(grad . dw > 0 taken)", "femadh/contact/landing.py",
+      (('ok = status == "converged" and rev @ x > 0 and np.all(np.isfinite(x))',
+        'ok = status == "converged" and rev @ x < 0 and np.all(np.isfinite(x))'),)),
+    D("landfast_rhs_order", "landing descent: the gradient not reversed into the factor's "
+      "node order", "femadh/contact/landing.py", (("rev = rhs[::-1]", "rev = rhs"),)),
+    D("landfast_whole_descent_single", "landing descent: the whole descent (lattice-trapped "
+      "grids, the retry after a failed polish) also by the single factor",
+      "femadh/contact/landing.py",
+      (("single = roundoff and H.shape[0] >= SINGLE_MIN_NODES",
+        "single = H.shape[0] >= SINGLE_MIN_NODES"),)),
+    D("landfast_factor_diagonal", "single factor: the damped diagonal not written (the "
+      "factor of H + its own diagonal again)", "femadh/contact/linalg.py",
+      (("        d[...] = diag                       # the damped diagonal, formed in double",
+        "        d += diag"),)),
 ]
 
 

@@ -6,7 +6,8 @@ from scipy import linalg as sla
 from ..interrupt import check as safe_point
 from .complementarity import MAX_GAP_CLOSURE, STALL_ITER, solve_complementarity
 from .subgrid import add_jacobian
-from .linalg import cho_factor, cho_solve, lu_factor, lu_solve
+from .linalg import (cho_factor, cho_factor_single, cho_solve, cho_solve_single, lu_factor,
+                     lu_solve, pcg)
 
 #: descent steps in a row that lower the energy by no more than its round-off after which the
 #: descent has settled in its basin (Newton polishes from there). Measured on the Fig 4 scene
@@ -91,6 +92,139 @@ SMOOTH_EDGES = True
 #: points of the straight path from the descent's start to a candidate landing at which the
 #: energy must fall monotonically (no barrier: the descent's surface can slide there)
 PATH_SAMPLES = 16
+#: free nodes from which the descent's damped steps are solved by conjugate gradients in
+#: double precision preconditioned by a single-precision Cholesky factor (:class:`_Damped`)
+#: instead of the double factorisation. Measured on one core (AMD EPYC, median of 7): the
+#: double factorisation and solve against the single one and 3 iterations 0.33 / 0.22 ms at
+#: 300 nodes, 2.0 / 1.3 ms at 600, 98 / 57 ms at 2500; at 100 nodes 0.02 / 0.04 ms (the
+#: iterations' Python overhead). Only in the descent that stops once settled at round-off:
+#: the whole descent, run on a lattice-trapped grid and as the retry after a polish that
+#: failed, keeps the double factorisation bit for bit, because there the states reached
+#: depend on the iterates (on the 100-node GW slider of tests/test_landing_smooth_edges.py
+#: the single path, forced, polished the landing that the double path's descent leaves
+#: stalled)
+SINGLE_MIN_NODES = 300
+#: the iterations' relative residual |r| / |grad| (2-norms): the double solve's own accuracy
+#: (measured on the Fig 4 scene's descents at 1396 nodes: the steps agree with the double
+#: factorisation's to 1e-15 - 3e-12 relative, as two double solves of these systems do)
+SINGLE_RTOL = 1e-13
+#: iterations a step may take from a fresh single factor (measured 3-5, SINGLE_RTOL met)
+#: before the trial falls back to the double factorisation (which then also decides whether
+#: the damped Hessian is positive definite)
+SINGLE_ITER = 10
+#: iterations a trial may take from the factor kept from an earlier trial (another damping,
+#: the Hessian of an earlier step on the same free nodes or on more of them) before a fresh
+#: factor is made: one per REUSE_NODES free nodes, at least REUSE_MIN. Each costs a product
+#: with the Hessian and two single triangular solves; a single factorisation of k nodes
+#: costs ~k/45 of them (measured on one core: 16 at 600 nodes, 32 at 1500, 52 at 2800), so
+#: a kept factor that does not converge costs at most about half a factorisation. Measured
+#: on the Fig 4 scene's descents (1396 nodes): 4-10 iterations from the last step's factor
+#: once the damping is below 1e-4, 15-27 above 1e-3 (where a factor's damping, 3x the
+#: trial's, still dominates the Hessian's softer modes)
+REUSE_NODES, REUSE_MIN = 100, 4
+
+
+class _Damped:
+    """The damped Newton systems (H + lam diag(s)) dw = rhs of the descent's steps (H the
+    energy Hessian on the step's free nodes, N/m; s the diagonal of sym(S) on them), solved
+    by conjugate gradients in double precision (:func:`femadh.contact.linalg.pcg`)
+    preconditioned by a single-precision Cholesky factor.
+
+    Why: the double factorisation of each trial was most of the descent (measured on the Fig
+    4 scene at accuracy 1e-4: 346 factorisations of ~1770 free nodes, 15 of the descents'
+    24 s). Single precision (LAPACK spotrf) takes half the time, and a few double
+    iterations make its solution the double system's (the residual to SINGLE_RTOL); between
+    steps only the law's diagonal and the damping move (the elastic block sym(S) is the same
+    while the free nodes are), so a factor kept from an earlier trial preconditions the next
+    ones in a few iterations. The step stays the damped Newton step of the double system,
+    and its energy is checked in double as before.
+
+    Each trial first tries the kept factor (REUSE_NODES, REUSE_MIN): if an iteration meets a
+    direction of non-positive curvature (p . A p <= 0 in double), the damped Hessian is not
+    positive definite - the trial is refused as the double factorisation's failure refused it
+    (:meth:`solve` returns NOT_PD: raise the damping), without a factorisation. Else a fresh
+    single factor of the trial's matrix is made: its failure (LAPACK's info) is NOT_PD; its
+    iterations (SINGLE_ITER) give the step, or - a direction of non-positive curvature, the
+    budget spent - None: the caller decides with the double factorisation as before. A step
+    is returned only where the iterations met SINGLE_RTOL with positive curvature on every
+    direction (the Hessian positive definite on the Krylov space that resolves the gradient
+    to SINGLE_RTOL) and it is a descent direction, grad . dw < 0.
+
+    The factor is kept in reversed node order: where the free nodes are the trailing block
+    m..n-1 (a disk-shaped contact), each smaller trailing block is a leading block of it,
+    whose factor is the leading part of the factor (as
+    :class:`femadh.contact.linalg.TrailingCholesky`'s), so a
+    contact that grows by a node keeps its preconditioner.
+    """
+
+    NOT_PD = "not positive definite"
+
+    def __init__(self, s):
+        self.s_all = s          # the diagonal of sym(S) on every node (N/m)
+        self.kept = None        # (factor, free mask, m or None) in reversed node order
+        self._block = None      # (k, the factor's leading k x k block, contiguous)
+        self.H = None
+
+    def step(self, H, free):
+        """A new step: its Hessian H on the nodes ``free`` (mask)."""
+        # C order: H.T is BLAS's Fortran order (its lower triangle is H's upper one)
+        self.H = np.ascontiguousarray(H, dtype=float)
+        self.free = free
+        m = free.size - int(np.count_nonzero(free))
+        self.m = m if free[m:].all() else None
+        self.s = self.s_all[free]
+
+    def _covered(self):
+        """The leading block of the kept factor (reversed order) that is this step's free
+        block, or None."""
+        if self.kept is None:
+            return None
+        u, free, m = self.kept
+        k = self.H.shape[0]
+        if np.array_equal(free, self.free):
+            return u
+        if m is None or self.m is None or self.m < m:
+            return None
+        if self._block is None or self._block[0] != k:
+            self._block = (k, np.asfortranarray(u[:k, :k]))
+        return self._block[1]
+
+    def solve(self, lam, rhs):
+        """dw (m) with (H + lam diag(s)) dw = rhs on this step's free nodes; NOT_PD (the
+        matrix is not positive definite: raise the damping) or None (decide with the double
+        factorisation)."""
+        from scipy.linalg import blas
+
+        H, damp = self.H, lam * self.s
+        rev = rhs[::-1]
+
+        def apply_a(v):
+            # (reversed order; H's upper triangle: the one the double factorisation reads)
+            return (blas.dsymv(1.0, H.T, v[::-1], lower=1) + damp * v[::-1])[::-1]
+
+        def solved(u, budget):
+            x, _, status = pcg(apply_a, lambda r: cho_solve_single(u, r), rev, SINGLE_RTOL,
+                               budget)
+            # a descent direction: grad . dw = -rhs . dw < 0
+            ok = status == "converged" and rev @ x > 0 and np.all(np.isfinite(x))
+            return (x[::-1] if ok else None), status
+
+        u = self._covered()
+        if u is not None:
+            x, status = solved(u, max(REUSE_MIN, H.shape[0] // REUSE_NODES))
+            if x is not None:
+                return x
+            if status == "curvature":
+                return self.NOT_PD
+        try:
+            u = cho_factor_single(H[::-1, ::-1], (np.diagonal(H) + damp)[::-1])
+        except FloatingPointError:
+            return None         # (beyond single precision's range, or not a number)
+        if u is None:
+            return self.NOT_PD
+        self.kept, self._block = (u, self.free, self.m), None
+        x, _ = solved(u, SINGLE_ITER)
+        return x
 
 
 def _roundoff(problem, w, e):
@@ -121,6 +255,7 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
     g = problem.energy_gradient(w, d)
     g0 = float(np.max(np.abs(g))) + 1e-300
     flat = 0            # steps in a row that lowered the energy by no more than its round-off
+    damped = _Damped(scale_diag)
     for _ in range(max_iter):
         safe_point()            # a signal stops the run between descent steps
         at_bound = (w >= upper - 1e-18) & (g < 0)   # pushing further into h < floor
@@ -128,20 +263,35 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
         if float(np.max(np.abs(g[free]), initial=0.0)) <= 1e-10 * g0:
             return w, True
         H = problem.energy_hessian(b - w, free)
+        # (the whole descent - a lattice-trapped grid, the retry after a failed polish -
+        # keeps the double factorisation, bit for bit: there the landing depends on the
+        # iterates, SINGLE_MIN_NODES)
+        single = roundoff and H.shape[0] >= SINGLE_MIN_NODES
+        if single:
+            damped.step(H, free)
         while True:
-            # a copy in LAPACK's (Fortran) order, factorised in place: the wrapper would
-            # otherwise copy a C-ordered M once more for every trial damping
-            M = np.array(H, order="F")
-            M[np.diag_indices_from(M)] += lam * scale_diag[free]
-            try:
-                c = cho_factor(M, overwrite_a=True)
-            except sla.LinAlgError:
+            step = damped.solve(lam, -g[free]) if single else None
+            if step is _Damped.NOT_PD:
                 lam *= 4
                 if lam > 1e12:
                     return w, False
                 continue
             dw = np.zeros_like(w)
-            dw[free] = -cho_solve(c, g[free])
+            if step is not None:
+                dw[free] = step
+            else:
+                # a copy in LAPACK's (Fortran) order, factorised in place: the wrapper would
+                # otherwise copy a C-ordered M once more for every trial damping
+                M = np.array(H, order="F")
+                M[np.diag_indices_from(M)] += lam * scale_diag[free]
+                try:
+                    c = cho_factor(M, overwrite_a=True)
+                except sla.LinAlgError:
+                    lam *= 4
+                    if lam > 1e12:
+                        return w, False
+                    continue
+                dw[free] = -cho_solve(c, g[free])
             w_new = np.minimum(w + dw, upper)
             e_new = problem.energy(w_new, d)
             if np.isfinite(e_new) and e_new <= e:
