@@ -2294,12 +2294,12 @@ DEFECTS = [
         '                    if hl_m is None:\n                        hl_m, how = rm.hl, rm.m.solves\n                if hl_m is not None:'),)),
     D("first_from_plan", "adaptive: a finer request's first member scaled from the plan's "
       "spacing where the trapping cap binds (the old rule)", "femadh/runner/adaptive.py",
-      (("            h = min(ref.spacing * scale, family.band / MIN_BAND_NODES)\n",
-        "            h = min(plan.spacing * scale, family.band / MIN_BAND_NODES)\n"),)),
+      (("            starts.insert(0, min(ref.spacing * scale, top))\n",
+        "            starts.insert(0, min(plan.spacing * scale, top))\n"),)),
     D("first_cap_inverted", "adaptive: the capped 1e-3 member's spacing used only where the cap "
       "does not bind", "femadh/runner/adaptive.py",
-      (("ref.follow is None and ref.spacing < ref.asked:",
-        "ref.follow is None and ref.spacing >= ref.asked:"),)),
+      (("not follows and ref.spacing < ref.asked:",
+        "not follows and ref.spacing >= ref.asked:"),)),
     D("first_scale_squared", "adaptive: the first member's scaling (target / 1e-3)^(2/ORDER)",
       "femadh/runner/adaptive.py",
       (("    scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)\n",
@@ -2366,8 +2366,8 @@ DEFECTS = [
         "    return zone[1] / CZ_NODES * (1 / share) ** (1 / FIRST_ORDER)"),)),
     D("cz_also_loose", "adaptive: the cohesive zone's start applied to looser requests too",
       "femadh/runner/adaptive.py",
-      (("    if target <= REFERENCE_ACCURACY and tr.follow is None and tr.operator is not None:",
-        "    if tr.follow is None and tr.operator is not None:"),)),
+      (("    if target <= REFERENCE_ACCURACY and not follows:",
+        "    if not follows:"),)),
     D("cz_pulloff_state_max", "maugis: the pull-off state at the largest P, not the least",
       "femadh/reference/maugis.py",
       (("    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))\n",
@@ -2404,6 +2404,29 @@ DEFECTS = [
       "factor of H + its own diagonal again)", "femadh/contact/linalg.py",
       (("        d[...] = diag                       # the damped diagonal, formed in double",
         "        d += diag"),)),
+    D("first_no_fallback", "adaptive: a first member the node budget refuses ends the request "
+      "(no fall back to the coarser start)", "femadh/runner/adaptive.py",
+      (("        if tr.operator is not None:\n            return tr\n    return tr",
+        "        return tr\n    return tr"),)),
+    D("first_zone_on_follow", "adaptive: the cohesive zone's start kept on a band following "
+      "the edge", "femadh/runner/adaptive.py",
+      (("        if tr.follow is not None and h != starts[-1]:", "        if False:"),)),
+    D("cz_on_closure", "adaptive: the cohesive zone's start on the Hertz closure model too",
+      "femadh/runner/adaptive.py",
+      (('    if gap is None or getattr(gap, "contact_model", "complementarity") != "complementarity":\n        return None\n    lj = {k: e',
+        '    if gap is None:\n        return None\n    lj = {k: e'),)),
+    D("figres_trial_level", "figures resume: a loop's trial reads back the user's folder "
+      "(it may hold another trial's run)", "femadh/runner/contact.py",
+      (("resume_from is None and (\n            folder_id is None or folder_id == scene_id(scene)):",
+        "resume_from is None and (\n            True):"),)),
+    D("figres_estimate_ignored", "figures resume: a resume asking for the estimate reads back a "
+      "run made without one", "femadh/runner/figures.py",
+      (('            estimate is True and not prev.get("error_estimates")):',
+        '            False):'),)),
+    D("figres_fields_unchecked", "figures resume: fields.csv's states taken without checking "
+      "them against curve.csv and the grid", "femadh/runner/figures.py",
+      (('        if float(rows[k][i_d]) != d or len({a.size for a in arrs}) != 1:\n            return None\n    if fields[0][1].size != (prev.get("grid") or {}).get("nodes"):\n        return None\n',
+        ''),)),
 ]
 
 

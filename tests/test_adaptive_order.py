@@ -230,3 +230,31 @@ def test_a_sigma_gap_request_starts_across_its_cohesive_zone():
     assert 0.2 < share < 0.5
     assert adaptive.cohesive_spacing(sl, 1e-3) == pytest.approx(
         adaptive.cohesive_zone(sl)[1] / adaptive.CZ_NODES / share**0.5, rel=1e-12, abs=0)
+
+
+def test_a_refused_start_falls_back_and_the_zone_keeps_its_scope(monkeypatch):
+    """A first member the node budget refuses falls back to the next coarser start (the
+    capped 1e-3 member's, 25.6 nm on Fig 4 at 1e-3) instead of ending the request before any
+    solve (measured before: Fig 4 at sigma 0.42 nm, R 4 mm, 1e-4 - a 4161-node zone start -
+    was refused where 3644 nodes fit). The zone's start is not taken on a band following
+    the edge (the slider at sigma = 0.3 nm: its own cap, from the plan's spacing) nor on the
+    Hertz closure model (no complementarity, no zone). Exact identities, no solve."""
+    from femadh.discretisation import plan_grid
+
+    monkeypatch.setattr(adaptive, "cohesive_spacing", lambda scene, target: None)
+    sc, plan, capped = _first(FIG4, 1e-3)
+    monkeypatch.setattr(adaptive, "cohesive_spacing", lambda scene, target: 1e-11)  # ~6e5 nodes
+    tr = adaptive.first_trial(sc, plan, 1e-3)
+    assert tr.operator is not None and tr.spacing == capped.spacing
+    monkeypatch.undo()
+    sl = femadh.load_scene("validation/scenes/paper1_slider_meniscus.toml").replace(
+        {"effects.asperity_gap.sigma": "0.3 nm", "effects.capillary.relative_pressure": 0.5,
+         "sweep.start": "4 nm"})
+    p = plan_grid(sl.effects, sl.gap.sigma, sl.sphere, sl.analysis_radius, sl.d_values, 1e-3)
+    assert adaptive.cohesive_spacing(sl, 1e-3) is not None
+    tr = adaptive.first_trial(sl, p, 1e-3)
+    plain = adaptive._trial(sl, p.family, min(p.spacing, p.family.band / adaptive.MIN_BAND_NODES))
+    assert tr.follow is not None and tr.spacing == plain.spacing
+    closure = femadh.load_scene(FIG4).replace(
+        {"effects.asperity_gap.contact_model": "hertz-closure"})
+    assert adaptive.cohesive_zone(closure) is None

@@ -3,6 +3,7 @@ SIGTERM at each phase end in exit 130/143, status "interrupted", promptly; --res
 with the summary.json of an uninterrupted run; a damaged folder is refused or repaired in
 one line; the time limit ends a run cleanly; femadh check estimates time."""
 import json
+import os
 import signal
 
 import pytest
@@ -597,3 +598,77 @@ def _stop_in_figures_then_resume(sc, out, tmp_path):
     for name in ("jumps", "headline", "estimates", "accuracy", "grid", "warnings"):
         assert differences(getattr(back, name), getattr(cut, name)) == [], name
     assert "stopped_in_figures" not in summary(out)
+
+
+def test_a_figures_resume_reads_back_only_the_run_asked_for(tmp_path, monkeypatch):
+    """A resume after a stop in the figures reads the result back only where the folder holds
+    the run that was asked for, its estimate as asked, and fields.csv as curve.csv records
+    it; else it solves as any resume. (a) An accuracy loop (uniform trials of 50 and 200
+    nodes) stopped in its second trial's figures: the trial's own call must not read back
+    the folder (before: the 200-node numbers were recorded for the 50-node step and the loop
+    declared met); resumed, its summary equals the uninterrupted one. (b) A run made without
+    its estimate, resumed asking for one: the estimate is made. (c) fields.csv's first state
+    edited (its w x 10, a node row dropped): the resume repairs and solves again."""
+    import femadh
+    import femadh.io.plots as plots
+    import femadh.runner.contact as contact
+    from femadh.io.atomic import write_atomic
+
+    stop = {"at": None, "calls": 0}
+
+    def draw(res, folder, only=None):
+        stop["calls"] += 1
+        for name in plots.figure_names(res):
+            if only is None or name in only:
+                write_atomic(folder / name, name)
+                if stop["calls"] == stop["at"]:
+                    os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(plots, "contact_figures", draw)
+    solved = []
+    real = contact._run
+    monkeypatch.setattr(contact, "_run", lambda sc, *a, **kw: solved.append(1) or real(sc, *a,
+                                                                                   **kw))
+    path = short_scene(tmp_path, nodes=50, step="0.5 nm")
+    path.write_text(path.read_text().replace("[solver]\n", "[solver]\naccuracy = 5e-3\n", 1))
+    sc = femadh.load_scene(path)
+    femadh.run(sc, tmp_path / "ref", progress=False)
+    ref = summary(tmp_path / "ref")
+    assert [s["nodes"] for s in ref["accuracy"]["steps"]] == [50, 200]
+    stop.update(at=2, calls=0)              # the second trial's figures
+    with pytest.raises(KeyboardInterrupt):
+        femadh.run(sc, tmp_path / "acc", progress=False)
+    assert summary(tmp_path / "acc")["stopped_in_figures"]["status"] == "converged"
+    stop.update(at=None)
+    femadh.run(sc, tmp_path / "acc", progress=False, resume=True)
+    assert differences(ref, summary(tmp_path / "acc")) == []
+    # (b) and (c) on the 50-node grid alone
+    one = femadh.load_scene(short_scene(tmp_path, nodes=50, step="0.5 nm"))
+    stop.update(at=1, calls=0)
+    with pytest.raises(KeyboardInterrupt):
+        femadh.run(one, tmp_path / "ne", progress=False, estimate="peak")
+    stop.update(at=None)
+    res = femadh.run(one, tmp_path / "ne", progress=False, resume=True)
+    assert res.status == "converged" and res.estimates and summary(tmp_path / "ne")[
+        "error_estimates"]
+    stop.update(at=1, calls=0)
+    with pytest.raises(KeyboardInterrupt):
+        femadh.run(one, tmp_path / "fd", progress=False)
+    f = tmp_path / "fd" / "fields.csv"
+    head, *rows = f.read_text().splitlines()
+    iw = head.split(",").index("w_m")
+    first = [i for i, r in enumerate(rows) if r.split(",")[0] == "0"]
+    cut = []
+    for i, r in enumerate(rows):
+        c = r.split(",")
+        if i in first:
+            if i == first[-1]:
+                continue
+            c[iw] = repr(10 * float(c[iw]))
+        cut.append(",".join(c))
+    f.write_text("\n".join([head, *cut]) + "\n")
+    stop.update(at=None)
+    solved.clear()
+    res = femadh.run(one, tmp_path / "fd", progress=False, resume=True)
+    assert res.status == "converged" and solved
+    assert any(w.startswith("resume: fields.csv") for w in res.warnings)

@@ -319,10 +319,11 @@ def cohesive_spacing(scene, target):
     if zone is None:
         return None
     lj = {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
-    share = work_of_adhesion(lj, scene.gap.sigma) / work_of_adhesion(scene.effects,
-                                                                      scene.gap.sigma)
-    if not 0 < share <= 1:
+    w_all = work_of_adhesion(scene.effects, scene.gap.sigma)
+    if not w_all > 0:
         return None
+    # (another law repulsive at sigma makes W_all < W_LJ: the LJ zone is then the whole)
+    share = min(1.0, work_of_adhesion(lj, scene.gap.sigma) / w_all)
     return zone[1] / CZ_NODES * (target / (REFERENCE_ACCURACY * share)) ** (1 / FIRST_ORDER)
 
 
@@ -334,34 +335,49 @@ def first_trial(scene, plan, target):
 
     For a finer request the scaling starts from the capped 1e-3 member: where the trapping
     cap binds, the cohesive zone is narrower than BAND_NODES resolve (its width and the safe
-    spacing both scale as E* / max|P'|), so the plan's spacing says nothing about the
-    accuracy there. And a sigma-gap Lennard-Jones request at or below 1e-3 starts no coarser
-    than :func:`cohesive_spacing` (CZ_NODES spacings across the law's cohesive zone). Measured
-    (validation/results/first_member.md, CPU seconds at load ~5): the Fig 4 scene
+    spacing both scale as E* delta / sigma0: :func:`cohesive_spacing`), so the plan's spacing
+    says nothing about the accuracy there. And a sigma-gap Lennard-Jones request at or below
+    1e-3 starts no coarser than :func:`cohesive_spacing` (CZ_NODES spacings across the law's
+    cohesive zone). A start the node budget refuses (MAX_NODES) falls back to the next
+    coarser of these (zone, capped, plan's): the loop then refines from it and says what the
+    request needs, where a refused start would end the request before any solve. A band
+    following the edge keeps its own cap (:func:`_follow_trial`): its spacing is scaled from
+    the plan's.
+
+    Measured (validation/results/first_member.md, CPU seconds at load ~5): the Fig 4 scene
     (sigma = 0.5 nm) at 1e-4 went 871 + 2791 nodes, 73.0 s (the plan's 39.3 nm scaled) ->
     1341 + 1765, 32.1 s (the capped 25.6 nm scaled) -> 1765 in one run, 21.3 s (the zone);
-    at 1e-3 279 + 493 -> 540 nodes, 1.8 -> 1.6 s; over the ten 1e-3 and 3e-4 requests
-    measured (Fig 4 and sigma variants, six stiction-map points) 73.4 -> 48.7 s, with the
-    estimate's jitter deciding single requests either way (Fig 4 at 3e-4: 2.5 -> 6.9 s, 624
-    -> 986 nodes; the slider at sigma 0.489 nm, p/psat 0.35: 22.8 -> 4.8 s). A band following
-    the edge keeps its own cap (:func:`_follow_trial`): its spacing is scaled from the
-    plan's."""
+    at 1e-3 279 + 493 -> 540 nodes, 1.8 -> 1.6 s. On the other 1e-3 and 3e-4 requests
+    measured (sigma variants of Fig 4, seven stiction-map points) the estimate's jitter
+    decides single requests either way: Fig 4 at 3e-4 2.5 -> 6.9 s (624 -> 986 nodes), the
+    slider at sigma 0.489 nm, p/psat 0.25 14.8 -> 22.3 s and p/psat 0.35 22.8 -> 4.8 s; the
+    eleven together 54.5 -> 48.3 s, and 31.7 -> 43.5 s without the last."""
     family = plan.family
+    top = family.band / MIN_BAND_NODES
     scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)
-    h = min(plan.spacing * scale, family.band / MIN_BAND_NODES)
+    # the starts, finest first; the last is the plan's
+    starts = [min(plan.spacing * scale, top)]
+    follows = False
     if scale < 1.0:
-        ref = _trial(scene, family, min(plan.spacing, family.band / MIN_BAND_NODES))
-        if ref.operator is not None and ref.follow is None and ref.spacing < ref.asked:
-            # (the probe's operator is dropped: the member is built at its own spacing)
-            h = min(ref.spacing * scale, family.band / MIN_BAND_NODES)
-    tr = _trial(scene, family, h)
-    if target <= REFERENCE_ACCURACY and tr.follow is None and tr.operator is not None:
+        ref = _trial(scene, family, min(plan.spacing, top))
+        follows = ref.follow is not None
+        if ref.operator is not None and not follows and ref.spacing < ref.asked:
+            starts.insert(0, min(ref.spacing * scale, top))
+        ref.operator = None         # (the probe's operator: the member is built at its own h)
+    if target <= REFERENCE_ACCURACY and not follows:
         # (a looser request keeps the trapping cap, which already over-resolves it: the Fig 4
         # scene at 3e-3 estimates 2.2e-3 on the capped member)
         hz = cohesive_spacing(scene, target)
-        if hz is not None and hz < tr.spacing:
-            tr = _trial(scene, family, hz)
-    return tr
+        if hz is not None and math.isfinite(hz) and 0 < hz < starts[0]:
+            starts.insert(0, hz)
+    for h in starts:
+        tr = _trial(scene, family, h)
+        if tr.follow is not None and h != starts[-1]:
+            # a band following the edge: its own cap, from the plan's spacing
+            return _trial(scene, family, starts[-1])
+        if tr.operator is not None:
+            return tr
+    return tr           # (every start refused: the loop says what the request needs)
 
 
 def _too_many_nodes(trial):

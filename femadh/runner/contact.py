@@ -39,13 +39,17 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
     claimed folder, then its figures. ``run``: the run of every kind
     (:func:`femadh.runner.run.run`), which the trials and the estimate's members go through
     (handed in: this module does not import its caller)."""
-    if resume and out_dir is not None and resume_from is None:
+    if resume and out_dir is not None and resume_from is None and (
+            folder_id is None or folder_id == scene_id(scene)):
         from .figures import resume_figures
 
         # a run stopped while its figures were drawn: its numbers are complete on disk
         # (every kind of run, before the adaptive or accuracy loop would start its trials
-        # over): only the missing figures are drawn
-        res = resume_figures(scene, out_dir, folder_id or scene_id(scene), figures=figures)
+        # over): only the missing figures are drawn. Only the run the user asked for: a
+        # loop's trial claims the user's folder under the user's scene id, and the folder
+        # may hold another trial's run
+        res = resume_figures(scene, out_dir, folder_id or scene_id(scene), figures=figures,
+                             estimate=estimate)
         if res is not None:
             return res
     if getattr(scene, "adaptive", False):

@@ -71,7 +71,7 @@ def _stopped(res, exc):
 STOPPED_IN_FIGURES = "stopped_in_figures"
 
 
-def resume_figures(scene, out_dir, folder_id, figures=True):
+def resume_figures(scene, out_dir, folder_id, figures=True, estimate=True):
     """``--resume`` of a run stopped while its figures were drawn: its sweep, peak search
     and error estimate are complete in its folder (summary.json, curve.csv, fields.csv), so
     nothing is solved again - the result is read back (:func:`_read_result`), the figures
@@ -85,7 +85,9 @@ def resume_figures(scene, out_dir, folder_id, figures=True):
     Returns the result, or None where this does not apply (the folder holds no such run,
     or a run this reader does not rebuild: an arclength trace, an [instrument], the edge
     route, an accuracy loop on uniform grids whose trial may not have been its last, files
-    that do not hold what the summary records): the caller resumes as any stopped run.
+    that do not hold what the summary records; or a resume that asks for the error
+    estimate (``estimate`` True) of a run made without one): the caller resumes as any
+    stopped run.
     summary.json is rewritten once, at the end: with the outcome once the figures are on
     disk, else (stopped again while drawing) as the first stop left it, the outcome kept; a
     kill while drawing leaves it as it was (each state on disk consistent: resumed alike).
@@ -95,7 +97,11 @@ def resume_figures(scene, out_dir, folder_id, figures=True):
     from ..io.run_folder import RunFolder, previous_run
     from ..io.progress import phase
 
-    if _pending_outcome(previous_run(Path(out_dir)), scene) is None:
+    prev = previous_run(Path(out_dir))
+    if _pending_outcome(prev, scene) is None or (
+            estimate is True and not prev.get("error_estimates")):
+        # (a run stopped in its figures without an estimate, resumed asking for one: the
+        # normal resume makes it)
         return None
     t0 = time.perf_counter()
     with RunFolder(out_dir, folder_id, scene.name, "resume") as folder:
@@ -200,6 +206,15 @@ def _read_result(scene, path, prev):
     except (OSError, ValueError, IndexError, KeyError):
         return None
     if fields is None or 0 not in fields:
+        return None
+    # fields.csv must hold the states curve.csv records (no checksum of its own): each state
+    # at its row's d (repr floats: the same bits), its columns of one length, the first
+    # state on the grid the summary names (a torn or edited file: solved again)
+    i_d = head.index("d_m")
+    for k, (d, *arrs) in fields.items():
+        if float(rows[k][i_d]) != d or len({a.size for a in arrs}) != 1:
+            return None
+    if fields[0][1].size != (prev.get("grid") or {}).get("nodes"):
         return None
     res.nodes = fields[0][1]
     for b, ks in picks.items():
