@@ -207,6 +207,58 @@ def test_bundled_scenes_keep_their_path(small):
     assert any("eq 20" in r for r in edge_route.static_reasons(fig8))
 
 
+#: the stiction map's sigma = 0.3 + 1.7/9 nm column (its points' exact sigma)
+MAP_SIGMA = "0.488888888889 nm"
+
+
+def test_auto_pilots_a_static_band_trapped_at_its_edge(monkeypatch):
+    """"auto" asks the pilot where the adaptive grid's first static member is trapped at the
+    contact edge by a meniscus step just above sigma (edge_route.edge_trap_ratio: its band
+    spacing over the one safe for LJ and the step summed). Measured on the stiction map
+    (validation/results/stiction_map_auto.md): sigma = 0.489 nm, p/psat 0.15, ratio 2.515
+    (first member 532 nodes; its sweep refined to 1772 and reached the map's 90-s limit,
+    the route converges in ~9 s) and p/psat 0.25, 1.690; not p/psat 0.45, 1.118 (within
+    EDGE_TRAP_MARGIN: the sweep meets 1e-3 on 289 and 395 nodes), nor the bundled slider
+    (sigma = 1 nm, p/psat 0.95: 0.19) or Fig 4 (no sub-grid step: 0). The ratio is the
+    capped member's, measured on the planned one (equal to 3 digits, docstring): checked
+    at p/psat 0.15 against the member the loop runs (7.5e-10 apart, measured). The pilot
+    (tested on its own) is a marker here: what is tested is the decision to ask it."""
+    import types
+
+    from femadh.discretisation import plan_grid
+    from femadh.discretisation.plan import follow_safe_spacing
+    from femadh.runner import adaptive
+
+    base = femadh.load_scene(SCENE).replace({"sweep.start": "4 nm"})
+
+    def point(rel):
+        return base.replace({"effects.asperity_gap.sigma": MAP_SIGMA,
+                             "effects.capillary.relative_pressure": rel})
+    low, mid, high = point(0.15), point(0.25), point(0.45)
+    ratios = [edge_route.edge_trap_ratio(sc) for sc in (low, mid, high)]
+    assert ratios[0] > ratios[1] > edge_route.EDGE_TRAP_MARGIN > ratios[2] > 1.0, ratios
+    assert edge_route.edge_trap_ratio(femadh.load_scene(SCENE)) < 0.5
+    assert edge_route.edge_trap_ratio(
+        femadh.load_scene("validation/scenes/paper1_fig4.toml")) == 0.0
+    # the member the loop runs: the ratio measured on it, capped as run_adaptive caps it
+    plan = plan_grid(low.effects, low.gap.sigma, low.sphere, low.analysis_radius,
+                     low.d_values, low.target_accuracy)
+    h = min(plan.spacing, plan.family.band / adaptive.MIN_BAND_NODES)
+    h, op, problem = adaptive._capped(low, plan.family, h)
+    assert op.grid.n == 532
+    assert ratios[0] == pytest.approx(h / follow_safe_spacing(problem), rel=1e-6)
+
+    marker = types.SimpleNamespace(retract=types.SimpleNamespace(
+        best=types.SimpleNamespace(d=math.inf)))      # a fold the sweep presses in to
+    asked = []
+    monkeypatch.setattr(edge_route, "pilot", lambda scene: asked.append(scene) or marker)
+    assert edge_route.route_for(low, False) is marker
+    assert edge_route.route_for(mid, False) is marker
+    assert edge_route.route_for(high, False) is None
+    assert edge_route.route_for(low.replace({"solver.route": "grid"}), False) is None
+    assert len(asked) == 2
+
+
 def test_pilot_fold_at_its_lowest_edge_radius_is_no_route():
     """The map's point sigma = 0.867 nm, p/psat 0.65: the pilot's d(c) turns just below its
     lowest edge radius (c ~ 0.046 um), where the finer members find no fold (measured: the

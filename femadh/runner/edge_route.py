@@ -24,7 +24,10 @@ Which runs take it (:func:`route_for`): a scene that
 - and whose adaptive grid would follow the contact edge, i.e. whose static band at the
   trapping-safe spacing exceeds :data:`~femadh.runner.adaptive.FOLLOW_NODES` (the scenes
   whose retract unzips node by node; every bundled scene has a static band and keeps its
-  path, numbers bit for bit);
+  path, numbers bit for bit), or whose static first member is trapped at the contact edge
+  by a sub-grid meniscus step just above sigma (:func:`edge_trapped`: the low-humidity
+  points of the stiction map, whose sweep refines its static band to 700-1800 nodes and
+  unzips there, 35-90+ s a point);
 
 and then a pilot trace (< 1 s) decides: a fold of d(c) at a finite edge radius takes the
 route, no fold (the contact shrinks to nothing without a jump, DMT's side: the largest force
@@ -219,20 +222,88 @@ def static_reasons(scene):
 #: tests compare the two)
 ENABLED = True
 
+#: :func:`edge_trapped`: how far the adaptive grid's first static member's band spacing may
+#: exceed the spacing safe for the softening a node at the contact edge actually meets
+#: (:func:`~femadh.discretisation.plan.follow_safe_spacing`: LJ and the meniscus step summed)
+#: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
+#: points (validation/results/stiction_map_auto.md): at a ratio 1.22-2.52 (7 points) the
+#: first member's estimate was 1.4e-3-1.6e-2, the sweep refined its band 2.3-8.5x in nodes
+#: (to 604-1772) and cost 6-90+ s (5 of 7 above 13 s; sigma 0.489 nm, p/psat 0.15 reached
+#: the map's 90-s limit); at 1.12 and below (18 points) it met 1e-3 at the first member or
+#: refined at most 3.3x to <= 602 nodes, 1-15 s, cheaper than the route's 6-12 s with the
+#: sweep's outputs. The margin sits in that gap (1.12-1.22): a ratio just above 1 (the
+#: estimate's coarsest member at the safe limit, 0.98-1.03 on the map's p/psat >= 0.55
+#: points at sigma 0.489 nm) costs the sweep nothing
+EDGE_TRAP_MARGIN = 1.2
+
+
+def edge_trap_ratio(scene):
+    """How far ``scene``'s adaptive first member (the static band the sweep's loop runs
+    first, :func:`femadh.runner.adaptive.run_adaptive`) is trapped at the contact edge: its
+    band spacing over the spacing safe for the softening a node at
+    the edge meets, LJ and a sub-grid meniscus step summed
+    (:func:`~femadh.discretisation.plan.follow_safe_spacing`). The static cap
+    (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of the two and
+    under-reads a meniscus edge just above sigma, which acts as a Dugdale cohesive zone of
+    ~30-200 nm at the contact edge (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`).
+    On such a scene the sweep's estimate members unzip, its loop refines the static band by
+    the accuracy (not by the trapping cap, so FOLLOW_NODES does not see it) and its retract
+    unzips node by node on 600-1800 nodes; the edge route traces the branch in its edge
+    radius instead.
+
+    Measured on the planned member (the loop's first spacing before the cap, ~180 nodes:
+    2-7 ms): both safe spacings grow like the spacing they are measured at, so the capped
+    spacing min(h, 0.98 safe) over the edge's safe spacing is the capped member's (equal to
+    3 digits on the stiction map's 90 points off the sigma = 0.3 nm column, measured on
+    the capped member itself). Only a scene with a sub-grid step law
+    (:attr:`~femadh.laws.step.SmoothStepLaw.SUBGRID`, the capillary condensate) is
+    measured: without one the two softenings are one (the bundled Fig 3 and Fig 4 scenes:
+    path and cost unchanged). 0 for a scene without one, or whose planned member the node
+    limit refuses (the sweep's loop reports that)."""
+    from ..discretisation import plan_grid
+    from ..discretisation.plan import follow_safe_spacing, safe_spacing
+    from ..elastic import GreenOperator
+    from ..elastic.grid import NodeBudgetError
+    from ..scene import build_problem
+    from . import adaptive
+
+    if scene.gap is None or not any(getattr(law, "SUBGRID", False)
+                                    for law in scene.effects.values()):
+        return 0.0
+    target = scene.target_accuracy
+    # the first member's spacing as run_adaptive plans it (before the trapping cap)
+    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
+                     scene.d_values, target)
+    fam = plan.family
+    h = min(plan.spacing * (target / adaptive.REFERENCE_ACCURACY) ** (1.0 / adaptive.ORDER),
+            fam.band / adaptive.MIN_BAND_NODES)
+    try:
+        problem = build_problem(scene, operator=GreenOperator(fam.member(h), scene.e_star))
+    except NodeBudgetError:
+        return 0.0
+    # (the cap's 0.98 as runner/adaptive.py _capped applies it)
+    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)
+
+
+def edge_trapped(scene):
+    """Whether ``scene``'s adaptive first member is trapped at the contact edge beyond
+    EDGE_TRAP_MARGIN (:func:`edge_trap_ratio`): "auto" then asks the pilot."""
+    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN
+
 
 def route_for(scene, follows):
     """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
     (:func:`femadh.runner.adaptive._follow_trial` chose a follow band). The scene's
-    ``[solver] route``: "grid" never, "auto" where its grid follows the edge, "edge"
-    wherever it can; the pilot then
-    decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
+    ``[solver] route``: "grid" never, "auto" where its grid follows the edge or its first
+    static member is trapped at the edge (:func:`edge_trapped`), "edge" wherever it can;
+    the pilot then decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
     whatever its route: the adaptive loop's trials and the estimate's members are such
     scenes (a grid of their own) and inherit the key."""
     route = getattr(scene, "route", "auto")
     if not ENABLED or route == "grid" or static_reasons(scene):
         return None
-    if route == "auto" and not follows:
+    if route == "auto" and not (follows or edge_trapped(scene)):
         return None
     # ("edge" and "peak" pilot wherever the route can carry the scene)
     try:
