@@ -2372,6 +2372,28 @@ DEFECTS = [
       "femadh/reference/maugis.py",
       (("    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))\n",
         "    x, P = _refined_min(lambda x: -P_of_logm(x), _LOG_M1, -P_of_logm(_LOG_M1))\n    P = -P\n"),)),
+    D("trap_auto_ignores_trap", "edge route: 'auto' pilots only where the grid follows the "
+      "edge (a static band trapped at its edge keeps the sweep)", "femadh/runner/edge_route.py",
+      (("    if route == \"auto\" and not (follows or edge_trapped(scene)):",
+        "    if route == \"auto\" and not follows:"),)),
+    D("trap_static_measure", "edge route: the trap ratio against the static cap's softening "
+      "(the larger of LJ and the step) instead of their sum", "femadh/runner/edge_route.py",
+      (("    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)",
+        "    return min(h, 0.98 * safe_spacing(problem)) / safe_spacing(problem)"),)),
+    D("trap_uncapped_spacing", "edge route: the trap ratio from the planned spacing, not the "
+      "trapping cap's", "femadh/runner/edge_route.py",
+      (("    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)",
+        "    return h / follow_safe_spacing(problem)"),)),
+    D("trap_no_margin", "edge route: 'auto' pilots at any trap ratio above 1 (no margin)",
+      "femadh/runner/edge_route.py",
+      (("    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN\n",
+        "    return edge_trap_ratio(scene) > 1.0\n"),)),
+    D("trap_every_law", "edge route: the trap ratio measured on a scene without a sub-grid "
+      "step too", "femadh/runner/edge_route.py",
+      (("    if scene.gap is None or not any(getattr(law, \"SUBGRID\", False)\n"
+        "                                    for law in scene.effects.values()):\n"
+        "        return 0.0",
+        "    if scene.gap is None:\n        return 0.0"),)),
 ]
 
 
