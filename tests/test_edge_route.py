@@ -194,7 +194,9 @@ def test_bundled_scenes_keep_their_path(small):
     assert edge_route.static_reasons(slider) == []
     assert edge_route.route_for(slider, True) is None
     assert edge_route.route_for(slider, False) is None          # a static band: no pilot
-    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot):
+    # a scene whose grid would not follow the edge, and whose static member is not trapped
+    # at the edge (test_auto_pilots_a_static_band_trapped_at_its_edge), keeps its path, fold
+    # or not (no pilot):
     # the bundled Fig 4 scene's pilot finds a fold, its default path is the sweep (its
     # headline numbers, all estimated, stay as they were)
     assert edge_route.route_for(small, False) is None

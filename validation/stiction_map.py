@@ -50,8 +50,10 @@ POINT_LIMIT = "90 s"
 #: sweep's outputs a routed point costs 8.1 and 16.0 CPU-s on the sigma = 0.3 nm column's two
 #: points measured (36-41 s wall at load 4-9: the approach by the sweep 8.7-26 s, the
 #: retract's states 3.9-26 s; validation/results/edge_route.md) against 1.2-1.5 CPU-s for the
-#: max adhesion alone, and "auto" pilots only where the adaptive grid would follow the edge
-#: (the four low-humidity static-band points stay on the sweep and reach POINT_LIMIT)
+#: max adhesion alone. "auto" (``--route auto``, validation/results/stiction_map_auto.md)
+#: pilots where the adaptive grid would follow the edge (the sigma = 0.3 nm column) or its
+#: first static member is trapped at the edge by the meniscus step
+#: (femadh/runner/edge_route.py edge_trap_ratio: seven low-humidity points)
 ROUTE = "peak"
 #: the routes ``--route`` may ask for: the map's own (ROUTE) or the scene's default ("auto":
 #: the map as a user who sets nothing runs it; validation/results/stiction_map_auto.md)
@@ -262,8 +264,8 @@ def _routed(out):
 
 def _slowest(out, points, n=8):
     """(sigma m, p/psat, wall s, how) of the ``n`` slowest of the study's ``points`` in its
-    folder ``out`` (their summaries' wall_time_s; how: the status and "edge route" or the
-    sweep's nodes, trial by trial)."""
+    folder ``out`` (their summaries' wall time, the adaptive loop's where it ran; how: the
+    status and "edge route" or the sweep's nodes, trial by trial)."""
     import json
 
     rows = []
@@ -276,9 +278,11 @@ def _slowest(out, points, n=8):
         how = ("edge route" if (d.get("grid") or {}).get("route") == "edge-branch" else
                "sweep, " + " -> ".join(str(s["nodes"]) for s in acc.get("steps", []))
                + " nodes")
+        # (an adaptive sweep's own wall_time_s is its last trial's: the loop's is the point's)
         rows.append((p.scene.gap.sigma,
                      float(p.scene.raw["effects"]["capillary"]["relative_pressure"]),
-                     d.get("wall_time_s", math.nan), f"{d.get('status')}, {how}"))
+                     acc.get("wall_time_s", d.get("wall_time_s", math.nan)),
+                     f"{d.get('status')}, {how}"))
     rows.sort(key=lambda x: -x[2])
     return rows[:n]
 
