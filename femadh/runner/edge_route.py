@@ -227,13 +227,13 @@ ENABLED = True
 #: (:func:`~femadh.discretisation.plan.follow_safe_spacing`: LJ and the meniscus step summed)
 #: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
 #: points (validation/results/stiction_map_auto.md): at a ratio 1.22-2.52 (7 points) the
-#: first member's estimate was 1.4e-3-1.6e-2, the sweep refined its band 2.3-8.5x in nodes
-#: (to 604-1772) and cost 6-90+ s (5 of 7 above 13 s; sigma 0.489 nm, p/psat 0.15 reached
-#: the map's 90-s limit); at 1.12 and below (18 points) it met 1e-3 at the first member or
-#: refined at most 3.3x to <= 602 nodes, 1-15 s, cheaper than the route's 6-12 s with the
-#: sweep's outputs. The margin sits in that gap (1.12-1.22): a ratio just above 1 (the
-#: estimate's coarsest member at the safe limit, 0.98-1.03 on the map's p/psat >= 0.55
-#: points at sigma 0.489 nm) costs the sweep nothing
+#: first member's estimate was 1.4e-3-1.6e-2, the sweep refined its band 2.5-8.5x in nodes
+#: (to 604-1772) and cost 4-90+ s wall at load 3-6 (sigma 0.489 nm, p/psat 0.15 reached the
+#: map's 90-s limit in every run); at 1.12 and below (18 points) it met 1e-3 at the first
+#: member or refined at most 3.3x to <= 602 nodes, 1-15 s, against 6-19 s by the route with
+#: the sweep's outputs at the same load. The margin sits in that gap (1.12-1.22): a ratio
+#: just above 1 (the estimate's coarsest member at the safe limit: 1.01-1.03 on the map's
+#: p/psat 0.55-0.65 points at sigma 0.489 nm) costs the sweep nothing
 EDGE_TRAP_MARGIN = 1.2
 
 
