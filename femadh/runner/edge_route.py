@@ -228,7 +228,7 @@ ENABLED = True
 #: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
 #: points (validation/results/stiction_map_auto.md): at a ratio 1.22-2.52 (7 points) the
 #: first member's estimate was 1.4e-3-1.6e-2, the sweep refined its band 2.5-8.5x in nodes
-#: (to 604-1772) and cost 4-90+ s wall at load 3-6 (sigma 0.489 nm, p/psat 0.15 reached the
+#: (to 604-1772) and cost 3.6-90+ s wall at load 3-6 (sigma 0.489 nm, p/psat 0.15 reached the
 #: map's 90-s limit in every run); at 1.12 and below (18 points) it met 1e-3 at the first
 #: member or refined at most 3.3x to <= 602 nodes, 1-15 s, against 6-19 s by the route with
 #: the sweep's outputs at the same load. The margin sits in that gap (1.12-1.22): a ratio
