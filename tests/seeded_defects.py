@@ -2378,12 +2378,12 @@ DEFECTS = [
         "    if route == \"auto\" and not follows:"),)),
     D("trap_static_measure", "edge route: the trap ratio against the static cap's softening "
       "(the larger of LJ and the step) instead of their sum", "femadh/runner/edge_route.py",
-      (("    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)",
-        "    return min(h, 0.98 * safe_spacing(problem)) / safe_spacing(problem)"),)),
-    D("trap_uncapped_spacing", "edge route: the trap ratio from the planned spacing, not the "
-      "trapping cap's", "femadh/runner/edge_route.py",
-      (("    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)",
-        "    return h / follow_safe_spacing(problem)"),)),
+      (("    from ..discretisation.plan import follow_safe_spacing\n",
+        "    from ..discretisation.plan import safe_spacing as follow_safe_spacing\n"),)),
+    D("trap_uncapped_spacing", "edge route: the trap ratio from the plan's spacing, not the "
+      "first member's", "femadh/runner/edge_route.py",
+      (("    return first.spacing / follow_safe_spacing(problem)",
+        "    return plan.spacing / follow_safe_spacing(problem)"),)),
     D("trap_no_margin", "edge route: 'auto' pilots at any trap ratio above 1 (no margin)",
       "femadh/runner/edge_route.py",
       (("    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN\n",

@@ -219,36 +219,37 @@ def test_auto_pilots_a_static_band_trapped_at_its_edge(monkeypatch):
     spacing over the one safe for LJ and the step summed). Measured on the stiction map
     (validation/results/stiction_map_auto.md): sigma = 0.489 nm, p/psat 0.15, ratio 2.515
     (first member 532 nodes; its sweep refined to 1772 and reached the map's 90-s limit,
-    the route converges in ~9 s) and p/psat 0.25, 1.690; not p/psat 0.45, 1.118 (within
-    EDGE_TRAP_MARGIN: the sweep meets 1e-3 on 289 and 395 nodes), nor the bundled slider
-    (sigma = 1 nm, p/psat 0.95: 0.19) or Fig 4 (no sub-grid step: 0). The ratio is the
-    capped member's, measured on the planned one (equal to 3 digits, docstring): checked
-    at p/psat 0.15 against the member the loop runs (7.5e-10 apart, measured). The pilot
-    (tested on its own) is a marker here: what is tested is the decision to ask it."""
+    the route converges in ~6-9 s) and p/psat 0.25, 1.350; not p/psat 0.35, 1.140, the
+    nearest below EDGE_TRAP_MARGIN (the sweep meets 1e-3 from its 322-node first member),
+    nor the bundled slider (sigma = 1 nm, p/psat 0.95: 0.19) or Fig 4 (no sub-grid step:
+    0). The pilot (tested on its own) is a marker here: what is tested is the decision to
+    ask it."""
     import types
 
-    from femadh.discretisation import plan_grid
-    from femadh.discretisation.plan import follow_safe_spacing
-    from femadh.runner import adaptive
+    from femadh.discretisation.plan import safe_spacing
+    from femadh.scene import build_problem
 
     base = femadh.load_scene(SCENE).replace({"sweep.start": "4 nm"})
 
     def point(rel):
         return base.replace({"effects.asperity_gap.sigma": MAP_SIGMA,
                              "effects.capillary.relative_pressure": rel})
-    low, mid, high = point(0.15), point(0.25), point(0.45)
+    low, mid, high = point(0.15), point(0.25), point(0.35)
     ratios = [edge_route.edge_trap_ratio(sc) for sc in (low, mid, high)]
     assert ratios[0] > ratios[1] > edge_route.EDGE_TRAP_MARGIN > ratios[2] > 1.0, ratios
     assert edge_route.edge_trap_ratio(femadh.load_scene(SCENE)) < 0.5
     assert edge_route.edge_trap_ratio(
         femadh.load_scene("validation/scenes/paper1_fig4.toml")) == 0.0
-    # the member the loop runs: the ratio measured on it, capped as run_adaptive caps it
+    # the static cap alone passes the 532-node member (0.98 of its safe spacing): the
+    # trap is the summed softening's
+    from femadh.discretisation import plan_grid
+    from femadh.runner import adaptive
+
     plan = plan_grid(low.effects, low.gap.sigma, low.sphere, low.analysis_radius,
                      low.d_values, low.target_accuracy)
-    h = min(plan.spacing, plan.family.band / adaptive.MIN_BAND_NODES)
-    h, op, problem = adaptive._capped(low, plan.family, h)
-    assert op.grid.n == 532
-    assert ratios[0] == pytest.approx(h / follow_safe_spacing(problem), rel=1e-6)
+    first = adaptive.first_trial(low, plan, low.target_accuracy)
+    assert first.nodes == 532 and first.follow is None
+    assert first.spacing < safe_spacing(build_problem(low, operator=first.operator))
 
     marker = types.SimpleNamespace(retract=types.SimpleNamespace(
         best=types.SimpleNamespace(d=math.inf)))      # a fold the sweep presses in to

@@ -239,31 +239,26 @@ EDGE_TRAP_MARGIN = 1.2
 
 def edge_trap_ratio(scene):
     """How far ``scene``'s adaptive first member (the static band the sweep's loop runs
-    first, :func:`femadh.runner.adaptive.run_adaptive`) is trapped at the contact edge: its
-    band spacing over the spacing safe for the softening a node at
-    the edge meets, LJ and a sub-grid meniscus step summed
-    (:func:`~femadh.discretisation.plan.follow_safe_spacing`). The static cap
-    (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of the two and
-    under-reads a meniscus edge just above sigma, which acts as a Dugdale cohesive zone of
-    ~30-200 nm at the contact edge (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`).
-    On such a scene the sweep's estimate members unzip, its loop refines the static band by
-    the accuracy (not by the trapping cap, so FOLLOW_NODES does not see it) and its retract
-    unzips node by node on 600-1800 nodes; the edge route traces the branch in its edge
-    radius instead.
+    first, :func:`femadh.runner.adaptive.first_trial`) is trapped at the contact edge: its
+    band spacing over the spacing safe for the softening a node at the edge meets, LJ and
+    a sub-grid meniscus step summed (:func:`~femadh.discretisation.plan.follow_safe_spacing`).
+    The static cap (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of
+    the two and under-reads a meniscus edge just above sigma, which acts as a Dugdale
+    cohesive zone of ~30-200 nm at the contact edge
+    (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`). On such a scene the sweep's
+    estimate members unzip, its loop refines the static band by the accuracy (not by the
+    trapping cap, so FOLLOW_NODES does not see it) and its retract unzips node by node on
+    600-1800 nodes; the edge route traces the branch in its edge radius instead.
 
-    Measured on the planned member (the loop's first spacing before the cap, ~180 nodes:
-    2-7 ms): both safe spacings grow like the spacing they are measured at, so the capped
-    spacing min(h, 0.98 safe) over the edge's safe spacing is the capped member's (equal to
-    3 digits on the stiction map's 90 points off the sigma = 0.3 nm column, measured on
-    the capped member itself). Only a scene with a sub-grid step law
+    The first member is built as the loop builds it (3-42 ms on the stiction map's points;
+    the loop's own is not handed to the route). Only a scene with a sub-grid step law
     (:attr:`~femadh.laws.step.SmoothStepLaw.SUBGRID`, the capillary condensate) is
     measured: without one the two softenings are one (the bundled Fig 3 and Fig 4 scenes:
-    path and cost unchanged). 0 for a scene without one, or whose planned member the node
-    limit refuses (the sweep's loop reports that)."""
+    path and cost unchanged). 0 for a scene without one, or whose first member follows the
+    edge (the route's other test) or is refused by the node limit (the sweep's loop reports
+    that)."""
     from ..discretisation import plan_grid
-    from ..discretisation.plan import follow_safe_spacing, safe_spacing
-    from ..elastic import GreenOperator
-    from ..elastic.grid import NodeBudgetError
+    from ..discretisation.plan import follow_safe_spacing
     from ..scene import build_problem
     from . import adaptive
 
@@ -271,18 +266,13 @@ def edge_trap_ratio(scene):
                                     for law in scene.effects.values()):
         return 0.0
     target = scene.target_accuracy
-    # the first member's spacing as run_adaptive plans it (before the trapping cap)
     plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
                      scene.d_values, target)
-    fam = plan.family
-    h = min(plan.spacing * (target / adaptive.REFERENCE_ACCURACY) ** (1.0 / adaptive.ORDER),
-            fam.band / adaptive.MIN_BAND_NODES)
-    try:
-        problem = build_problem(scene, operator=GreenOperator(fam.member(h), scene.e_star))
-    except NodeBudgetError:
+    first = adaptive.first_trial(scene, plan, target)
+    if first.operator is None or first.follow is not None:
         return 0.0
-    # (the cap's 0.98 as runner/adaptive.py _capped applies it)
-    return min(h, 0.98 * safe_spacing(problem)) / follow_safe_spacing(problem)
+    problem = build_problem(scene, operator=first.operator)
+    return first.spacing / follow_safe_spacing(problem)
 
 
 def edge_trapped(scene):
