@@ -53,7 +53,7 @@ POINT_LIMIT = "90 s"
 #: max adhesion alone. "auto" (``--route auto``, validation/results/stiction_map_auto.md)
 #: pilots where the adaptive grid would follow the edge (the sigma = 0.3 nm column) or its
 #: first static member is trapped at the edge by the meniscus step
-#: (femadh/runner/edge_route.py edge_trap_ratio: seven low-humidity points)
+#: (femadh/runner/edge_route.py edge_trap_ratio: six low-humidity points)
 ROUTE = "peak"
 #: the routes ``--route`` may ask for: the map's own (ROUTE) or the scene's default ("auto":
 #: the map as a user who sets nothing runs it; validation/results/stiction_map_auto.md)

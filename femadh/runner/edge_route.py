@@ -226,14 +226,14 @@ ENABLED = True
 #: exceed the spacing safe for the softening a node at the contact edge actually meets
 #: (:func:`~femadh.discretisation.plan.follow_safe_spacing`: LJ and the meniscus step summed)
 #: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
-#: points (validation/results/stiction_map_auto.md): at a ratio 1.22-2.52 (7 points) the
-#: first member's estimate was 1.4e-3-1.6e-2, the sweep refined its band 2.5-8.5x in nodes
-#: (to 604-1772) and cost 3.6-90+ s wall at load 3-6 (sigma 0.489 nm, p/psat 0.15 reached the
-#: map's 90-s limit in every run); at 1.12 and below (18 points) it met 1e-3 at the first
-#: member or refined at most 3.3x to <= 602 nodes, 1-15 s, against 6-19 s by the route with
-#: the sweep's outputs at the same load. The margin sits in that gap (1.12-1.22): a ratio
-#: just above 1 (the estimate's coarsest member at the safe limit: 1.01-1.03 on the map's
-#: p/psat 0.55-0.65 points at sigma 0.489 nm) costs the sweep nothing
+#: points (validation/results/stiction_map_auto.md, main's sweep at load 3-4.5): at a ratio
+#: 1.22-2.52 (6 points) the first member's estimate was 4.4e-3-1.6e-2 and the sweep refined
+#: its band 2.7-8.5x in nodes (to 604-1772): 16-90+ s on four (sigma 0.489 nm, p/psat 0.15
+#: reached the map's 90-s limit in every run), 2-3 s on two; the route 3.3-5.0 s. At 1.14
+#: and below (19 points) it met 1e-3 at the first member or refined at most 3.3x to <= 615
+#: nodes, 0.3-6.6 s. The margin sits in that gap (1.14-1.22): a ratio just above 1 (the
+#: estimate's coarsest member at the safe limit: 1.01-1.14 on the map's p/psat 0.35-0.65
+#: points at sigma 0.489 nm) costs the sweep nothing
 EDGE_TRAP_MARGIN = 1.2
 
 
