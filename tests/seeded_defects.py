@@ -2427,6 +2427,28 @@ DEFECTS = [
       "them against curve.csv and the grid", "femadh/runner/figures.py",
       (('        if float(rows[k][i_d]) != d or len({a.size for a in arrs}) != 1:\n            return None\n    if fields[0][1].size != (prev.get("grid") or {}).get("nodes"):\n        return None\n',
         ''),)),
+    D("trap_auto_ignores_trap", "edge route: 'auto' pilots only where the grid follows the "
+      "edge (a static band trapped at its edge keeps the sweep)", "femadh/runner/edge_route.py",
+      (("    if route == \"auto\" and not (follows or edge_trapped(scene)):",
+        "    if route == \"auto\" and not follows:"),)),
+    D("trap_static_measure", "edge route: the trap ratio against the static cap's softening "
+      "(the larger of LJ and the step) instead of their sum", "femadh/runner/edge_route.py",
+      (("    from ..discretisation.plan import follow_safe_spacing\n",
+        "    from ..discretisation.plan import safe_spacing as follow_safe_spacing\n"),)),
+    D("trap_uncapped_spacing", "edge route: the trap ratio from the plan's spacing, not the "
+      "first member's", "femadh/runner/edge_route.py",
+      (("    return first.spacing / follow_safe_spacing(problem)",
+        "    return plan.spacing / follow_safe_spacing(problem)"),)),
+    D("trap_no_margin", "edge route: 'auto' pilots at any trap ratio above 1 (no margin)",
+      "femadh/runner/edge_route.py",
+      (("    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN\n",
+        "    return edge_trap_ratio(scene) > 1.0\n"),)),
+    D("trap_every_law", "edge route: the trap ratio measured on a scene without a sub-grid "
+      "step too", "femadh/runner/edge_route.py",
+      (("    if scene.gap is None or not any(getattr(law, \"SUBGRID\", False)\n"
+        "                                    for law in scene.effects.values()):\n"
+        "        return 0.0",
+        "    if scene.gap is None:\n        return 0.0"),)),
 ]
 
 

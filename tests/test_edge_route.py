@@ -194,7 +194,9 @@ def test_bundled_scenes_keep_their_path(small):
     assert edge_route.static_reasons(slider) == []
     assert edge_route.route_for(slider, True) is None
     assert edge_route.route_for(slider, False) is None          # a static band: no pilot
-    # a scene whose grid would not follow the edge keeps its path, fold or not (no pilot):
+    # a scene whose grid would not follow the edge, and whose static member is not trapped
+    # at the edge (test_auto_pilots_a_static_band_trapped_at_its_edge), keeps its path, fold
+    # or not (no pilot):
     # the bundled Fig 4 scene's pilot finds a fold, its default path is the sweep (its
     # headline numbers, all estimated, stay as they were)
     assert edge_route.route_for(small, False) is None
@@ -205,6 +207,59 @@ def test_bundled_scenes_keep_their_path(small):
     assert any("grid is set" in r for r in edge_route.static_reasons(fig6))
     fig8 = femadh.load_scene("validation/scenes/paper1_fig8_rho179.toml")
     assert any("eq 20" in r for r in edge_route.static_reasons(fig8))
+
+
+#: the stiction map's sigma = 0.3 + 1.7/9 nm column (its points' exact sigma)
+MAP_SIGMA = "0.488888888889 nm"
+
+
+def test_auto_pilots_a_static_band_trapped_at_its_edge(monkeypatch):
+    """"auto" asks the pilot where the adaptive grid's first static member is trapped at the
+    contact edge by a meniscus step just above sigma (edge_route.edge_trap_ratio: its band
+    spacing over the one safe for LJ and the step summed). Measured on the stiction map
+    (validation/results/stiction_map_auto.md): sigma = 0.489 nm, p/psat 0.15, ratio 2.515
+    (first member 532 nodes; its sweep refined to 1772 and reached the map's 90-s limit,
+    the route converges in ~6-9 s) and p/psat 0.25, 1.350; not p/psat 0.35, 1.140, the
+    nearest below EDGE_TRAP_MARGIN (the sweep meets 1e-3 from its 322-node first member),
+    nor the bundled slider (sigma = 1 nm, p/psat 0.95: 0.19) or Fig 4 (no sub-grid step:
+    0). The pilot (tested on its own) is a marker here: what is tested is the decision to
+    ask it."""
+    import types
+
+    from femadh.discretisation.plan import safe_spacing
+    from femadh.scene import build_problem
+
+    base = femadh.load_scene(SCENE).replace({"sweep.start": "4 nm"})
+
+    def point(rel):
+        return base.replace({"effects.asperity_gap.sigma": MAP_SIGMA,
+                             "effects.capillary.relative_pressure": rel})
+    low, mid, high = point(0.15), point(0.25), point(0.35)
+    ratios = [edge_route.edge_trap_ratio(sc) for sc in (low, mid, high)]
+    assert ratios[0] > ratios[1] > edge_route.EDGE_TRAP_MARGIN > ratios[2] > 1.0, ratios
+    assert edge_route.edge_trap_ratio(femadh.load_scene(SCENE)) < 0.5
+    assert edge_route.edge_trap_ratio(
+        femadh.load_scene("validation/scenes/paper1_fig4.toml")) == 0.0
+    # the static cap alone passes the 532-node member (0.98 of its safe spacing): the
+    # trap is the summed softening's
+    from femadh.discretisation import plan_grid
+    from femadh.runner import adaptive
+
+    plan = plan_grid(low.effects, low.gap.sigma, low.sphere, low.analysis_radius,
+                     low.d_values, low.target_accuracy)
+    first = adaptive.first_trial(low, plan, low.target_accuracy)
+    assert first.nodes == 532 and first.follow is None
+    assert first.spacing < safe_spacing(build_problem(low, operator=first.operator))
+
+    marker = types.SimpleNamespace(retract=types.SimpleNamespace(
+        best=types.SimpleNamespace(d=math.inf)))      # a fold the sweep presses in to
+    asked = []
+    monkeypatch.setattr(edge_route, "pilot", lambda scene: asked.append(scene) or marker)
+    assert edge_route.route_for(low, False) is marker
+    assert edge_route.route_for(mid, False) is marker
+    assert edge_route.route_for(high, False) is None
+    assert edge_route.route_for(low.replace({"solver.route": "grid"}), False) is None
+    assert len(asked) == 2
 
 
 def test_pilot_fold_at_its_lowest_edge_radius_is_no_route():

@@ -50,17 +50,23 @@ POINT_LIMIT = "90 s"
 #: sweep's outputs a routed point costs 8.1 and 16.0 CPU-s on the sigma = 0.3 nm column's two
 #: points measured (36-41 s wall at load 4-9: the approach by the sweep 8.7-26 s, the
 #: retract's states 3.9-26 s; validation/results/edge_route.md) against 1.2-1.5 CPU-s for the
-#: max adhesion alone, and "auto" pilots only where the adaptive grid would follow the edge
-#: (the four low-humidity static-band points stay on the sweep and reach POINT_LIMIT)
+#: max adhesion alone. "auto" (``--route auto``, validation/results/stiction_map_auto.md)
+#: pilots where the adaptive grid would follow the edge (the sigma = 0.3 nm column) or its
+#: first static member is trapped at the edge by the meniscus step
+#: (femadh/runner/edge_route.py edge_trap_ratio: six low-humidity points)
 ROUTE = "peak"
+#: the routes ``--route`` may ask for: the map's own (ROUTE) or the scene's default ("auto":
+#: the map as a user who sets nothing runs it; validation/results/stiction_map_auto.md)
+ROUTES = ("peak", "auto")
 
 
-def stiction_map(out, sigma=None):
+def stiction_map(out, sigma=None, route=ROUTE):
     """The map at the scene's defaults: the adaptive grid to accuracy 1e-3, the points whose
-    retract has a pull-off fold by the edge route (ROUTE; points femadh refuses, or that
-    reach POINT_LIMIT, keep their reason); ``sigma`` (e.g. "0.3 nm"): only that column."""
+    retract has a pull-off fold by the edge route (``route``, ROUTE by default; points femadh
+    refuses, or that reach POINT_LIMIT, keep their reason); ``sigma`` (e.g. "0.3 nm"): only
+    that column."""
     scene = femadh.load_scene(SCENE).replace({"solver.time_limit": POINT_LIMIT,
-                                              "solver.route": ROUTE})
+                                              "solver.route": route})
     t0 = time.perf_counter()
     vary = MAP if sigma is None else {**MAP, "effects.asperity_gap.sigma": [sigma]}
     points, records = run_study(scene, vary, out, workers=2,
@@ -85,7 +91,7 @@ def stiction_map(out, sigma=None):
         else:
             fails.append((p.scene.gap.sigma, rel_of(p), _reason(out, p, rec)))
     norm = 4 * math.pi * scene.sphere.radius * gamma
-    return sig, rel, F, E, norm, wall, fails, len(points)
+    return sig, rel, F, E, norm, wall, fails, len(points), points
 
 
 def _reason(out, point, rec):
@@ -167,38 +173,50 @@ def main(argv=None):
                     "whose meniscus edge sits just above sigma (printed, no file written)")
     ap.add_argument("--sigma", help="only the map's column at this asperity gap (e.g. "
                     "'0.3 nm', the map's first): printed, no file written")
+    ap.add_argument("--route", choices=ROUTES, default=ROUTE,
+                    help=f"[solver] route of the map's points (default {ROUTE!r}, the max "
+                    "adhesion alone; 'auto': the scene's default, written to "
+                    "stiction_map_auto.md/.png)")
     args = ap.parse_args(argv)
     if args.only == "edge":
         edge_points()
         return
     if args.sigma:
-        column(args.sigma)
+        column(args.sigma, args.route)
         return
     RESULTS.mkdir(exist_ok=True)
     if args.only != "scaling":
-        the_map()
+        the_map(args.route)
     if args.only != "map":
         scaling_table()
 
 
-def the_map():
+def the_map(route=ROUTE):
+    """The map at ``route`` into validation/results/stiction_map.md and .png (ROUTE), or
+    stiction_map_<route>.md and .png (another route)."""
     out = Path("out/stiction-map")
     shutil.rmtree(out, ignore_errors=True)
     import os
 
+    stem = "stiction_map" if route == ROUTE else f"stiction_map_{route}"
     load = os.getloadavg()
-    sig, rel, F, E, norm, wall, fails, n = stiction_map(out)
+    sig, rel, F, E, norm, wall, fails, n, points = stiction_map(out, route=route)
     load_end = os.getloadavg()
-    figure(sig, rel, F, norm, RESULTS / "stiction_map.png")
+    figure(sig, rel, F, norm, RESULTS / f"{stem}.png")
     routed = _routed(out)
     lines = ["# Stiction map: the 2-mm slider with LJ, the sigma-gap and an ethanol meniscus",
              "", "(`python -m validation.stiction_map`; scene "
              "`validation/scenes/paper1_slider_meniscus.toml`, bare meniscus, at its "
              "defaults: the adaptive banded grid to accuracy 1e-3, analysis radius planned "
-             f"from delta = 50 nm, [solver] route = '{ROUTE}' (the map asks for the max "
-             "adhesion alone: a point whose pilot finds the retract's pull-off fold is traced "
-             "in its edge radius, femadh/runner/edge_route.py; the others by the adaptive "
-             f"sweep); at most {POINT_LIMIT} per point. Machine load (1-min "
+             f"from delta = 50 nm, [solver] route = '{route}' ("
+             + ("the map asks for the max adhesion alone: a point whose pilot finds the "
+                "retract's pull-off fold is traced in its edge radius, "
+                "femadh/runner/edge_route.py; the others by the adaptive sweep"
+                if route == "peak" else
+                "the scene's default: the edge route with the sweep's outputs where the "
+                "runner sends a point to it, femadh/runner/edge_route.py route_for; the "
+                "others by the adaptive sweep")
+             + f"); at most {POINT_LIMIT} per point. Machine load (1-min "
              f"average) {load[0]:.1f} at the start, {load_end[0]:.1f} at the end, 2 cores.)",
              "",
              f"{n} points on 2 local processes in {wall:.1f} s "
@@ -218,8 +236,12 @@ def the_map():
     lines += ["", "Refused or failed points (sigma, p/psat: femadh's message):", ""]
     for sg, r, err in fails:
         lines.append(f"- {sg * 1e9:.3g} nm, {r:.2f}: {err}")
-    lines += ["", "![](stiction_map.png)", ""]
-    (RESULTS / "stiction_map.md").write_text("\n".join(lines) + "\n")
+    slow = _slowest(out, points)
+    lines += ["", f"The {len(slow)} slowest points (wall s of the point's run, its route):",
+              ""]
+    lines += [f"- {sg * 1e9:.3g} nm, {r:.2f}: {w:.1f} s, {how}" for sg, r, w, how in slow]
+    lines += ["", f"![]({stem}.png)", ""]
+    (RESULTS / f"{stem}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
@@ -240,7 +262,32 @@ def _routed(out):
     return rows
 
 
-def column(sigma):
+def _slowest(out, points, n=8):
+    """(sigma m, p/psat, wall s, how) of the ``n`` slowest of the study's ``points`` in its
+    folder ``out`` (their summaries' wall time, the adaptive loop's where it ran; how: the
+    status and "edge route" or the sweep's nodes, trial by trial)."""
+    import json
+
+    rows = []
+    for p in points:
+        summ = Path(out) / "points" / p.id / "summary.json"
+        if not summ.exists():
+            continue
+        d = json.loads(summ.read_text())
+        acc = d.get("accuracy") or {}
+        how = ("edge route" if (d.get("grid") or {}).get("route") == "edge-branch" else
+               "sweep, " + " -> ".join(str(s["nodes"]) for s in acc.get("steps", []))
+               + " nodes")
+        # (an adaptive sweep's own wall_time_s is its last trial's: the loop's is the point's)
+        rows.append((p.scene.gap.sigma,
+                     float(p.scene.raw["effects"]["capillary"]["relative_pressure"]),
+                     acc.get("wall_time_s", d.get("wall_time_s", math.nan)),
+                     f"{d.get('status')}, {how}"))
+    rows.sort(key=lambda x: -x[2])
+    return rows[:n]
+
+
+def column(sigma, route=ROUTE):
     """One sigma column of the map as the map runs it (2 processes, POINT_LIMIT per point):
     per point its status, max adhesion / 4 pi R gamma, estimated relative error and reason;
     the wall time and the machine's load. Printed only."""
@@ -249,7 +296,7 @@ def column(sigma):
     out = Path("out/stiction-map-column")
     shutil.rmtree(out, ignore_errors=True)
     load = os.getloadavg()[0]
-    sig, rel, F, E, norm, wall, fails, n = stiction_map(out, sigma)
+    sig, rel, F, E, norm, wall, fails, n, _ = stiction_map(out, sigma, route)
     print(f"sigma = {sigma}: {n} points in {wall:.1f} s on 2 processes (load "
           f"{load:.1f} -> {os.getloadavg()[0]:.1f}); {n - len(fails)} converged")
     for i, r in enumerate(rel):

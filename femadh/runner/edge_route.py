@@ -24,7 +24,10 @@ Which runs take it (:func:`route_for`): a scene that
 - and whose adaptive grid would follow the contact edge, i.e. whose static band at the
   trapping-safe spacing exceeds :data:`~femadh.runner.adaptive.FOLLOW_NODES` (the scenes
   whose retract unzips node by node; every bundled scene has a static band and keeps its
-  path, numbers bit for bit);
+  path, numbers bit for bit), or whose static first member is trapped at the contact edge
+  by a sub-grid meniscus step just above sigma (:func:`edge_trapped`: the low-humidity
+  points of the stiction map, whose sweep refines its static band to 700-1800 nodes and
+  unzips there, 35-90+ s a point);
 
 and then a pilot trace (< 1 s) decides: a fold of d(c) at a finite edge radius takes the
 route, no fold (the contact shrinks to nothing without a jump, DMT's side: the largest force
@@ -219,20 +222,78 @@ def static_reasons(scene):
 #: tests compare the two)
 ENABLED = True
 
+#: :func:`edge_trapped`: how far the adaptive grid's first static member's band spacing may
+#: exceed the spacing safe for the softening a node at the contact edge actually meets
+#: (:func:`~femadh.discretisation.plan.follow_safe_spacing`: LJ and the meniscus step summed)
+#: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
+#: points (validation/results/stiction_map_auto.md, main's sweep at load 3-4.5): at a ratio
+#: 1.22-2.52 (6 points) the first member's estimate was 4.4e-3-1.6e-2 and the sweep refined
+#: its band 2.7-8.5x in nodes (to 604-1772): 16-90+ s on four (sigma 0.489 nm, p/psat 0.15
+#: reached the map's 90-s limit in every run), 2-3 s on two; the route 3.3-5.0 s. At 1.14
+#: and below (19 points) it met 1e-3 at the first member or refined at most 3.3x to <= 615
+#: nodes, 0.3-6.6 s. The margin sits in that gap (1.14-1.22): a ratio just above 1 (the
+#: estimate's coarsest member at the safe limit: 1.01-1.14 on the map's p/psat 0.35-0.65
+#: points at sigma 0.489 nm) costs the sweep nothing
+EDGE_TRAP_MARGIN = 1.2
+
+
+def edge_trap_ratio(scene):
+    """How far ``scene``'s adaptive first member (the static band the sweep's loop runs
+    first, :func:`femadh.runner.adaptive.first_trial`) is trapped at the contact edge: its
+    band spacing over the spacing safe for the softening a node at the edge meets, LJ and
+    a sub-grid meniscus step summed (:func:`~femadh.discretisation.plan.follow_safe_spacing`).
+    The static cap (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of
+    the two and under-reads a meniscus edge just above sigma, which acts as a Dugdale
+    cohesive zone of ~30-200 nm at the contact edge
+    (:meth:`~femadh.laws.step.SmoothStepLaw.edge_softening`). On such a scene the sweep's
+    estimate members unzip, its loop refines the static band by the accuracy (not by the
+    trapping cap, so FOLLOW_NODES does not see it) and its retract unzips node by node on
+    600-1800 nodes; the edge route traces the branch in its edge radius instead.
+
+    The first member is built as the loop builds it (3-42 ms on the stiction map's points;
+    the loop's own is not handed to the route). Only a scene with a sub-grid step law
+    (:attr:`~femadh.laws.step.SmoothStepLaw.SUBGRID`, the capillary condensate) is
+    measured: without one the two softenings are one (the bundled Fig 3 and Fig 4 scenes:
+    path and cost unchanged). 0 for a scene without one, or whose first member follows the
+    edge (the route's other test) or is refused by the node limit (the sweep's loop reports
+    that)."""
+    from ..discretisation import plan_grid
+    from ..discretisation.plan import follow_safe_spacing
+    from ..scene import build_problem
+    from . import adaptive
+
+    if scene.gap is None or not any(getattr(law, "SUBGRID", False)
+                                    for law in scene.effects.values()):
+        return 0.0
+    target = scene.target_accuracy
+    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
+                     scene.d_values, target)
+    first = adaptive.first_trial(scene, plan, target)
+    if first.operator is None or first.follow is not None:
+        return 0.0
+    problem = build_problem(scene, operator=first.operator)
+    return first.spacing / follow_safe_spacing(problem)
+
+
+def edge_trapped(scene):
+    """Whether ``scene``'s adaptive first member is trapped at the contact edge beyond
+    EDGE_TRAP_MARGIN (:func:`edge_trap_ratio`): "auto" then asks the pilot."""
+    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN
+
 
 def route_for(scene, follows):
     """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
     (:func:`femadh.runner.adaptive._follow_trial` chose a follow band). The scene's
-    ``[solver] route``: "grid" never, "auto" where its grid follows the edge, "edge"
-    wherever it can; the pilot then
-    decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
+    ``[solver] route``: "grid" never, "auto" where its grid follows the edge or its first
+    static member is trapped at the edge (:func:`edge_trapped`), "edge" wherever it can;
+    the pilot then decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
     whatever its route: the adaptive loop's trials and the estimate's members are such
     scenes (a grid of their own) and inherit the key."""
     route = getattr(scene, "route", "auto")
     if not ENABLED or route == "grid" or static_reasons(scene):
         return None
-    if route == "auto" and not follows:
+    if route == "auto" and not (follows or edge_trapped(scene)):
         return None
     # ("edge" and "peak" pilot wherever the route can carry the scene)
     try:
