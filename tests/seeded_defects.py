@@ -1704,8 +1704,8 @@ DEFECTS = [
         "        if False:\n            lost = s"),)),
     D("eroute_pilots_static", "edge route: pilots scenes whose grid would not follow the edge",
       "femadh/runner/edge_route.py",
-      (("    if route == \"auto\" and not follows:\n",
-        "    if route == \"auto\" and not follows and False:\n"),)),
+      (("    if route == \"auto\" and not (follows or edge_trapped(scene)):\n",
+        "    if route == \"auto\" and not (follows or edge_trapped(scene)) and False:\n"),)),
     D("eroute_headline_extrapolated", "edge route: the headline the extrapolation, not the "
       "finest member's state", "femadh/runner/edge_route.py",
       (('    hl["max_adhesion_N"] = fam.value', '    hl["max_adhesion_N"] = fam.extrapolation'),)),
