@@ -7,8 +7,10 @@ traceback. Exit codes: 0 done; 2 the scene or the command line is wrong; 3 a sol
 folder holds another run (use --resume or --overwrite); 5 an optional
 dependency is missing; 6 the run reached its time limit (``[solver] time_limit``,
 ``--time-limit``: completed states kept, ``--resume`` continues); 130 / 143 interrupted by
-SIGINT / SIGTERM (completed states kept, ``--resume`` continues); 1 an internal error (a bug:
-set FEMADH_DEBUG=1 for its traceback).
+SIGINT / SIGTERM (completed states kept, ``--resume`` continues); 141 the reader of its
+output went away (``femadh keys | head``: quiet, as a program ended by SIGPIPE; what a run
+wrote to its folder is whole); 1 an internal error (a bug: set FEMADH_DEBUG=1 for its
+traceback).
 """
 import os
 import signal
@@ -71,6 +73,8 @@ from .errors import (DependencyError, FemadhError, Interrupted, OutputError,  # 
                      SceneError)
 
 EXIT_SCENE, EXIT_SOLVE, EXIT_OUTPUT, EXIT_DEPENDENCY, EXIT_BUG = 2, 3, 4, 5, 1
+#: the shell's code of a program ended by SIGPIPE (128 + 13)
+EXIT_PIPE = 141
 
 
 def _parser():
@@ -299,6 +303,15 @@ def _main(argv, program=False):
         _error("out of memory: reduce [solver] nodes or the sweep (femadh check estimates the "
                "memory a scene needs)")
         return EXIT_SCENE
+    except BrokenPipeError:
+        # the reader of stdout went away (``| head``): nothing more to say to it; stdout is
+        # pointed at /dev/null so that the last flush at exit does not fail again
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return EXIT_PIPE
     except Exception as exc:     # a bug: one line, the traceback on request
         if os.environ.get("FEMADH_DEBUG"):
             raise

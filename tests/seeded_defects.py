@@ -2449,6 +2449,9 @@ DEFECTS = [
         "                                    for law in scene.effects.values()):\n"
         "        return 0.0",
         "    if scene.gap is None:\n        return 0.0"),)),
+    D("cli_broken_pipe_bug", "cli: a reader that goes away is reported as an internal error",
+      "femadh/cli.py",
+      (("    except BrokenPipeError:\n", "    except ZeroDivisionError:\n"),)),
 ]
 
 

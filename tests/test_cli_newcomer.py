@@ -124,3 +124,15 @@ def test_check_names_the_grid_the_run_will_use(capsys):
     assert "adaptive grid to accuracy 0.001" in out and "200 nodes" not in out
     assert main(["check", str(ROOT / "validation/scenes/afm_tip_cantilever.toml")]) == 0
     assert ", 150 nodes, green" in capsys.readouterr().out
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly():
+    """``femadh keys | head -1`` (found by a newcomer trial): the reader closes the pipe
+    while femadh still writes; femadh ends quietly with 141, as a program ended by SIGPIPE
+    (it was exit 1, "internal error BrokenPipeError ... a bug in femadh")."""
+    p = subprocess.Popen([sys.executable, "-m", "femadh", "keys"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    p.stdout.close()                        # the reader is gone before femadh writes
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=60) == 141
+    assert err == ""
