@@ -352,13 +352,18 @@ def _dispatch(args):
 
     scene = load_scene(args.scene)
     check_resources(scene)
+    first = None
     if args.command in ("check", "run"):
         from .scene.resources import check_cost
 
+        if scene.kind == "contact" and getattr(scene, "adaptive", False):
+            from .runner.adaptive import planned_first_nodes
+
+            first = planned_first_nodes(scene)
         # a scene whose cost is beyond reason is refused before it starts
-        check_cost(scene, force=args.force)
+        check_cost(scene, force=args.force, first_nodes=first)
     if args.command == "check":
-        return _check(scene, args.scene)
+        return _check(scene, args.scene, first)
     if args.command == "mesh":
         _require_contact(scene, "mesh")
         return _mesh(scene, args.out)
@@ -377,7 +382,7 @@ def _require_contact(scene, what):
                          "of a contact scene")
 
 
-def _check(scene, path):
+def _check(scene, path, first=None):
     if scene.kind == "meniscus":
         from .scene.resources import _hms, meniscus_time
 
@@ -389,7 +394,7 @@ def _check(scene, path):
     from .scene.resources import _hms, memory_estimate, time_estimate
 
     mem, _ = memory_estimate(scene)
-    t, what = time_estimate(scene)
+    t, what = time_estimate(scene, first and first[0])
     # an adaptive scene's node count is femadh's to choose: its default 'nodes' is not run
     grid = (f"adaptive grid to accuracy {scene.target_accuracy:g}" if scene.adaptive else
             "banded grid" if scene.grid is not None else f"{scene.nodes} nodes")

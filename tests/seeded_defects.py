@@ -2387,8 +2387,8 @@ DEFECTS = [
     D("landfast_curvature_ignored", "pcg: a direction of negative curvature taken as any other "
       "(an indefinite damped Hessian solved as if positive definite)",
       "femadh/contact/linalg.py",
-      (("if not (pq > 0 and rz > 0):     # (NaN fails this too)",
-        "if not (pq != 0 and rz != 0):"),)),
+      (('        if not pq > 0:\n            return x, k, "curvature"',
+        '        if not pq != 0:\n            return x, k, "curvature"'),)),
     D("landfast_descent_check", "landing descent: the descent-direction check inverted "
       "(grad . dw > 0 taken)", "femadh/contact/landing.py",
       (('ok = status == "converged" and rev @ x > 0 and np.all(np.isfinite(x))',
@@ -2452,6 +2452,30 @@ DEFECTS = [
     D("cli_broken_pipe_bug", "cli: a reader that goes away is reported as an internal error",
       "femadh/cli.py",
       (("    except BrokenPipeError:\n", "    except ZeroDivisionError:\n"),)),
+    D("landfast_spotrf_notpd", "landing: a failed single-precision factorisation refuses the "
+      "trial as not positive definite (a matrix only beyond single precision's condition)",
+      "femadh/contact/landing.py",
+      (("            # factorisation decides, as it did before this path\n            return None\n",
+        "            # factorisation decides, as it did before this path\n            return self.NOT_PD\n"),)),
+    D("pcg_breakdown_as_curvature", "pcg: a preconditioner's breakdown reported as curvature",
+      "femadh/contact/linalg.py",
+      (('        if not rz > 0:\n            return x, k, "breakdown"',
+        '        if not rz > 0:\n            return x, k, "curvature"'),)),
+    D("solve_single_unscaled", "cho_solve_single: the residual cast to single precision "
+      "unscaled (a tiny residual vanishes)", "femadh/contact/linalg.py",
+      (("    y = blas.strsv(u, (r / scale).astype(np.float32), trans=1)",
+        "    y = blas.strsv(u, r.astype(np.float32), trans=1)"),
+       ("    return y.astype(float) * scale\n", "    return y.astype(float)\n"))),
+    D("trap_ratio_request", "edge route: the trap ratio read on the request's own first member "
+      "(a finer request reads below the margin)", "femadh/runner/edge_route.py",
+      (("    target = adaptive.REFERENCE_ACCURACY\n    plan = plan_grid(",
+        "    target = scene.target_accuracy\n    plan = plan_grid("),)),
+    D("check_first_unrefused", "check: an adaptive request whose first member exceeds the node "
+      "budget passes the check", "femadh/scene/resources.py",
+      (("        if first_nodes[1] > BANDED_MAX_NODES:", "        if False:"),)),
+    D("check_first_fixed_300", "check: an adaptive scene's time estimated on 300 nodes whatever "
+      "its plan", "femadh/scene/resources.py",
+      (("            n = first_nodes or 300", "            n = 300"),)),
 ]
 
 

@@ -136,3 +136,24 @@ def test_a_reader_that_goes_away_ends_the_command_quietly():
     err = p.stderr.read().decode()
     assert p.wait(timeout=60) == 141
     assert err == ""
+
+
+def test_check_plans_an_adaptive_scenes_first_member(tmp_path, capsys):
+    """``femadh check`` reads an adaptive scene's first member off the plan (newcomer trial:
+    it said "72 states of 300 nodes, <1 s" for Fig 4 at any accuracy, and passed 1e-5, which
+    the run then refused before any solve): Fig 4 at 1e-3 plans 540 nodes (the cohesive
+    zone's start), at 1e-4 1766 (the run: 1765 after its trapping check); at 1e-5 even the
+    coarsest start needs ~4166 nodes, above the budget of 4000: refused with one line naming
+    the key, as the run would refuse it."""
+    text = Path("validation/scenes/paper1_fig4.toml").read_text()
+    assert text.count("accuracy = 3e-3") == 1
+    for acc, nodes in (("1e-3", 540), ("1e-4", 1766)):
+        p = tmp_path / f"f4_{acc}.toml"
+        p.write_text(text.replace("accuracy = 3e-3", f"accuracy = {acc}", 1))
+        assert main(["check", str(p)]) == 0
+        assert f"72 states of {nodes} nodes" in capsys.readouterr().out
+    p = tmp_path / "f4_1e-5.toml"
+    p.write_text(text.replace("accuracy = 3e-3", "accuracy = 1e-5", 1))
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "[solver.accuracy] = 1e-05" in err and "4000" in err

@@ -59,8 +59,8 @@ def test_every_step_is_the_double_systems_solution(trials):
 
 
 def test_a_refused_trial_is_not_positive_definite(trials):
-    """Each trial refused (NOT_PD: a kept factor met non-positive curvature, or the single
-    factorisation failed) is one the double factorisation refuses too: the 12 refused damped
+    """Each trial refused (NOT_PD: a kept factor met non-positive curvature, the only proof
+    the single path takes) is one the double factorisation refuses too: the 12 refused damped
     Hessians' least eigenvalues (of diag(s)^-1/2 M diag(s)^-1/2) measured -1.4e-2 ... -6.0e-5,
     far from zero against the ~1e-7 at which single and double precision could disagree; the
     accepted trials' measured >= 9.2e-5 (the same on the three OPENBLAS_CORETYPEs)."""
@@ -167,3 +167,36 @@ def test_pcg_solves_and_refuses_what_it_must():
     assert (k, status) == (3, "budget")
     x, k, status = pcg(lambda v: A @ v, lambda r: r, 0 * b, 1e-13, 3)
     assert (k, status) == (0, "converged") and not x.any()
+
+
+def test_what_the_single_path_cannot_prove_goes_to_the_double_factorisation():
+    """Only a direction of non-positive curvature proves a damped Hessian indefinite. A matrix
+    positive definite in double whose condition (1e9) is beyond single precision fails spotrf:
+    the trial goes to the double factorisation (None), not "not positive definite" (which
+    would raise the damping where the double path takes the step; review of landfast). pcg
+    tells a preconditioner's breakdown and a NaN from curvature, and the preconditioner's
+    solve is linear down to residuals far below single precision's range (r x 1e-30: a
+    float32 cast alone made it 0)."""
+    from femadh.contact.linalg import cho_factor_single, cho_solve_single, pcg
+
+    rng = np.random.default_rng(0)
+    n = 120
+    q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    h = (q * np.geomspace(1e-9, 1.0, n)) @ q.T
+    h = (h + h.T) / 2
+    sla.cho_factor(h)                                  # positive definite in double
+    assert cho_factor_single(h, np.diagonal(h).copy()) is None
+    d = landing._Damped(np.ones(n))
+    d.step(h, np.ones(n, bool))
+    assert d.solve(1e-12, rng.standard_normal(n)) is None
+    a = np.diag(np.linspace(1.0, 2.0, n))
+    u = cho_factor_single(a, np.diagonal(a).copy())
+    r = rng.standard_normal(n)
+    assert np.allclose(cho_solve_single(u, r * 1e-30), cho_solve_single(u, r) * 1e-30,
+                       rtol=1e-12, atol=0)
+    b = rng.standard_normal(n)
+    indefinite = np.diag(np.linspace(-1.0, 2.0, n))
+    assert pcg(lambda v: indefinite @ v, lambda v: v, b, 1e-13, n)[2] == "curvature"
+    assert pcg(lambda v: a @ v, lambda v: -v, b, 1e-13, n)[2] == "breakdown"
+    assert pcg(lambda v: a @ v * np.nan, lambda v: v, b, 1e-13, n)[2] == "nan"
+    assert pcg(lambda v: a @ v, lambda v: v, b, 1e-13, n)[2] == "converged"

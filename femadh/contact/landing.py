@@ -142,10 +142,12 @@ class _Damped:
     Each trial first tries the kept factor (REUSE_NODES, REUSE_MIN): if an iteration meets a
     direction of non-positive curvature (p . A p <= 0 in double), the damped Hessian is not
     positive definite - the trial is refused as the double factorisation's failure refused it
-    (:meth:`solve` returns NOT_PD: raise the damping), without a factorisation. Else a fresh
-    single factor of the trial's matrix is made: its failure (LAPACK's info) is NOT_PD; its
-    iterations (SINGLE_ITER) give the step, or - a direction of non-positive curvature, the
-    budget spent - None: the caller decides with the double factorisation as before. A step
+    (:meth:`solve` returns NOT_PD: raise the damping), without a factorisation; a breakdown
+    of the preconditioner or a NaN proves nothing and goes on to a fresh factor. Else a fresh
+    single factor of the trial's matrix is made: its failure (LAPACK's info: not positive
+    definite, or only beyond single precision's ~1e7 condition) and its iterations'
+    (SINGLE_ITER) failure - a direction of non-positive curvature, a breakdown, the budget
+    spent - return None: the caller decides with the double factorisation as before. A step
     is returned only where the iterations met SINGLE_RTOL with positive curvature on every
     direction (the Hessian positive definite on the Krylov space that resolves the gradient
     to SINGLE_RTOL) and it is a descent direction, grad . dw < 0.
@@ -221,7 +223,10 @@ class _Damped:
         except FloatingPointError:
             return None         # (beyond single precision's range, or not a number)
         if u is None:
-            return self.NOT_PD
+            # spotrf failed: not positive definite, or merely beyond single precision's
+            # ~1e7 condition (a soft mode below ~1e-7 of the stiffest): the double
+            # factorisation decides, as it did before this path
+            return None
         self.kept, self._block = (u, self.free, self.m), None
         x, _ = solved(u, SINGLE_ITER)
         return x

@@ -132,10 +132,16 @@ def cho_factor_single(H, diag):
 def cho_solve_single(u, r):
     """x (float64) with U^T U x = r for U from :func:`cho_factor_single`: two triangular
     solves (BLAS strsv) in single precision - a preconditioner's application, good to the
-    factor's ~7 digits."""
-    y = blas.strsv(u, np.asarray(r, dtype=np.float32), trans=1)     # U^T y = r
+    factor's ~7 digits. r is scaled to a largest entry of 1 before it is rounded to single
+    precision (a residual of ~1e-30 would otherwise fall into its subnormal range and
+    vanish: the solve is linear, the scale is put back in double)."""
+    r = np.asarray(r, dtype=float)
+    scale = float(np.max(np.abs(r), initial=0.0))
+    if not scale > 0 or not math.isfinite(scale):
+        return np.zeros_like(r) if scale == 0 else np.full_like(r, np.nan)
+    y = blas.strsv(u, (r / scale).astype(np.float32), trans=1)      # U^T y = r
     y = blas.strsv(u, y, trans=0, overwrite_x=1)                     # U x = y
-    return y.astype(float)
+    return y.astype(float) * scale
 
 
 def pcg(apply_a, apply_m, b, rtol, maxiter):
@@ -155,9 +161,11 @@ def pcg(apply_a, apply_m, b, rtol, maxiter):
     Returns
     -------
     (x, iterations, status)
-        status "converged" (rtol met), "curvature" (a direction with p.A p <= 0, or not a
-        number: A is not positive definite on the Krylov space, or a NaN - x is then the last
-        iterate before it) or "budget" (maxiter products without meeting rtol).
+        status "converged" (rtol met), "curvature" (a direction with p.A p <= 0: A is not
+        positive definite on the Krylov space - the only status that proves it), "breakdown"
+        (r.M^-1 r <= 0: the preconditioner failed, not A), "nan" (a product or a
+        preconditioner solve was not a number) or "budget" (maxiter products without meeting
+        rtol); x is the last iterate before the status.
     """
     x = np.zeros_like(b)
     r = np.array(b, dtype=float)
@@ -170,7 +178,11 @@ def pcg(apply_a, apply_m, b, rtol, maxiter):
     for k in range(1, maxiter + 1):
         q = apply_a(p)
         pq = p @ q
-        if not (pq > 0 and rz > 0):     # (NaN fails this too)
+        if not (math.isfinite(pq) and math.isfinite(rz)):
+            return x, k, "nan"
+        if not rz > 0:
+            return x, k, "breakdown"
+        if not pq > 0:
             return x, k, "curvature"
         alpha = rz / pq
         x += alpha * p

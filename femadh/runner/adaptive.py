@@ -380,6 +380,26 @@ def first_trial(scene, plan, target):
     return tr           # (every start refused: the loop says what the request needs)
 
 
+def planned_first_nodes(scene):
+    """About how many nodes :func:`first_trial` starts ``scene`` (an adaptive contact scene)
+    on, and how many its coarsest start needs, read off the plan without building an
+    operator (``femadh check``'s time estimate and its refusal of a request the node budget
+    cannot start): (nodes, coarsest) - the zone's start where it fits the budget, else the
+    plan's scaled spacing (the trapping cap, measured on a built member, can only make
+    either finer)."""
+    target = scene.target_accuracy
+    plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
+                     scene.sphere, scene.analysis_radius, scene.d_values, target)
+    family = plan.family
+    h = min(plan.spacing * (target / REFERENCE_ACCURACY) ** (1.0 / ORDER),
+            family.band / MIN_BAND_NODES)
+    coarsest = family.count(h)
+    hz = cohesive_spacing(scene, target) if target <= REFERENCE_ACCURACY else None
+    if hz is not None and math.isfinite(hz) and 0 < hz < h and family.count(hz) <= MAX_NODES:
+        return family.count(hz), coarsest
+    return coarsest, coarsest
+
+
 def _too_many_nodes(trial):
     return (f"the grid would need more than {MAX_NODES} nodes (band spacing "
             f"{trial.asked * 1e9:.3g} nm over {trial.family.band * 1e6:.3g} um)")

@@ -238,8 +238,9 @@ EDGE_TRAP_MARGIN = 1.2
 
 
 def edge_trap_ratio(scene):
-    """How far ``scene``'s adaptive first member (the static band the sweep's loop runs
-    first, :func:`femadh.runner.adaptive.first_trial`) is trapped at the contact edge: its
+    """How far ``scene``'s adaptive first member for 1e-3 (the static band the sweep's loop
+    runs first at that request, :func:`femadh.runner.adaptive.first_trial`; the same member
+    whatever the request) is trapped at the contact edge: its
     band spacing over the spacing safe for the softening a node at the edge meets, LJ and
     a sub-grid meniscus step summed (:func:`~femadh.discretisation.plan.follow_safe_spacing`).
     The static cap (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of
@@ -265,7 +266,12 @@ def edge_trap_ratio(scene):
     if scene.gap is None or not any(getattr(law, "SUBGRID", False)
                                     for law in scene.effects.values()):
         return 0.0
-    target = scene.target_accuracy
+    # (the member for REFERENCE_ACCURACY whatever the request: the trap is the contact
+    # edge's, not the request's, and EDGE_TRAP_MARGIN was measured on it - the request's own
+    # first member shrinks as (target / 1e-3)^(1/ORDER), and at 3e-4 the ratio of sigma =
+    # 0.489 nm, p/psat 0.15 fell to 1.11: not routed, its sweep reached the 90-s limit where
+    # the route converged in 6.1 CPU-s)
+    target = adaptive.REFERENCE_ACCURACY
     plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
                      scene.d_values, target)
     first = adaptive.first_trial(scene, plan, target)

@@ -122,13 +122,15 @@ def _state_time(n):
     return max(STATE_FLOOR, STATE_N2 * n * n + STATE_N3 * n ** 3)
 
 
-def time_estimate(scene):
+def time_estimate(scene, first_nodes=None):
     """Seconds a contact run of the scene takes on this machine class, and the words that
     say what it counts. A rough figure, from the rates above: measured against the bundled
     scenes (idle 2-core machine) Fig 3 adaptive 1 s estimated / 0.5 s real, Fig 3 FE 1 s /
     2.2 s, uniform N = 400 1.0 s / 1.3 s; scenes whose sweep folds and jumps take many more
     solves per state (Fig 4: 1 s / 8.5 s, the mu = 2 arclength trace <1 s / 1.7 s) - an
-    order of magnitude at most, which is what the refusal of absurd scenes needs."""
+    order of magnitude at most, which is what the refusal of absurd scenes needs.
+    ``first_nodes``: an adaptive scene's first member as planned
+    (:func:`femadh.runner.adaptive.planned_first_nodes`; else ~300, Fig 4's at 1e-3)."""
     n = scene.nodes
     if scene.grid is not None or getattr(scene, "adaptive", False):
         if scene.grid is not None:
@@ -137,7 +139,7 @@ def time_estimate(scene):
             g = scene.grid
             n = GridFamily(scene.analysis_radius, g["band"], g["grading"]).count(g["spacing"])
         else:
-            n = 300             # the adaptive grid's first member: ~285 nodes on Fig 4
+            n = first_nodes or 300      # the first member (~285-540 nodes on Fig 4)
     states = len(scene.d_values) * len(scene.directions)
     t_state = _state_time(n)
     t = (states + FIRST_STATE) * t_state
@@ -151,9 +153,12 @@ def time_estimate(scene):
     return t_est, what
 
 
-def check_cost(scene, force=False):
+def check_cost(scene, force=False, first_nodes=None):
     """Refuse (SceneError) a contact scene whose estimated run time is beyond reason, or
-    whose accuracy target the node budget cannot reach, unless ``force``."""
+    whose accuracy target the node budget cannot reach, unless ``force``. ``first_nodes``:
+    (nodes, coarsest) of an adaptive scene's first member as planned
+    (:func:`femadh.runner.adaptive.planned_first_nodes`): a request whose coarsest start
+    exceeds the node budget is refused here, as the run would refuse it before any solve."""
     if force:
         return
     if scene.kind != "contact":
@@ -174,7 +179,15 @@ def check_cost(scene, force=False):
                          f"a relative accuracy >= {MIN_REACHABLE_ACCURACY:g}: finer targets "
                          f"need more nodes than the budget ({budget}) allows (use --force to "
                          "try)")
-    t, what = time_estimate(scene)
+    if first_nodes is not None:
+        from ..estimate.refine import BANDED_MAX_NODES
+
+        if first_nodes[1] > BANDED_MAX_NODES:
+            raise SceneError(scene.path, "solver.accuracy", scene.target_accuracy,
+                             f"an accuracy the node budget reaches: the adaptive grid's "
+                             f"first member alone would need about {first_nodes[1]} nodes "
+                             f"(budget {BANDED_MAX_NODES}); a looser accuracy")
+    t, what = time_estimate(scene, first_nodes and first_nodes[0])
     if t > MAX_REASONABLE_S:
         key, value = ("solver.nodes", scene.nodes) if scene.grid is None else (
             "solver.grid", scene.grid)
