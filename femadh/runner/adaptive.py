@@ -4,8 +4,10 @@ A scene that fixes neither ``[solver] nodes`` nor ``[solver.grid]`` (Green metho
 complementarity sigma-gap or smooth laws) gets a banded grid planned from its laws and sweep
 (:func:`femadh.discretisation.plan_grid`: the band where the gaps reach the laws' features,
 an analysis radius whose tail is negligible), its band spacing capped so that neither it nor
-the coarser members of its estimate are lattice-trapped, and then refined by the estimate
-until the headline numbers meet ``[solver] accuracy`` (default 1e-3):
+the coarser members of its estimate are lattice-trapped - a sigma-gap Lennard-Jones request
+at or below 1e-3 starting across its Maugis-Dugdale cohesive zone (:func:`first_trial`,
+:func:`cohesive_spacing`) - and then refined by the estimate until the headline numbers
+meet ``[solver] accuracy`` (default 1e-3):
 
     h <- h * clamp((s * target / error)^(1/p), MIN_FACTOR, MAX_FACTOR)
 
