@@ -1704,8 +1704,8 @@ DEFECTS = [
         "        if False:\n            lost = s"),)),
     D("eroute_pilots_static", "edge route: pilots scenes whose grid would not follow the edge",
       "femadh/runner/edge_route.py",
-      (("    if route == \"auto\" and not (follows or edge_trapped(scene)):\n",
-        "    if route == \"auto\" and not (follows or edge_trapped(scene)) and False:\n"),)),
+      (("            and edge_trap_ratio(scene, member()) > EDGE_TRAP_MARGIN)):\n        return None\n",
+        "            and edge_trap_ratio(scene, member()) > EDGE_TRAP_MARGIN)):\n        pass\n"),)),
     D("eroute_headline_extrapolated", "edge route: the headline the extrapolation, not the "
       "finest member's state", "femadh/runner/edge_route.py",
       (('    hl["max_adhesion_N"] = fam.value', '    hl["max_adhesion_N"] = fam.extrapolation'),)),
@@ -2429,26 +2429,26 @@ DEFECTS = [
         ''),)),
     D("trap_auto_ignores_trap", "edge route: 'auto' pilots only where the grid follows the "
       "edge (a static band trapped at its edge keeps the sweep)", "femadh/runner/edge_route.py",
-      (("    if route == \"auto\" and not (follows or edge_trapped(scene)):",
-        "    if route == \"auto\" and not follows:"),)),
+      (("    if route == \"auto\" and not (follows or (\n",
+        "    if route == \"auto\" and not (follows or False and (\n"),)),
     D("trap_static_measure", "edge route: the trap ratio against the static cap's softening "
       "(the larger of LJ and the step) instead of their sum", "femadh/runner/edge_route.py",
       (("    from ..discretisation.plan import follow_safe_spacing\n",
         "    from ..discretisation.plan import safe_spacing as follow_safe_spacing\n"),)),
-    D("trap_uncapped_spacing", "edge route: the trap ratio from the plan's spacing, not the "
-      "first member's", "femadh/runner/edge_route.py",
-      (("    return first.spacing / follow_safe_spacing(problem)",
-        "    return plan.spacing / follow_safe_spacing(problem)"),)),
+    D("trap_uncapped_spacing", "edge route: the trap ratio inverted (safe spacing over the "
+      "member's)", "femadh/runner/edge_route.py",
+      (("    return member.spacing / follow_safe_spacing(problem)",
+        "    return follow_safe_spacing(problem) / member.spacing"),)),
     D("trap_no_margin", "edge route: 'auto' pilots at any trap ratio above 1 (no margin)",
       "femadh/runner/edge_route.py",
-      (("    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN\n",
-        "    return edge_trap_ratio(scene) > 1.0\n"),)),
+      (("            and edge_trap_ratio(scene, member()) > EDGE_TRAP_MARGIN)):",
+        "            and edge_trap_ratio(scene, member()) > 1.0)):"),)),
     D("trap_every_law", "edge route: the trap ratio measured on a scene without a sub-grid "
       "step too", "femadh/runner/edge_route.py",
-      (("    if scene.gap is None or not any(getattr(law, \"SUBGRID\", False)\n"
-        "                                    for law in scene.effects.values()):\n"
-        "        return 0.0",
-        "    if scene.gap is None:\n        return 0.0"),)),
+      (("    return scene.gap is not None and any(getattr(law, \"SUBGRID\", False)\n",
+        "    return scene.gap is not None and (True or any(getattr(law, \"SUBGRID\", False)\n"),
+       ("                                         for law in scene.effects.values())\n",
+        "                                         for law in scene.effects.values()))\n"))),
     D("cli_broken_pipe_bug", "cli: a reader that goes away is reported as an internal error",
       "femadh/cli.py",
       (("    except BrokenPipeError:\n", "    except ZeroDivisionError:\n"),)),
@@ -2467,9 +2467,9 @@ DEFECTS = [
         "    y = blas.strsv(u, r.astype(np.float32), trans=1)"),
        ("    return y.astype(float) * scale\n", "    return y.astype(float)\n"))),
     D("trap_ratio_request", "edge route: the trap ratio read on the request's own first member "
-      "(a finer request reads below the margin)", "femadh/runner/edge_route.py",
-      (("    target = adaptive.REFERENCE_ACCURACY\n    plan = plan_grid(",
-        "    target = scene.target_accuracy\n    plan = plan_grid("),)),
+      "(a finer request reads below the margin)", "femadh/runner/adaptive.py",
+      (("                              member=lambda: reference_trial(scene)))",
+        "                              member=lambda: first))"),)),
     D("check_first_unrefused", "check: an adaptive request whose first member exceeds the node "
       "budget passes the check", "femadh/scene/resources.py",
       (("        if first_nodes[1] > BANDED_MAX_NODES:", "        if False:"),)),

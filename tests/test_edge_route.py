@@ -235,18 +235,20 @@ def test_auto_pilots_a_static_band_trapped_at_its_edge(monkeypatch):
         return base.replace({"effects.asperity_gap.sigma": MAP_SIGMA,
                              "effects.capillary.relative_pressure": rel})
     low, mid, high = point(0.15), point(0.25), point(0.35)
-    ratios = [edge_route.edge_trap_ratio(sc) for sc in (low, mid, high)]
+    from femadh.runner import adaptive
+
+    def ratio(sc):
+        return edge_route.edge_trap_ratio(sc, adaptive.reference_trial(sc))
+    ratios = [ratio(sc) for sc in (low, mid, high)]
     assert ratios[0] > ratios[1] > edge_route.EDGE_TRAP_MARGIN > ratios[2] > 1.0, ratios
     # the 1e-3 member decides whatever the request (at 3e-4 the request's own member read
     # 1.11 for the p/psat 0.15 point, whose sweep then reached the map's 90-s limit)
-    assert edge_route.edge_trap_ratio(low.replace({"solver.accuracy": 3e-4})) == ratios[0]
-    assert edge_route.edge_trap_ratio(femadh.load_scene(SCENE)) < 0.5
-    assert edge_route.edge_trap_ratio(
-        femadh.load_scene("validation/scenes/paper1_fig4.toml")) == 0.0
+    assert ratio(low.replace({"solver.accuracy": 3e-4})) == ratios[0]
+    assert ratio(femadh.load_scene(SCENE)) < 0.5
+    assert ratio(femadh.load_scene("validation/scenes/paper1_fig4.toml")) == 0.0
     # the static cap alone passes the 532-node member (0.98 of its safe spacing): the
     # trap is the summed softening's
     from femadh.discretisation import plan_grid
-    from femadh.runner import adaptive
 
     plan = plan_grid(low.effects, low.gap.sigma, low.sphere, low.analysis_radius,
                      low.d_values, low.target_accuracy)
@@ -258,10 +260,12 @@ def test_auto_pilots_a_static_band_trapped_at_its_edge(monkeypatch):
         best=types.SimpleNamespace(d=math.inf)))      # a fold the sweep presses in to
     asked = []
     monkeypatch.setattr(edge_route, "pilot", lambda scene: asked.append(scene) or marker)
-    assert edge_route.route_for(low, False) is marker
-    assert edge_route.route_for(mid, False) is marker
-    assert edge_route.route_for(high, False) is None
-    assert edge_route.route_for(low.replace({"solver.route": "grid"}), False) is None
+    def route(sc):
+        return edge_route.route_for(sc, False, member=lambda: adaptive.reference_trial(sc))
+    assert route(low) is marker and route(mid) is marker
+    assert route(high) is None
+    assert route(low.replace({"solver.route": "grid"})) is None
+    assert edge_route.route_for(low, False) is None         # no member: nothing measured
     assert len(asked) == 2
 
 
@@ -526,3 +530,27 @@ def test_peak_route_ends_its_curve_where_the_branch_stops_being_stable(small, pe
     monkeypatch.setattr(SigmaEdgeBranch, "stable", lambda self, st: st.c > 1.01 * c_star)
     res = femadh.run(sc, None, figures=False, progress=False)
     assert res.status == "failed" and "not the retract's" in res.error
+
+
+def test_the_adaptive_loop_asks_the_route_with_its_1e3_member(monkeypatch):
+    """run_adaptive hands route_for the loop's member for 1e-3 whatever the request (the
+    trap is the contact edge's; at 3e-4 the request's own first member read 1.11 on the
+    stiction map's sigma = 0.489 nm, p/psat 0.15 point, below the margin, and its sweep
+    reached the 90-s limit). The route's decision is stopped at once (no solve)."""
+    from femadh.runner import adaptive
+
+    class Asked(Exception):
+        pass
+
+    def route_for(scene, follows, member=None):
+        raise Asked(member)
+
+    monkeypatch.setattr(edge_route, "route_for", route_for)
+    sc = femadh.load_scene(SCENE).replace({
+        "sweep.start": "4 nm", "effects.asperity_gap.sigma": MAP_SIGMA,
+        "effects.capillary.relative_pressure": 0.15, "solver.accuracy": 3e-4})
+    with pytest.raises(Asked) as got:
+        adaptive.run_adaptive(sc, None, run=None)
+    member = got.value.args[0]()
+    assert member.spacing == adaptive.reference_trial(sc).spacing
+    assert member.nodes == 532

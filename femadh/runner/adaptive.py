@@ -382,6 +382,15 @@ def first_trial(scene, plan, target):
     return tr           # (every start refused: the loop says what the request needs)
 
 
+def reference_trial(scene):
+    """The :class:`Trial` the loop would start from at REFERENCE_ACCURACY whatever the
+    scene's request (the edge route's trap measure,
+    :func:`femadh.runner.edge_route.edge_trap_ratio`)."""
+    plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
+                     scene.sphere, scene.analysis_radius, scene.d_values, REFERENCE_ACCURACY)
+    return first_trial(scene, plan, REFERENCE_ACCURACY)
+
+
 def planned_first_nodes(scene):
     """About how many nodes :func:`first_trial` starts ``scene`` (an adaptive contact scene)
     on, and how many its coarsest start needs, read off the plan without building an
@@ -479,7 +488,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
         # (a resumed folder of the sweep's path keeps that path: the route would start over)
         pil = (None if resume and holds_sweep_run(out_dir)
-               else route_for(scene, first.follow is not None))
+               else route_for(scene, first.follow is not None,
+                              member=lambda: reference_trial(scene)))
         if pil is not None:
             return run_edge_route(scene, out_dir, pil, trial=first, figures=figures,
                                   overwrite=overwrite, resume=resume,

@@ -25,7 +25,7 @@ Which runs take it (:func:`route_for`): a scene that
   trapping-safe spacing exceeds :data:`~femadh.runner.adaptive.FOLLOW_NODES` (the scenes
   whose retract unzips node by node; every bundled scene has a static band and keeps its
   path, numbers bit for bit), or whose static first member is trapped at the contact edge
-  by a sub-grid meniscus step just above sigma (:func:`edge_trapped`: the low-humidity
+  by a sub-grid meniscus step just above sigma (:func:`edge_trap_ratio`: the low-humidity
   points of the stiction map, whose sweep refines its static band to 700-1800 nodes and
   unzips there, 35-90+ s a point);
 
@@ -222,7 +222,7 @@ def static_reasons(scene):
 #: tests compare the two)
 ENABLED = True
 
-#: :func:`edge_trapped`: how far the adaptive grid's first static member's band spacing may
+#: :func:`route_for`: how far the adaptive grid's first static member's band spacing may
 #: exceed the spacing safe for the softening a node at the contact edge actually meets
 #: (:func:`~femadh.discretisation.plan.follow_safe_spacing`: LJ and the meniscus step summed)
 #: before "auto" asks the pilot. Measured on the stiction map's 25 foldable static-band
@@ -237,10 +237,10 @@ ENABLED = True
 EDGE_TRAP_MARGIN = 1.2
 
 
-def edge_trap_ratio(scene):
-    """How far ``scene``'s adaptive first member for 1e-3 (the static band the sweep's loop
-    runs first at that request, :func:`femadh.runner.adaptive.first_trial`; the same member
-    whatever the request) is trapped at the contact edge: its
+def edge_trap_ratio(scene, member):
+    """How far ``scene``'s adaptive first member for 1e-3 (``member``, the static band the
+    sweep's loop runs first at that request: :func:`femadh.runner.adaptive.reference_trial`;
+    the same member whatever the request) is trapped at the contact edge: its
     band spacing over the spacing safe for the softening a node at the edge meets, LJ and
     a sub-grid meniscus step summed (:func:`~femadh.discretisation.plan.follow_safe_spacing`).
     The static cap (:func:`~femadh.discretisation.plan.safe_spacing`) keeps the larger of
@@ -251,55 +251,50 @@ def edge_trap_ratio(scene):
     trapping cap, so FOLLOW_NODES does not see it) and its retract unzips node by node on
     600-1800 nodes; the edge route traces the branch in its edge radius instead.
 
-    The first member is built as the loop builds it (3-42 ms on the stiction map's points;
-    the loop's own is not handed to the route). Only a scene with a sub-grid step law
-    (:attr:`~femadh.laws.step.SmoothStepLaw.SUBGRID`, the capillary condensate) is
-    measured: without one the two softenings are one (the bundled Fig 3 and Fig 4 scenes:
-    path and cost unchanged). 0 for a scene without one, or whose first member follows the
-    edge (the route's other test) or is refused by the node limit (the sweep's loop reports
-    that)."""
-    from ..discretisation import plan_grid
+    Why the 1e-3 member whatever the request: the trap is the contact edge's, not the
+    request's, and EDGE_TRAP_MARGIN was measured on it - the request's own first member
+    shrinks as (target / 1e-3)^(1/ORDER), and at 3e-4 the ratio of sigma = 0.489 nm, p/psat
+    0.15 fell to 1.11: not routed, its sweep reached the 90-s limit where the route converged
+    in 6.1 CPU-s. Only a scene with a sub-grid step law (:func:`traps_at_edge`, the
+    capillary condensate) is measured: without one the two softenings are one (the bundled
+    Fig 3 and Fig 4 scenes: path and cost unchanged). 0 for a scene without one, or whose
+    member follows the edge (the route's other test) or is refused by the node limit (the
+    sweep's loop reports that)."""
     from ..discretisation.plan import follow_safe_spacing
     from ..scene import build_problem
-    from . import adaptive
 
-    if scene.gap is None or not any(getattr(law, "SUBGRID", False)
-                                    for law in scene.effects.values()):
+    if not traps_at_edge(scene) or member is None or member.operator is None \
+            or member.follow is not None:
         return 0.0
-    # (the member for REFERENCE_ACCURACY whatever the request: the trap is the contact
-    # edge's, not the request's, and EDGE_TRAP_MARGIN was measured on it - the request's own
-    # first member shrinks as (target / 1e-3)^(1/ORDER), and at 3e-4 the ratio of sigma =
-    # 0.489 nm, p/psat 0.15 fell to 1.11: not routed, its sweep reached the 90-s limit where
-    # the route converged in 6.1 CPU-s)
-    target = adaptive.REFERENCE_ACCURACY
-    plan = plan_grid(scene.effects, scene.gap.sigma, scene.sphere, scene.analysis_radius,
-                     scene.d_values, target)
-    first = adaptive.first_trial(scene, plan, target)
-    if first.operator is None or first.follow is not None:
-        return 0.0
-    problem = build_problem(scene, operator=first.operator)
-    return first.spacing / follow_safe_spacing(problem)
+    problem = build_problem(scene, operator=member.operator)
+    return member.spacing / follow_safe_spacing(problem)
 
 
-def edge_trapped(scene):
-    """Whether ``scene``'s adaptive first member is trapped at the contact edge beyond
-    EDGE_TRAP_MARGIN (:func:`edge_trap_ratio`): "auto" then asks the pilot."""
-    return edge_trap_ratio(scene) > EDGE_TRAP_MARGIN
+def traps_at_edge(scene):
+    """Whether ``scene`` has a sub-grid step law (a condensed meniscus) with a sigma-gap: the
+    scenes :func:`edge_trap_ratio` measures."""
+    return scene.gap is not None and any(getattr(law, "SUBGRID", False)
+                                         for law in scene.effects.values())
 
 
-def route_for(scene, follows):
+def route_for(scene, follows, member=None):
     """The :class:`Pilot` that sends ``scene`` down the edge route, or None (the present
     path). ``follows``: whether the scene's adaptive grid would follow the contact edge
-    (:func:`femadh.runner.adaptive._follow_trial` chose a follow band). The scene's
-    ``[solver] route``: "grid" never, "auto" where its grid follows the edge or its first
-    static member is trapped at the edge (:func:`edge_trapped`), "edge" wherever it can;
+    (:func:`femadh.runner.adaptive._follow_trial` chose a follow band); ``member``: a
+    callable giving the adaptive loop's first member for 1e-3 (built only where it is
+    measured, :func:`traps_at_edge`), or None. The scene's
+    ``[solver] route``: "grid" never, "auto" where its grid follows the edge or that member
+    is trapped at the edge beyond EDGE_TRAP_MARGIN (:func:`edge_trap_ratio`), "edge"
+    wherever it can;
     the pilot then decides. A scene the route cannot carry (:func:`static_reasons`) keeps the sweep
     whatever its route: the adaptive loop's trials and the estimate's members are such
     scenes (a grid of their own) and inherit the key."""
     route = getattr(scene, "route", "auto")
     if not ENABLED or route == "grid" or static_reasons(scene):
         return None
-    if route == "auto" and not (follows or edge_trapped(scene)):
+    if route == "auto" and not (follows or (
+            member is not None and traps_at_edge(scene)
+            and edge_trap_ratio(scene, member()) > EDGE_TRAP_MARGIN)):
         return None
     # ("edge" and "peak" pilot wherever the route can carry the scene)
     try:
