@@ -901,7 +901,8 @@ DEFECTS = [
     D("landing_damps_the_hessian_itself", "landing descent: each trial damping added to the "
       "Hessian itself (a view), earlier dampings carried over",
       "femadh/contact/landing.py",
-      (('            M = np.array(H, order="F")', "            M = H.T"),)),
+      (('    M = np.array(H, order="F")\n    M[np.diag_indices_from(M)] += damp',
+        "    M = H.T\n    M[np.diag_indices_from(M)] += damp"),)),
     D("newton_givens_rotation", "GMRES: the earlier Givens rotations applied transposed",
       "femadh/contact/linalg.py",
       (("col[i], col[i + 1] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c",
@@ -2366,8 +2367,8 @@ DEFECTS = [
         "    return zone[1] / CZ_NODES * (1 / share) ** (1 / FIRST_ORDER)"),)),
     D("cz_also_loose", "adaptive: the cohesive zone's start applied to looser requests too",
       "femadh/runner/adaptive.py",
-      (("    if target <= REFERENCE_ACCURACY and not follows:",
-        "    if not follows:"),)),
+      (("    if target > REFERENCE_ACCURACY:\n        return None\n    hz = cohesive_spacing",
+        "    if False:\n        return None\n    hz = cohesive_spacing"),)),
     D("cz_pulloff_state_max", "maugis: the pull-off state at the largest P, not the least",
       "femadh/reference/maugis.py",
       (("    x, P = _refined_min(P_of_logm, _LOG_M1, P_of_logm(_LOG_M1))\n",
@@ -2413,8 +2414,8 @@ DEFECTS = [
       (("        if tr.follow is not None and h != starts[-1]:", "        if False:"),)),
     D("cz_on_closure", "adaptive: the cohesive zone's start on the Hertz closure model too",
       "femadh/runner/adaptive.py",
-      (('    if gap is None or getattr(gap, "contact_model", "complementarity") != "complementarity":\n        return None\n    lj = {k: e',
-        '    if gap is None:\n        return None\n    lj = {k: e'),)),
+      (('    if gap is None or getattr(gap, "contact_model", "complementarity") != "complementarity":\n        return None\n    lj = _lj_laws',
+        '    if gap is None:\n        return None\n    lj = _lj_laws'),)),
     D("figres_trial_level", "figures resume: a loop's trial reads back the user's folder "
       "(it may hold another trial's run)", "femadh/runner/contact.py",
       (("resume_from is None and (\n            folder_id is None or folder_id == scene_id(scene)):",
@@ -2468,8 +2469,8 @@ DEFECTS = [
        ("    return y.astype(float) * scale\n", "    return y.astype(float)\n"))),
     D("trap_ratio_request", "edge route: the trap ratio read on the request's own first member "
       "(a finer request reads below the margin)", "femadh/runner/adaptive.py",
-      (("                              member=lambda: reference_trial(scene)))",
-        "                              member=lambda: first))"),)),
+      (("                                              else reference_trial(scene))))",
+        "                                              else first)))"),)),
     D("check_first_unrefused", "check: an adaptive request whose first member exceeds the node "
       "budget passes the check", "femadh/scene/resources.py",
       (("        if first_nodes[1] > BANDED_MAX_NODES:", "        if False:"),)),

@@ -232,6 +232,20 @@ class _Damped:
         return x
 
 
+def _double_step(H, damp, g):
+    """The damped step -(H + diag(damp))^-1 g by the double Cholesky factorisation, or
+    _Damped.NOT_PD where the matrix is not positive definite."""
+    # a copy in LAPACK's (Fortran) order, factorised in place: the wrapper would otherwise
+    # copy a C-ordered M once more for every trial damping
+    M = np.array(H, order="F")
+    M[np.diag_indices_from(M)] += damp
+    try:
+        c = cho_factor(M, overwrite_a=True)
+    except sla.LinAlgError:
+        return _Damped.NOT_PD
+    return -cho_solve(c, g)
+
+
 def _roundoff(problem, w, e):
     """Round-off (J) of the total energy ``e`` at w: ROUNDOFF_ULPS ulps of the magnitudes
     of its elastic and interaction parts."""
@@ -276,27 +290,15 @@ def _lm_descent(problem, d, w, h_floor, *, max_iter=400, roundoff=True):
             damped.step(H, free)
         while True:
             step = damped.solve(lam, -g[free]) if single else None
+            if step is None:
+                step = _double_step(H, lam * scale_diag[free], g[free])
             if step is _Damped.NOT_PD:
                 lam *= 4
                 if lam > 1e12:
                     return w, False
                 continue
             dw = np.zeros_like(w)
-            if step is not None:
-                dw[free] = step
-            else:
-                # a copy in LAPACK's (Fortran) order, factorised in place: the wrapper would
-                # otherwise copy a C-ordered M once more for every trial damping
-                M = np.array(H, order="F")
-                M[np.diag_indices_from(M)] += lam * scale_diag[free]
-                try:
-                    c = cho_factor(M, overwrite_a=True)
-                except sla.LinAlgError:
-                    lam *= 4
-                    if lam > 1e12:
-                        return w, False
-                    continue
-                dw[free] = -cho_solve(c, g[free])
+            dw[free] = step
             w_new = np.minimum(w + dw, upper)
             e_new = problem.energy(w_new, d)
             if np.isfinite(e_new) and e_new <= e:

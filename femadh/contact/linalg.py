@@ -147,6 +147,11 @@ def cho_solve_single(u, r):
 def pcg(apply_a, apply_m, b, rtol, maxiter):
     """Preconditioned conjugate gradients for a symmetric positive definite A x = b.
 
+    Written here rather than taken from :func:`scipy.sparse.linalg.cg`: that one neither
+    stops at nor reports a direction of non-positive curvature, which is what proves a
+    damped Hessian indefinite to the landing's descent (:class:`femadh.contact.landing.
+    _Damped`), nor tells a preconditioner's breakdown from it.
+
     Parameters
     ----------
     apply_a, apply_m : callable(ndarray) -> ndarray

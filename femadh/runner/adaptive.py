@@ -276,17 +276,23 @@ def _trial(scene, family, spacing):
 CZ_NODES = 16
 
 
+def _lj_laws(scene):
+    """{name: law} of the scene's Lennard-Jones laws."""
+    from ..laws.lj import LennardJones
+
+    return {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
+
+
 def cohesive_zone(scene):
     """(lambda, width in m) of the Lennard-Jones cohesive zone of a sigma-gap contact at its
     pull-off, or None (no such law or no gap; see :func:`cohesive_spacing`)."""
     from ..discretisation.plan import work_of_adhesion
-    from ..laws.lj import LennardJones
     from ..reference.maugis import maugis_length_units, maugis_pull_off_state
 
     gap = scene.gap
     if gap is None or getattr(gap, "contact_model", "complementarity") != "complementarity":
         return None
-    lj = {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
+    lj = _lj_laws(scene)
     if not lj:
         return None
     w_lj = work_of_adhesion(lj, gap.sigma)
@@ -315,12 +321,11 @@ def cohesive_spacing(scene, target):
     trapping-safe spacing (both scale as E* delta / sigma0), so where that cap binds the
     plan's spacing says nothing of the accuracy, this does."""
     from ..discretisation.plan import work_of_adhesion
-    from ..laws.lj import LennardJones
 
     zone = cohesive_zone(scene)
     if zone is None:
         return None
-    lj = {k: e for k, e in scene.effects.items() if isinstance(e, LennardJones)}
+    lj = _lj_laws(scene)
     w_all = work_of_adhesion(scene.effects, scene.gap.sigma)
     if not w_all > 0:
         return None
@@ -358,7 +363,7 @@ def first_trial(scene, plan, target):
     top = family.band / MIN_BAND_NODES
     scale = (target / REFERENCE_ACCURACY) ** (1.0 / ORDER)
     # the starts, finest first; the last is the plan's
-    starts = [min(plan.spacing * scale, top)]
+    starts = [_plan_start(plan, target)]
     follows = False
     if scale < 1.0:
         ref = _trial(scene, family, min(plan.spacing, top))
@@ -366,12 +371,9 @@ def first_trial(scene, plan, target):
         if ref.operator is not None and not follows and ref.spacing < ref.asked:
             starts.insert(0, min(ref.spacing * scale, top))
         ref.operator = None         # (the probe's operator: the member is built at its own h)
-    if target <= REFERENCE_ACCURACY and not follows:
-        # (a looser request keeps the trapping cap, which already over-resolves it: the Fig 4
-        # scene at 3e-3 estimates 2.2e-3 on the capped member)
-        hz = cohesive_spacing(scene, target)
-        if hz is not None and math.isfinite(hz) and 0 < hz < starts[0]:
-            starts.insert(0, hz)
+    hz = None if follows else _zone_start(scene, target, starts[0])
+    if hz is not None:
+        starts.insert(0, hz)
     for h in starts:
         tr = _trial(scene, family, h)
         if tr.follow is not None and h != starts[-1]:
@@ -380,6 +382,24 @@ def first_trial(scene, plan, target):
         if tr.operator is not None:
             return tr
     return tr           # (every start refused: the loop says what the request needs)
+
+
+def _plan_start(plan, target):
+    """The plan's start (m): BAND_NODES across the band (at least MIN_BAND_NODES) scaled by
+    (target / REFERENCE_ACCURACY)^(1/ORDER), before the trapping cap."""
+    return min(plan.spacing * (target / REFERENCE_ACCURACY) ** (1.0 / ORDER),
+               plan.family.band / MIN_BAND_NODES)
+
+
+def _zone_start(scene, target, coarser):
+    """The cohesive zone's start (m, :func:`cohesive_spacing`) where it is finer than
+    ``coarser`` (m), else None. Only for a request at or below 1e-3: a looser one keeps the
+    trapping cap, which already over-resolves it (the Fig 4 scene at 3e-3 estimates 2.2e-3
+    on the capped member)."""
+    if target > REFERENCE_ACCURACY:
+        return None
+    hz = cohesive_spacing(scene, target)
+    return hz if hz is not None and math.isfinite(hz) and 0 < hz < coarser else None
 
 
 def reference_trial(scene):
@@ -401,13 +421,11 @@ def planned_first_nodes(scene):
     target = scene.target_accuracy
     plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
                      scene.sphere, scene.analysis_radius, scene.d_values, target)
-    family = plan.family
-    h = min(plan.spacing * (target / REFERENCE_ACCURACY) ** (1.0 / ORDER),
-            family.band / MIN_BAND_NODES)
-    coarsest = family.count(h)
-    hz = cohesive_spacing(scene, target) if target <= REFERENCE_ACCURACY else None
-    if hz is not None and math.isfinite(hz) and 0 < hz < h and family.count(hz) <= MAX_NODES:
-        return family.count(hz), coarsest
+    h = _plan_start(plan, target)
+    coarsest = plan.family.count(h)
+    hz = _zone_start(scene, target, h)
+    if hz is not None and plan.family.count(hz) <= MAX_NODES:
+        return plan.family.count(hz), coarsest
     return coarsest, coarsest
 
 
@@ -489,7 +507,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         # (a resumed folder of the sweep's path keeps that path: the route would start over)
         pil = (None if resume and holds_sweep_run(out_dir)
                else route_for(scene, first.follow is not None,
-                              member=lambda: reference_trial(scene)))
+                              member=lambda: (first if target == REFERENCE_ACCURACY
+                                              else reference_trial(scene))))
         if pil is not None:
             return run_edge_route(scene, out_dir, pil, trial=first, figures=figures,
                                   overwrite=overwrite, resume=resume,
