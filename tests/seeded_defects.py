@@ -439,7 +439,9 @@ DEFECTS = [
         "    return (fine - coarse) / (2.0**order - 1.0)"),)),
     D("envelope_dropped", "oscillating members: the finest difference alone (may cancel)",
       "femadh/estimate/richardson.py",
-      (("max(abs(d1), abs(d2) * scale)", "abs(d1)"),)),
+      (("                out[k] = math.copysign(max(abs(d1), abs(d2) * _implied(p, ratio, "
+        "ratio2)),", "                out[k] = math.copysign(max(abs(d1), 0.0 * _implied(p, "
+        "ratio, ratio2)),"),)),
     D("member_spacing", "estimate members: both at r h instead of r h and r^2 h",
       "femadh/runner/estimates.py", (('h = g["spacing"] * r**k', 'h = g["spacing"] * r'),)),
     D("tail_share", "analysis radius: the tail allowed the whole target, not its share",
@@ -1156,7 +1158,7 @@ DEFECTS = [
     D("envelope_uneven_factor", "oscillating members at uneven ratios: the coarser "
       "difference scaled by 1/r2^p (the model's factor only for even ratios)",
       "femadh/estimate/richardson.py",
-      (("(ratio**p - 1) / (ratio**p * (ratio2**p - 1)) if uneven", "ratio2**-p if uneven"),)),
+      (("    return (ratio**p - 1) / (ratio**p * (ratio2**p - 1))", "    return ratio2**-p"),)),
     D("relative_nan_met", "accuracy: a NaN error part dropped by max() (an unknown error "
       "called met)", "femadh/runner/estimates.py",
       (("        if not all(math.isfinite(comp.get(part, 0.0)) for part in (\"total\", \"tail\")):",
@@ -2477,6 +2479,20 @@ DEFECTS = [
     D("check_first_fixed_300", "check: an adaptive scene's time estimated on 300 nodes whatever "
       "its plan", "femadh/scene/resources.py",
       (("            n = first_nodes or 300", "            n = 300"),)),
+    D("decay_bound_off", "Richardson: a monotone triple extrapolated from its finest difference "
+      "alone, however fast it fell (the coarser difference's bound dropped)",
+      "femadh/estimate/richardson.py",
+      (("            d1 = math.copysign(max(abs(d1), abs(d2) * _implied(DECAY_ORDER, ratio, "
+        "ratio2)),\n",
+        "            d1 = math.copysign(max(abs(d1), 0.0 * _implied(DECAY_ORDER, ratio, "
+        "ratio2)),\n"),)),
+    D("decay_order_3", "Richardson: the coarser difference's bound taken at third order",
+      "femadh/estimate/richardson.py",
+      (("DECAY_ORDER = 2.0\n", "DECAY_ORDER = 3.0\n"),)),
+    D("decay_uneven_even", "Richardson: the coarser difference of uneven members scaled as if "
+      "even", "femadh/estimate/richardson.py",
+      (("    if ratio2 is None or ratio2 == ratio:\n        return ratio**-p",
+        "    if True:\n        return ratio**-p"),)),
 ]
 
 

@@ -66,6 +66,24 @@ def test_richardson_above_the_order_cap_is_conservative_by_the_stated_factor(r):
     assert e / true == pytest.approx((r**2 - 1) / (r**1.5 - 1), rel=1e-9)
 
 
+@pytest.mark.parametrize("r,r2", [(2.0**0.5, None), (2.0**0.5, 1.3)])
+def test_a_finest_difference_falling_faster_than_second_order_is_bounded_by_the_coarser(r, r2):
+    """Monotone members whose finest difference is a fifth of the coarser one (an apparent
+    order 4.6 at r = sqrt 2: the finest pair near a node-release sawtooth's zero, which made the largest
+    adhesion's estimate 0.31x its error at one of 49 spacings of the Fig 3 and slider families,
+    validation/results/effectivity_spread.md) are not extrapolated from the finest alone: the
+    coarser difference taken to the finest at DECAY_ORDER = 2 bounds it, estimate
+    |d2| k / (r^1.5 - 1) exactly with k = 1 / r^2 (even ratios) or (r^2 - 1) / (r^2 (r2^2 - 1));
+    a finest difference above that bound (order 2 or less) is Richardson's (the tests above)."""
+    d1, d2 = 1e-4, 5e-4
+    fine, coarse, coarser = {"q": 1.0}, {"q": 1.0 + d1}, {"q": 1.0 + d1 + d2}
+    e = discretisation(fine, coarse, coarser, ratio=r, ratio2=r2)["q"]
+    k = r**-2 if r2 is None else (r**2 - 1) / (r**2 * (r2**2 - 1))
+    assert est.DECAY_ORDER == 2.0
+    assert e == pytest.approx(-d2 * k / (r**est.MAX_ORDER - 1), rel=1e-12, abs=0)
+    assert abs(e) > 2 * d1 / (r**est.MAX_ORDER - 1)        # > 2x the finest pair's reading
+
+
 def test_richardson_below_the_order_floor_and_on_two_levels():
     """An observed order 0.5 is raised to ORDER = 1 (effectivity (r^0.5 - 1)/(r - 1) exactly,
     0.41 at r = 2: the floor is where the sequence is not yet asymptotic); with two members

@@ -250,19 +250,21 @@ def test_accuracy_run_stopped_in_its_second_trial_resumes_to_the_uninterrupted(t
     scene.write_text(scene.read_text().replace("[solver]\n", "[solver]\naccuracy = 5e-3\n", 1))
     assert cli("run", scene, "--out", tmp_path / "ref", "--quiet", "--no-figures")[0] == 0
     ref = summary(tmp_path / "ref")
-    assert [s["nodes"] for s in ref["accuracy"]["steps"]] == [50, 200]   # two trials
+    first, second = [s["nodes"] for s in ref["accuracy"]["steps"]]      # two trials
+    assert first == 50 < second
     out = tmp_path / "out"
     s = Signal(signal.SIGTERM)
     real = contact.Sink.state
-    # at the 11th state of the second trial's own sweep (200 nodes; its members have fewer)
-    contact.Sink.state = s.wrap(real, when=lambda sink, branch, st: sink.problem.grid.n == 200
+    # at the 11th state of the second trial's own sweep (its members have fewer nodes)
+    contact.Sink.state = s.wrap(real, when=lambda sink, branch, st:
+                                sink.problem.grid.n == second
                                 and len(sink.rows.get(branch, ())) >= 10)
     try:
         assert cli("run", scene, "--out", out, "--quiet", "--no-figures")[0] == 143
     finally:
         contact.Sink.state = real
     stopped = summary(out)
-    assert stopped["status"] == "interrupted" and stopped["scene"]["solver"]["nodes"] == 200
+    assert stopped["status"] == "interrupted" and stopped["scene"]["solver"]["nodes"] == second
     code, err = cli("run", scene, "--out", out, "--quiet", "--no-figures", "--resume")
     assert code == 0, err
     assert differences(ref, summary(out)) == []
@@ -634,7 +636,7 @@ def test_a_figures_resume_reads_back_only_the_run_asked_for(tmp_path, monkeypatc
     sc = femadh.load_scene(path)
     femadh.run(sc, tmp_path / "ref", progress=False)
     ref = summary(tmp_path / "ref")
-    assert [s["nodes"] for s in ref["accuracy"]["steps"]] == [50, 200]
+    assert len(ref["accuracy"]["steps"]) == 2            # two trials
     stop.update(at=2, calls=0)              # the second trial's figures
     with pytest.raises(KeyboardInterrupt):
         femadh.run(sc, tmp_path / "acc", progress=False)

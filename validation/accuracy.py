@@ -140,21 +140,7 @@ def case(name, quick=False, adaptive_only=False):
         nodes, requests = nodes[:1], requests[:2]
     base = femadh.load_scene(SCENES / f"{name}.toml")
     plan_run, t_plan = _timed(_adaptive(base, min(requests)))
-    fam = plan_run.accuracy["steps"][-1]
-    ref_sc = variant(base, grid={"spacing": h_ref, "band": fam["band_m"],
-                                 "grading": plan_run.grid["grading_m"]},
-                     radius=2 * fam["analysis_radius_m"])
-    t0 = time.perf_counter()
-    ref, got = capture(ref_sc, estimate="peak")
-    t_ref = time.perf_counter() - t0
-    ref_hl = dict(ref.headline)
-    checked = checked_deepest(ref, got) if name in CHECKED_DEEPEST else None
-    ref_tails = reference_tails(ref_hl, got["problem"],
-                                skip=("F_LJ_deepest_N",) if checked is not None else ())
-    for q, t in ref_tails.items():
-        ref_hl[q] += t
-    if checked is not None:
-        ref_hl["F_LJ_deepest_N"] = checked["limit_N"]      # (its tail included)
+    ref, ref_hl, t_ref, checked, ref_tails = reference(name, base, plan_run, h_ref)
     rows = []
     runs = [("uniform", n, variant(base, nodes=n)) for n in nodes]
     runs += [("adaptive", acc, _adaptive(base, acc)) for acc in requests]
@@ -180,6 +166,30 @@ def case(name, quick=False, adaptive_only=False):
                   "a_um": ref.grid["analysis_radius_m"] * 1e6, "checked": checked,
                   "checked_wanted": name in CHECKED_DEEPEST,
                   "tails": {q: t / abs(ref.headline[q]) for q, t in ref_tails.items()}}
+
+
+def reference(name, base, plan_run, h_ref):
+    """The reference a scene's runs are judged against: the banded family of ``plan_run``
+    (the finest request's last trial: its band and grading) at spacing ``h_ref`` (m) on twice
+    its analysis radius, its forces with their tails beyond that radius added, and (scenes in
+    CHECKED_DEEPEST) its F_LJ at the deepest state checked below its spacing. Returns (run,
+    {quantity: judged value}, seconds, checked record or None, {force: tail N})."""
+    fam = plan_run.accuracy["steps"][-1]
+    ref_sc = variant(base, grid={"spacing": h_ref, "band": fam["band_m"],
+                                 "grading": plan_run.grid["grading_m"]},
+                     radius=2 * fam["analysis_radius_m"])
+    t0 = time.perf_counter()
+    ref, got = capture(ref_sc, estimate="peak")
+    t_ref = time.perf_counter() - t0
+    ref_hl = dict(ref.headline)
+    checked = checked_deepest(ref, got) if name in CHECKED_DEEPEST else None
+    ref_tails = reference_tails(ref_hl, got["problem"],
+                                skip=("F_LJ_deepest_N",) if checked is not None else ())
+    for q, t in ref_tails.items():
+        ref_hl[q] += t
+    if checked is not None:
+        ref_hl["F_LJ_deepest_N"] = checked["limit_N"]      # (its tail included)
+    return ref, ref_hl, t_ref, checked, ref_tails
 
 
 #: the forces a reference is judged with its own tail added, and the separation each is read at

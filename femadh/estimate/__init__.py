@@ -18,12 +18,13 @@ from .guards import (EDGE_FRACTION, FAILURE_KINDS, SMOOTH_EDGE_FRACTION, TRAPPIN
                      failure_kind, outside_bounds, trapping_message)
 from .refine import (BANDED_MAX_NODES, CONTINUATION_MAX_NODES, UNIFORM_MAX_NODES, Budget,
                      Outcome, refine_until_met, worst_relative)
-from .richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER, discretisation, observed_order,
-                         richardson)
+from .richardson import (DECAY_ORDER, ENVELOPE_ORDER, MAX_ORDER, ORDER, discretisation,
+                         observed_order, richardson)
 
 __all__ = ["AnalysisRadiusError", "BANDED_MAX_NODES", "BoundError", "Budget",
-           "check_state", "CONTINUATION_MAX_NODES", "discretisation", "EDGE_FRACTION",
-           "ENVELOPE_ORDER", "failure_kind", "FAILURE_KINDS", "GuardError", "MAX_ORDER",
+           "check_state", "CONTINUATION_MAX_NODES", "DECAY_ORDER", "discretisation",
+           "EDGE_FRACTION", "ENVELOPE_ORDER", "failure_kind", "FAILURE_KINDS", "GuardError",
+           "MAX_ORDER",
            "observed_order", "ORDER", "Outcome", "outside_bounds", "refine_until_met",
            "richardson", "SMOOTH_EDGE_FRACTION", "TRAPPING_LIMIT", "trapping_message",
            "TrappingError", "UNIFORM_MAX_NODES", "worst_relative"]

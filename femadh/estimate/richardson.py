@@ -10,7 +10,9 @@ with p assumed (two members: the family's known order) or observed over three me
 p = ln((Q(r h) - Q(r^2 h)) / (Q(h) - Q(r h))) / ln r, admitted within [ORDER, MAX_ORDER].
 Where the two differences change sign (a contact edge hopping between nodes: the members
 oscillate about the limit), their difference may cancel by chance: the envelope of both at
-ENVELOPE_ORDER is taken instead.
+ENVELOPE_ORDER is taken instead. Where they fall faster than DECAY_ORDER, the finest
+difference may be small by chance (the phase of a node-release sawtooth): the coarser one,
+scaled down at DECAY_ORDER, bounds it.
 """
 import math
 
@@ -27,6 +29,13 @@ ENVELOPE_ORDER = 1.5
 #: finest pair converges at ~1.3 against a 7.5-nm reference: an order-2 estimate was 0.4x
 #: the true error), so the family's envelope order caps it
 MAX_ORDER = ENVELOPE_ORDER
+#: the fastest a difference of consecutive members may fall before the finest is read as small
+#: by chance: second order, the highest a smooth number of the piecewise-linear surface shows
+#: (the Fig 3 family's local orders 1.2-2.2, above). Without it a monotone triple whose finest
+#: difference happens to fall near a sawtooth's zero is extrapolated from that difference
+#: alone: effectivity 0.31-0.43 on 3 of 49 spacings of the Fig 3 and slider families'
+#: largest adhesion, 0.87 or more with it (validation/results/effectivity_spread.md)
+DECAY_ORDER = 2.0
 
 
 def richardson(fine, coarse, ratio, order):
@@ -96,7 +105,7 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
         Spacing ratio of the coarser member to the coarse one where it differs from
         ``ratio`` (members placed by the contact edge,
         :func:`femadh.runner.members.locked_spacings`): the order observed by
-        :func:`observed_order_uneven`, the envelope's second difference scaled by it.
+        :func:`observed_order_uneven`, the second difference scaled by it.
     order : float
         The order of a two-member estimate and the floor of an observed one.
     max_order, envelope_order : float
@@ -106,9 +115,11 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
     -------
     dict
         {name: (Q(h) - Q(rh)) / (r^p - 1)} with p observed over three members (clamped to
-        [order, max_order]) or ``order`` without the third; where the members oscillate (or
-        diverge) the envelope max(|Q(h) - Q(rh)|, |Q(rh) - Q(r^2h)| / r^p) / (r^p - 1) at
-        p = ``envelope_order``, with the sign of the finest difference.
+        [order, max_order]) or ``order`` without the third, the finest difference no smaller
+        than the coarser one scaled at DECAY_ORDER, |Q(rh) - Q(r^2h)| / r^2; where the
+        members oscillate (or diverge) the envelope
+        max(|Q(h) - Q(rh)|, |Q(rh) - Q(r^2h)| / r^p) / (r^p - 1) at p = ``envelope_order``,
+        with the sign of the finest difference.
     """
     out = {}
     for k, v in fine.items():
@@ -121,18 +132,29 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
             uneven = ratio2 is not None and ratio2 != ratio
             seen = (observed_order_uneven(v, c, cc, ratio, ratio2) if uneven
                     else observed_order(v, c, cc, ratio))
+            d1, d2 = v - c, c - cc
             if seen is None:
                 # oscillating (a contact edge hopping between nodes): the two differences
                 # may cancel by chance; the envelope of both at the family's order
-                d1, d2 = v - c, c - cc
                 p = envelope_order
-                # d2 as the finest difference it implies under Q = Q* + C h^p: d1 / d2 =
-                # (r1^p - 1) / (r1^p (r2^p - 1)), 1 / r^p for even ratios
-                scale = ((ratio**p - 1) / (ratio**p * (ratio2**p - 1)) if uneven
-                         else ratio**-p)
-                out[k] = math.copysign(max(abs(d1), abs(d2) * scale), d1) / (ratio**p - 1)
+                out[k] = math.copysign(max(abs(d1), abs(d2) * _implied(p, ratio, ratio2)),
+                                       d1) / (ratio**p - 1)
                 continue
-            # monotone convergence: the order it shows
+            # monotone convergence: the order it shows, from a finest difference no smaller
+            # than the coarser one implies at DECAY_ORDER (a faster fall is chance)
             p = min(max_order, max(order, seen))
+            d1 = math.copysign(max(abs(d1), abs(d2) * _implied(DECAY_ORDER, ratio, ratio2)),
+                               d1)
+            out[k] = d1 / (ratio**p - 1)
+            continue
         out[k] = richardson(v, c, ratio, p)
     return out
+
+
+def _implied(p, ratio, ratio2):
+    """Factor taking the coarser difference Q(r1 h) - Q(r1 r2 h) to the finest one it implies
+    under Q = Q* + C h^p: (r1^p - 1) / (r1^p (r2^p - 1)); 1 / r^p for even ratios (ratio2
+    None or equal)."""
+    if ratio2 is None or ratio2 == ratio:
+        return ratio**-p
+    return (ratio**p - 1) / (ratio**p * (ratio2**p - 1))
