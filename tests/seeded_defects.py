@@ -556,9 +556,10 @@ DEFECTS = [
       (("if not (d1 * d2 > 0 and abs(d2) > abs(d1)):", "if not d1 * d2 > 0:"),)),
     D("est_grid_part_half", "the grid part halved on its way into the breakdown",
       "femadh/runner/estimates.py",
-      (('ratio=ratio, ratio2=ratio2).items():\n                parts.setdefault(k, {})["grid"] = v',
-        'ratio=ratio, ratio2=ratio2).items():\n                parts.setdefault(k, {})["grid"] = '
-        '0.5 * v'),)),
+      (('decay_order=decay).items():\n                parts.setdefault(k, {})["grid"] = v\n'
+        '        if locked',
+        'decay_order=decay).items():\n                parts.setdefault(k, {})["grid"] = '
+        '0.5 * v\n        if locked'),)),
     D("est_total_signed", "total: |sum of the signed parts| (grid and tail cancel)",
       "femadh/runner/estimates.py",
       (('comp["total"] = float(sum(abs(v) for v in comp.values()))',
@@ -1094,7 +1095,7 @@ DEFECTS = [
         "    h0 = float(problem.grid.nodes[1])"))),
     D("lock_ratio_swap", "uneven Richardson: the two ratios swapped",
       "femadh/runner/estimates.py",
-      (("ratio=h1 / h0, ratio2=h2 / h1).items():", "ratio=h2 / h1, ratio2=h1 / h0).items():"),)),
+      (("ratio=h1 / h0, ratio2=h2 / h1,\n", "ratio=h2 / h1, ratio2=h1 / h0,\n"),)),
     D("uneven_order_formula", "uneven observed order: r2^p (r1^p - 1) / (r2^p - 1)",
       "femadh/estimate/richardson.py",
       (("        return ratio**p * (ratio2**p - 1.0) / (ratio**p - 1.0) - rho",
@@ -1864,8 +1865,8 @@ DEFECTS = [
         "        return 2**0.5, out, (n1 - 0.5) / (n2 - 0.5)"),)),
     D("uniform_ratio2_dropped", "uniform sqrt2 members: the estimate ignores the second ratio",
       "femadh/runner/estimates.py",
-      (("                                   ratio=ratio, ratio2=ratio2).items():",
-        "                                   ratio=ratio).items():"),)),
+      (("                                   ratio=ratio, ratio2=ratio2, decay_order=decay).items():",
+        "                                   ratio=ratio, decay_order=decay).items():"),)),
     # -- the corrector made cheaper (branch corrector): releases carry h, P, K w; the first
     #    step at a set solved to GMRES_RTOL_NEW_SET; GMRES's rotations in Python floats; the
     #    preconditioner's block size checked once
@@ -2482,10 +2483,9 @@ DEFECTS = [
     D("decay_bound_off", "Richardson: a monotone triple extrapolated from its finest difference "
       "alone, however fast it fell (the coarser difference's bound dropped)",
       "femadh/estimate/richardson.py",
-      (("            d1 = math.copysign(max(abs(d1), abs(d2) * _implied(DECAY_ORDER, ratio, "
-        "ratio2)),\n",
-        "            d1 = math.copysign(max(abs(d1), 0.0 * _implied(DECAY_ORDER, ratio, "
-        "ratio2)),\n"),)),
+      (("                d1 = math.copysign(max(abs(d1), abs(d2) * _implied(decay_order, "
+        "ratio,\n", "                d1 = math.copysign(max(abs(d1), 0.0 * _implied(decay_order, "
+        "ratio,\n"),)),
     D("decay_order_3", "Richardson: the coarser difference's bound taken at third order",
       "femadh/estimate/richardson.py",
       (("DECAY_ORDER = 2.0\n", "DECAY_ORDER = 3.0\n"),)),
@@ -2493,6 +2493,14 @@ DEFECTS = [
       "even", "femadh/estimate/richardson.py",
       (("    if ratio2 is None or ratio2 == ratio:\n        return ratio**-p",
         "    if True:\n        return ratio**-p"),)),
+    D("decay_on_uniform", "estimate: the coarser difference bounds the finest on uniform grids "
+      "too (a trapped N/4 member inflates the estimate)", "femadh/runner/estimates.py",
+      (("    decay = DECAY_ORDER if scene.grid is not None else None\n",
+        "    decay = DECAY_ORDER\n"),)),
+    D("decay_off_banded", "estimate: banded families' finest difference read alone (the "
+      "chance-small difference under-reads)", "femadh/runner/estimates.py",
+      (("    decay = DECAY_ORDER if scene.grid is not None else None\n",
+        "    decay = None\n"),)),
 ]
 
 

@@ -51,6 +51,9 @@ def one(name, mode):
     sc = femadh.load_scene(SCENES / f"{scene}.toml")
     if acc is not None:
         sc = sc.replace({"solver.accuracy": acc})
+    # the grid route throughout: route "auto" sends a band that follows the edge to the edge
+    # route (femadh/runner/edge_route.py route_for), whose run has no grid trials to compare
+    sc = sc.replace({"solver.route": "grid"})
     saved = adaptive.FOLLOW_NODES
     adaptive.FOLLOW_NODES = mode
     try:

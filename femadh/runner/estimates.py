@@ -52,7 +52,7 @@ from .peak import peak_adhesion
 from ..estimate.guards import (EDGE_FRACTION, TRAPPING_LIMIT, BoundError,  # noqa: F401
                                GuardError, TrappingError, check_state, outside_bounds)
 from ..estimate.richardson import _finite  # noqa: E402 (one home)
-from ..estimate.richardson import (ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F401
+from ..estimate.richardson import (DECAY_ORDER, ENVELOPE_ORDER, MAX_ORDER, ORDER,  # noqa: F401
                                    discretisation)
 
 #: convergence order of the P2 FE body in the headline forces under element-size halving
@@ -314,6 +314,9 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
                                 f"({_short(g.error)}); the FE mesh part of the error is not "
                                 "estimated: the stated errors lack it")
     ratio, members, ratio2 = coarser_members(scene, problem, green)
+    # the coarser difference bounds the finest on banded families only, whose members the
+    # plan keeps trapping-safe (femadh.estimate.richardson.DECAY_ORDER)
+    decay = DECAY_ORDER if scene.grid is not None else None
     # the forces at the deepest separation: members placed by its contact edge (the same
     # fraction of a spacing as the fine grid's), where they can be; the family's reduced
     # members then skip that state (its grid part would be replaced)
@@ -336,13 +339,14 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
         if levels:
             for k, v in discretisation(fine_hl, levels[0],
                                        levels[1] if len(levels) > 1 else None,
-                                       ratio=ratio, ratio2=ratio2).items():
+                                       ratio=ratio, ratio2=ratio2, decay_order=decay).items():
                 parts.setdefault(k, {})["grid"] = v
         if locked is not None and levels:
             (h1, h2), (lv1, lv2) = locked
             h0 = float(problem.grid.nodes[1])
             for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
-                                       ratio=h1 / h0, ratio2=h2 / h1).items():
+                                       ratio=h1 / h0, ratio2=h2 / h1,
+                                       decay_order=decay).items():
                 parts.setdefault(k, {})["grid"] = v
             if scene.grid is not None:
                 res.grid["deepest_member_spacings_m"] = [h1, h2]
