@@ -2233,7 +2233,8 @@ DEFECTS = [
         "        return (f\"not assessed ({res.status})\" if False and not a[\"met\"]"),)),
     D("study_vary_error_on_file", "study: a --vary value's error named against the scene "
       "file", "femadh/studies/sweep.py",
-      (("                if source and e.key in keys:", "                if False:"),)),
+      (("    where = (lambda key: f\"{source} {key}\") if source else (scene.path or \"study\")",
+        "    where = scene.path or \"study\""),)),
     D("resume_estimate_stop_no_checkpoint", "run: a stop in the peak search or the estimate "
       "leaves no checkpoint (the resumed members re-search their folds)",
       "femadh/runner/contact.py",
@@ -2477,6 +2478,15 @@ DEFECTS = [
     D("check_first_fixed_300", "check: an adaptive scene's time estimated on 300 nodes whatever "
       "its plan", "femadh/scene/resources.py",
       (("            n = first_nodes or 300", "            n = 300"),)),
+    # -- newcomer trial (ux14): where a bad value came from, what a resume refusal names, the
+    # estimate as one phase of the progress line
+    D("ux14_replace_error_on_file", "Scene.replace: a value given to the call reported "
+      "against the scene file", "femadh/scene/__init__.py",
+      (("        raise given_by(exc, where, changes) from None", "        raise exc from None"),)),
+    D("ux14_replace_error_every_line_on_call", "Scene.replace: every error line named against "
+      "the call, a value the file holds too", "femadh/errors.py",
+      (("        return isinstance(key, str) and any(key == k or key.startswith(k + \".\") for k "
+        "in keys)", "        return True"),)),
 ]
 
 
