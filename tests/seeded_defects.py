@@ -2487,6 +2487,16 @@ DEFECTS = [
       "the call, a value the file holds too", "femadh/errors.py",
       (("        return isinstance(key, str) and any(key == k or key.startswith(k + \".\") for k "
         "in keys)", "        return True"),)),
+    D("ux14_resume_refusal_no_keys", "resume of a changed scene: the refusal names no key "
+      "(as before)", "femadh/io/run_folder.py",
+      (("        if old is None or self.given is None:", "        if True:"),)),
+    D("ux14_resume_keys_undotted", "resume of a changed scene: a key named without its tables",
+      "femadh/io/run_folder.py",
+      (("            out += changed_keys(old.get(k, _UNSET), new.get(k, _UNSET), f\"{prefix}{k}.\")",
+        "            out += changed_keys(old.get(k, _UNSET), new.get(k, _UNSET), f\"{k}.\")"),)),
+    D("ux14_resume_trial_keys", "resume of a changed adaptive scene: the folder records its "
+      "trial's keys (its grid, its radius) as the user's", "femadh/runner/estimates.py",
+      (("    out.given = scene.as_given          # (its run folder is the user's scene's)\n", ""),)),
 ]
 
 

@@ -68,7 +68,8 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
     from ..io.run_folder import RunFolder
 
     mode = "resume" if resume else "overwrite" if overwrite else "new"
-    with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
+    with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode,
+                   given=scene.as_given) as folder:
         res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
                    resume_from=resume_from, run=run)
         if figures and res.status in ("converged", "failed") and any(

@@ -118,7 +118,9 @@ def variant(scene, **changes):
                           if v is not None}        # (follow: None is a static band)
     solver.pop("accuracy", None)
     raw.pop("study", None)
-    return scene_from_dict(raw, scene.path, bare_numbers=True)
+    out = scene_from_dict(raw, scene.path, bare_numbers=True)
+    out.given = scene.as_given          # (its run folder is the user's scene's)
+    return out
 
 
 def refine_peak(scene, res, problem, sink):
