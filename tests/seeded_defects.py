@@ -2497,6 +2497,13 @@ DEFECTS = [
     D("ux14_resume_trial_keys", "resume of a changed adaptive scene: the folder records its "
       "trial's keys (its grid, its radius) as the user's", "femadh/runner/estimates.py",
       (("    out.given = scene.as_given          # (its run folder is the user's scene's)\n", ""),)),
+    D("ux14_estimate_not_one_phase", "progress: the estimate's members shown as parts of the "
+      "grid's phase (no estimate phase of their own)", "femadh/runner/contact.py",
+      (("            with deferring(None), phase(\"estimate\"):", "            with deferring(None):"),)),
+    D("ux14_estimate_judged_pass_shown", "progress: the members' judged numbers at hand shown "
+      "as a pass through the members again", "femadh/runner/estimates.py",
+      (("                if not judged_only:\n                    # (the judged numbers alone",
+        "                if True:\n                    # (the judged numbers alone"),)),
 ]
 
 

@@ -246,7 +246,8 @@ def _finish(scene, res, problem, sink, estimate, run):
             # an adaptive trial's estimate may defer what its loop does not judge
             # (estimates.deferring: set around the trial's run, not its members')
             defer = deferred_target()
-            with deferring(None):
+            # (one phase of the display: its members are its parts, estimates._part)
+            with deferring(None), phase("estimate"):
                 res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
                                                 defer=defer)
         guard_bounds(res, problem)      # a BoundError: its kind decides the refinement
