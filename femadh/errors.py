@@ -45,6 +45,23 @@ class SceneErrors(SceneError):
         Exception.__init__(self, "\n".join(str(e) for e in self.errors))
 
 
+def given_by(exc, where, keys):
+    """``exc`` (a SceneError, or SceneErrors) with each line about one of ``keys`` named against
+    ``where`` instead of the scene file: the value came from a call or an option, and the file
+    does not hold it. A line is about a key when its key is that key or lies under it (a table
+    given whole: ``{"solver": {"accuracy": -1}}`` is about ``solver.accuracy``); every other
+    line keeps its file. ``where``: a label (``"given to Scene.replace"``) or a function of the
+    line's key giving one (``"--vary sphere.radius"``)."""
+    keys = [k for k in keys if isinstance(k, str)]
+
+    def about(key):
+        return isinstance(key, str) and any(key == k or key.startswith(k + ".") for k in keys)
+
+    errs = [SceneError(where(e.key) if callable(where) else where, e.key, e.value, e.expected)
+            if about(e.key) else e for e in getattr(exc, "errors", [exc])]
+    return errs[0] if len(errs) == 1 else SceneErrors(errs)
+
+
 class _Missing:
     def __repr__(self):
         return "(missing)"

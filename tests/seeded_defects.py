@@ -296,8 +296,8 @@ DEFECTS = [
       (("        except BaseException as exc:\n", "        except GeneratorExit as exc:\n"),)),
     D("accuracy_mode_cleans", "accuracy mode claims its folder anew, deleting the outputs",
       "femadh/runner/accuracy.py",
-      (('RunFolder(out_dir, scene_id(scene), scene.name, "amend")',
-        'RunFolder(out_dir, scene_id(scene), scene.name, "overwrite")'),)),
+      (('RunFolder(out_dir, scene_id(scene), scene.name, "amend",',
+        'RunFolder(out_dir, scene_id(scene), scene.name, "overwrite",'),)),
     # -- stepping: a fold inside one step told by the step's energy
     D("fold_energy_sign", "stepping: the step's energy change counted with the wrong sign",
       "femadh/contact/stepping.py",
@@ -2236,7 +2236,8 @@ DEFECTS = [
         "        return (f\"not assessed ({res.status})\" if False and not a[\"met\"]"),)),
     D("study_vary_error_on_file", "study: a --vary value's error named against the scene "
       "file", "femadh/studies/sweep.py",
-      (("                if source and e.key in keys:", "                if False:"),)),
+      (("    where = (lambda key: f\"{source} {key}\") if source else (scene.path or \"study\")",
+        "    where = scene.path or \"study\""),)),
     D("resume_estimate_stop_no_checkpoint", "run: a stop in the peak search or the estimate "
       "leaves no checkpoint (the resumed members re-search their folds)",
       "femadh/runner/contact.py",
@@ -2294,8 +2295,10 @@ DEFECTS = [
         "        pass\n"),)),
     D("defer_rest_fail_uses_judged", "estimate: a member's failed rest falls back on its judged "
       "numbers instead of its whole trace", "femadh/runner/estimates.py",
-      (('                    if hl_m is None:\n                        r = run(member, progress=False, estimate="peak")\n                if hl_m is not None:',
-        '                    if hl_m is None:\n                        hl_m, how = rm.hl, rm.m.solves\n                if hl_m is not None:'),)),
+      (('                if hl_m is None:\n                    r = run(member, progress=False, '
+        'estimate="peak")\n                if hl_m is not None:',
+        '                if hl_m is None:\n                    hl_m, how = rm.hl, rm.m.solves\n'
+        '                if hl_m is not None:'),)),
     D("first_from_plan", "adaptive: a finer request's first member scaled from the plan's "
       "spacing where the trapping cap binds (the old rule)", "femadh/runner/adaptive.py",
       (("            starts.insert(0, min(ref.spacing * scale, top))\n",
@@ -2501,6 +2504,32 @@ DEFECTS = [
       "chance-small difference under-reads)", "femadh/runner/estimates.py",
       (("    decay = DECAY_ORDER if scene.grid is not None else None\n",
         "    decay = None\n"),)),
+    # -- newcomer trial (ux14): where a bad value came from, what a resume refusal names, the
+    # estimate as one phase of the progress line
+    D("ux14_replace_error_on_file", "Scene.replace: a value given to the call reported "
+      "against the scene file", "femadh/scene/__init__.py",
+      (("        raise given_by(exc, where, changes) from None", "        raise exc from None"),)),
+    D("ux14_replace_error_every_line_on_call", "Scene.replace: every error line named against "
+      "the call, a value the file holds too", "femadh/errors.py",
+      (("        return isinstance(key, str) and any(key == k or key.startswith(k + \".\") for k "
+        "in keys)", "        return True"),)),
+    D("ux14_resume_refusal_no_keys", "resume of a changed scene: the refusal names no key "
+      "(as before)", "femadh/io/run_folder.py",
+      (("        if old is None or self.given is None:", "        if True:"),)),
+    D("ux14_resume_keys_undotted", "resume of a changed scene: a key named without its tables",
+      "femadh/io/run_folder.py",
+      (("            out += changed_keys(old.get(k, _UNSET), new.get(k, _UNSET), f\"{prefix}{k}.\")",
+        "            out += changed_keys(old.get(k, _UNSET), new.get(k, _UNSET), f\"{k}.\")"),)),
+    D("ux14_resume_trial_keys", "resume of a changed adaptive scene: the folder records its "
+      "trial's keys (its grid, its radius) as the user's", "femadh/runner/estimates.py",
+      (("    out.given = scene.as_given          # (its run folder is the user's scene's)\n", ""),)),
+    D("ux14_estimate_not_one_phase", "progress: the estimate's members shown as parts of the "
+      "grid's phase (no estimate phase of their own)", "femadh/runner/contact.py",
+      (("            with deferring(None), phase(\"estimate\"):", "            with deferring(None):"),)),
+    D("ux14_estimate_judged_pass_shown", "progress: the members' judged numbers at hand shown "
+      "as a pass through the members again", "femadh/runner/estimates.py",
+      (("                if not judged_only:\n                    # (the judged numbers alone",
+        "                if True:\n                    # (the judged numbers alone"),)),
 ]
 
 

@@ -157,3 +157,31 @@ def test_check_plans_an_adaptive_scenes_first_member(tmp_path, capsys):
     assert main(["check", str(p)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "[solver.accuracy] = 1e-05" in err and "4000" in err
+
+
+def test_a_resume_of_a_changed_scene_names_the_keys_that_changed(tmp_path, capsys):
+    """``femadh run SCENE --resume`` on a folder whose run had other scene keys (a newcomer
+    trial: the refusal named no key): one line naming each changed key, dotted as the scene
+    writes it, with the run's value and today's, and what to do; restored, the refusal is
+    the one of a finished run (the folder is this scene's again). An adaptive scene: the
+    folder's run is its grid's trial, whose own keys (the grid, the analysis radius) are not
+    the user's."""
+    text = _edit("[solver]\n", "[solver]\naccuracy = 1e-2\n").replace('stop = "-5 nm"',
+                                                                     'stop = "1 nm"')
+    path, out = tmp_path / "s.toml", tmp_path / "out"
+    path.write_text(text)
+    quick = ["--out", str(out), "--quiet", "--no-estimate", "--no-figures"]
+    assert main(["run", str(path), *quick]) == 0
+    capsys.readouterr()
+    path.write_text(text.replace("accuracy = 1e-2", "accuracy = 5e-3")
+                    .replace('sigma = "1.0 nm"', 'sigma = "0.9 nm"'))
+    assert main(["run", str(path), *quick, "--resume"]) == 4
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert ("whose scene has changed since: effects.asperity_gap.sigma was '1.0 nm', is "
+            "'0.9 nm' now; solver.accuracy was 0.01, is 0.005 now; it cannot be resumed: "
+            "rerun with --overwrite instead of --resume to start again, or restore "
+            "effects.asperity_gap.sigma, solver.accuracy to resume it") in err, err
+    path.write_text(text)
+    assert main(["run", str(path), *quick, "--resume"]) == 4
+    assert "it has finished, there is nothing to resume" in capsys.readouterr().err

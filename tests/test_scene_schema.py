@@ -83,6 +83,31 @@ def test_replace_revalidates_and_recomputes_derived_values():
     assert e.value.key == "materials.disk.poisson_ratio"
 
 
+def test_a_value_given_to_replace_is_named_against_the_call_not_the_file(tmp_path):
+    """A bad value given through ``scene.replace`` (a dict of dotted keys, a table given
+    whole, keywords) is the call's, not the scene file's, which does not hold it (a newcomer
+    trial was sent to look for it there): one line naming the call, the key, the value and
+    what was expected. A line about a value the file does hold (the sigma a smaller sphere
+    no longer admits) still names the file, and a file's own bad value names the file."""
+    sc = femadh.load_scene(FIG3)
+    want = "given to Scene.replace: [solver.accuracy] = -1: expected a number in (0, 0.1]"
+    for args, kw in ((({"solver.accuracy": -1},), {}), (({"solver": {"accuracy": -1}},), {}),
+                     ((), {"solver__accuracy": -1})):
+        with pytest.raises(SceneError) as e:
+            sc.replace(*args, **kw)
+        assert str(e.value) == want, (args, kw)
+    with pytest.raises(SceneErrors) as e:
+        sc.replace({"sphere.radius": "0.5 nm", "solver.accuracy": -1})
+    lines = {x.key: str(x) for x in e.value.errors}
+    assert lines["solver.accuracy"] == want
+    assert lines["effects.asperity_gap.sigma"].startswith(f"{FIG3}: [effects.asperity_gap.sigma]"
+                                                          " = '1.0 nm': expected a sigma below")
+    p = write(tmp_path, fig3_uniform_text().replace("[solver]\n", "[solver]\naccuracy = -1\n"))
+    with pytest.raises(SceneError) as e:
+        femadh.load_scene(p)
+    assert str(e.value) == f"{p}: [solver.accuracy] = -1: expected a number in (0, 0.1]"
+
+
 def test_eq20_model_choice_builds_the_constraint_or_the_law():
     sc = femadh.load_scene(SCENES / "paper1_fig8_rho179.toml")
     # default: eq 20 exactly on the contact set, carried by the sigma-gap

@@ -123,18 +123,22 @@ def check_keys(scene, keys):
         raise SceneError("command line", "--vary", list(keys), "1 to 3 scene keys")
     if len(set(keys)) != len(keys):
         raise SceneError("command line", "--vary", list(keys), "distinct keys")
+    from ..scene import replace_scene
+
     values = []
     for k in keys:
         try:
             v = scene_value(scene, k)
         except SceneError as exc:
             if exc.value == "(not set)":
-                # an unknown key: the scene reader's message (with its did-you-mean) says more
-                scene.replace({k: 1.0}, si=True)
+                # an unknown key: the scene reader's message (with its did-you-mean) says
+                # more, naming the --vary that gave the key (the file does not hold it)
+                replace_scene(scene, {k: 1.0}, {}, True, f"--vary {k}")
             raise
         if not (math.isfinite(v) and v > 0):
             raise SceneError(scene.path, k, v, "a positive value to fit (relative steps)")
-        scene.replace({k: v}, si=True)
+        # the scene's own value, changed by the fit: its errors name the file that holds it
+        replace_scene(scene, {k: v}, {}, True, scene.path)
         values.append(v)
     return values
 

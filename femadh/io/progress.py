@@ -2,11 +2,13 @@
 
 A run shows **one** display from its start to its end (:func:`display`): a tqdm line whose
 label names the phase - ``paper1-fig4 › operator``, ``› approach 12/36``, ``› estimate:
-N = 100 › retract``, ``› refinement 2``, ``› figures`` - and whose counter restarts with each
-phase that has a known number of steps. Code that runs inside a run (its branches, its
-estimate members, the refinements of an adaptive run) names its part with :func:`phase` and
-:func:`begin` / :func:`advance`; these are no-ops when no display is shown, so pipes, logs,
-tests and nested runs stay quiet. Callers decide ``enabled`` (default: stderr is a
+member 1/2 (N = 100) › retract``, ``› refinement 2``, ``› figures`` - and whose counter
+restarts with each phase that has a known number of steps. Code that runs inside a run (its
+branches, its estimate members, the refinements of an adaptive run) names its part with
+:func:`phase`, :func:`part` (the next part of the open phase: an estimate's next member,
+without the line falling back to the enclosing phase between them) and :func:`begin` /
+:func:`advance`; these are no-ops when no display is shown, so pipes, logs, tests and nested
+runs stay quiet. Callers decide ``enabled`` (default: stderr is a
 terminal).
 
 The width is the terminal's, asked again at each phase; a terminal that reports 0 columns
@@ -68,6 +70,7 @@ class Display:
         self.stream = stream or sys.stderr
         self.name = name
         self.frames = []          # labels of the open phases, outermost first
+        self.bases = []           # their names as opened (a part's label adds to its own)
         self.leaf = None          # the current step's label inside the innermost phase
         self.t0 = time.perf_counter()
         self.bar = tqdm(total=None, desc=name, file=self.stream, leave=False,
@@ -104,12 +107,20 @@ class Display:
 
     def push(self, label):
         self.frames.append(label)
+        self.bases.append(label)
         self.leaf = None
         self._redraw()
 
     def pop(self):
         if self.frames:
             self.frames.pop()
+            self.bases.pop()
+        self.leaf = None
+        self._redraw()
+
+    def part(self, label):
+        if self.frames:
+            self.frames[-1] = f"{self.bases[-1]}: {label}"
         self.leaf = None
         self._redraw()
 
@@ -160,6 +171,14 @@ def phase(label):
         yield
     finally:
         d.pop()
+
+
+def part(label):
+    """The open phase's next part (``estimate`` -> ``estimate: member 2/2 (N = 100)``): the
+    phase stays open, so its parts follow one another on the line without the enclosing
+    phase's label (the grid's sweep) between them; nothing when no display is shown."""
+    if _active is not None:
+        _active.part(label)
 
 
 def begin(label, total=None):

@@ -64,6 +64,10 @@ class RunFolder:
     mode : {"new", "overwrite", "resume", "amend"}
         ``amend`` reopens the folder of a run of the same scene that has just written it, to
         update its summary, and touches none of its outputs.
+    given : dict, optional
+        The scene's keys as the user gave them (:attr:`Scene.as_given`): summary.json records
+        them ("scene_given"), and a ``resume`` of a folder whose run had other keys names
+        the keys that changed.
 
     Raises
     ------
@@ -72,9 +76,13 @@ class RunFolder:
         outputs that ``mode`` does not allow to touch.
     """
 
-    def __init__(self, path, scene_id, scene_name, mode="new"):
+    def __init__(self, path, scene_id, scene_name, mode="new", given=None):
         self.path = Path(path)
         self.scene_id, self.scene_name, self.mode = scene_id, scene_name, mode
+        # as summary.json holds them (JSON's lists and numbers), to compare with a previous
+        # run's
+        self.given = None if given is None else json.loads(json.dumps(
+            given, default=lambda o: _json_default(o, str)))
         if self.path.exists() and not self.path.is_dir():
             raise OutputError(f"output folder {self.path} is an existing file; give a folder "
                               "(--out DIR)")
@@ -155,13 +163,34 @@ class RunFolder:
                 # this scene (their checksums are seeded with its id) before it keeps any
                 return prev
             if prev.get("scene_id") != self.scene_id:
-                raise OutputError(f"{what} of another scene (or of this scene changed): it "
-                                  "cannot be resumed; use --overwrite to replace it")
+                raise OutputError(self._changed(what, prev))
             if prev.get("status") == "converged" and not prev.get("trial"):
                 raise OutputError(f"{what}: it has finished, there is nothing to resume")
             return prev
         raise OutputError(f"{what}; use --resume to continue it or --overwrite to replace it "
                           "(or give another --out)")
+
+    def _changed(self, what, prev):
+        """The one line refusing to resume a run of other keys: the first few keys that
+        changed (dotted, as the scene names them), each with the run's value and this
+        scene's, and what to do."""
+        old = prev.get("scene_given")
+        if old is None or self.given is None:
+            # (a folder written before its summary recorded the scene's keys)
+            return (f"{what} of another scene (or of this scene changed): it cannot be "
+                    "resumed; use --overwrite to replace it")
+        diff = changed_keys(old, self.given)
+        if not diff:
+            return (f"{what} of the same scene keys resolved otherwise (femadh "
+                    f"{prev.get('femadh_version', '?')} wrote it): it cannot be resumed; use "
+                    "--overwrite to run it again")
+        shown = "; ".join(f"{k} was {_value(a)}, is {_value(b)} now" for k, a, b in diff[:3])
+        more = (f" (and {len(diff) - 3} more key{'s' if len(diff) > 4 else ''})"
+                if len(diff) > 3 else "")
+        keys = ", ".join(k for k, _, _ in diff[:3]) + (", ..." if more else "")
+        return (f"{what}, whose scene has changed since: {shown}{more}; it cannot be resumed: "
+                "rerun with --overwrite instead of --resume to start again, or restore "
+                f"{keys} to resume it")
 
     def clean(self):
         """Remove femadh's own outputs (and nothing else) from the folder."""
@@ -179,8 +208,9 @@ class RunFolder:
 
     def write_summary(self, data):
         """summary.json, atomically; ``data`` gets the scene id."""
+        given = {} if self.given is None else {"scene_given": self.given}
         write_atomic(self.path / "summary.json",
-                     json.dumps({"scene_id": self.scene_id, **data}, indent=2,
+                     json.dumps({"scene_id": self.scene_id, **given, **data}, indent=2,
                                 default=_json_default) + "\n")
 
     def release(self):
@@ -205,7 +235,9 @@ class RunFolder:
         return False
 
 
-def _json_default(o):
+def _json_default(o, other=None):
+    """``o`` as JSON (numpy scalars and arrays); anything else by ``other`` (e.g. str: a
+    TOML date among a scene's keys), else TypeError."""
     import numpy as np
 
     if isinstance(o, (np.floating, np.integer)):
@@ -214,4 +246,37 @@ def _json_default(o):
         return o.tolist()
     if isinstance(o, np.bool_):
         return bool(o)
+    if other is not None:
+        return other(o)
     raise TypeError(type(o))
+
+
+#: a key one scene sets and the other does not
+_UNSET = object()
+
+
+def changed_keys(old, new, prefix=""):
+    """[(dotted key, old value, new value)] of every leaf that differs between two scenes'
+    keys (nested dicts as the TOML tables; a list of tables by index,
+    ``substrate.layers.0.thickness``); a key only one of them sets has ``_UNSET`` on the
+    other side."""
+    out = []
+    if isinstance(old, dict) and isinstance(new, dict):
+        for k in list(old) + [k for k in new if k not in old]:
+            out += changed_keys(old.get(k, _UNSET), new.get(k, _UNSET), f"{prefix}{k}.")
+        return out
+    if (isinstance(old, list) and isinstance(new, list) and len(old) == len(new)
+            and any(isinstance(x, dict) for x in old + new)):
+        for i, (a, b) in enumerate(zip(old, new)):
+            out += changed_keys(a, b, f"{prefix}{i}.")
+        return out
+    return [] if old == new else [(prefix[:-1], old, new)]
+
+
+def _value(v):
+    """A scene value as the refusal shows it: as written in TOML (strings quoted)."""
+    if v is _UNSET:
+        return "not set"
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return repr(v) if isinstance(v, str) else json.dumps(v)

@@ -85,6 +85,7 @@ def run_to_accuracy(scene, out_dir, *, run, figures=True, progress=None, overwri
         from .result import contact_summary as summary
 
         # the last trial's outputs stay; only its summary gains the accuracy record
-        with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
+        with RunFolder(out_dir, scene_id(scene), scene.name, "amend",
+                       given=scene.as_given) as folder:
             folder.write_summary(summary(res))
     return res

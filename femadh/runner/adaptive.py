@@ -585,7 +585,8 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
         from .result import contact_summary as summary
 
         # the last trial's outputs stay; its summary gains the accuracy record, its figures
-        with RunFolder(out_dir, scene_id(scene), scene.name, "amend") as folder:
+        with RunFolder(out_dir, scene_id(scene), scene.name, "amend",
+                       given=scene.as_given) as folder:
             if figures and raised is None and res.status in ("converged", "failed") \
                     and res.branches and any(
                     len(next(iter(b.values()))) for b in res.branches.values()):

@@ -68,7 +68,8 @@ def run_contact(scene, out_dir=None, *, run, figures=True, progress=False, overw
     from ..io.run_folder import RunFolder
 
     mode = "resume" if resume else "overwrite" if overwrite else "new"
-    with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode) as folder:
+    with RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode,
+                   given=scene.as_given) as folder:
         res = _run(scene, folder, progress=progress, operator=operator, estimate=estimate,
                    resume_from=resume_from, run=run)
         if figures and res.status in ("converged", "failed") and any(
@@ -245,7 +246,8 @@ def _finish(scene, res, problem, sink, estimate, run):
             # an adaptive trial's estimate may defer what its loop does not judge
             # (estimates.deferring: set around the trial's run, not its members')
             defer = deferred_target()
-            with deferring(None):
+            # (one phase of the display: its members are its parts, estimates._part)
+            with deferring(None), phase("estimate"):
                 res.estimates = estimate_errors(scene, res, problem, sink, half, run=run,
                                                 defer=defer)
         guard_bounds(res, problem)      # a BoundError: its kind decides the refinement

@@ -592,7 +592,8 @@ def run_edge_route(scene, out_dir, pil, *, trial=None, figures=True, overwrite=F
         from ..io.run_folder import RunFolder
 
         mode = "overwrite" if (overwrite or resume) else "new"
-        folder = RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode)
+        folder = RunFolder(out_dir, folder_id or scene_id(scene), scene.name, mode,
+                           given=scene.as_given)
         folder.__enter__()
         res.out_dir = str(folder.path)
 

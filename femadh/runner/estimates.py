@@ -118,7 +118,9 @@ def variant(scene, **changes):
                           if v is not None}        # (follow: None is a static band)
     solver.pop("accuracy", None)
     raw.pop("study", None)
-    return scene_from_dict(raw, scene.path, bare_numbers=True)
+    out = scene_from_dict(raw, scene.path, bare_numbers=True)
+    out.given = scene.as_given          # (its run folder is the user's scene's)
+    return out
 
 
 def refine_peak(scene, res, problem, sink):
@@ -296,8 +298,8 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
                                 "estimated")
             g = None
         else:
-            with _phase("estimate: " + ("Green function" if green else "coarser mesh")):
-                g = run(other, progress=False, estimate="peak")
+            _part("Green function" if green else "coarser mesh")
+            g = run(other, progress=False, estimate="peak")
         _stop_if_stopped(g)
         if g is not None and g.status == "converged":
             # layered: Richardson at the P2 body's order over the meshes' size ratio (the
@@ -396,16 +398,16 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
     levels = []
     solved = []
     for i, (label, member) in enumerate(members):
-        with _phase(f"estimate: {label}"):
-            # the member solved only where the headline numbers are read, from the fine
-            # run's states (femadh.runner.members); traced whole where it cannot stand in
-            hl_m, how = (reduced_member(scene, member, problem, sink, res, deepest=deepest)
-                         if REDUCED_MEMBERS else (None, "reduced members off"))
-            if hl_m is not None:
-                levels.append(hl_m)
-                solved.append({"member": label, "reduced": True, "solves": how})
-                continue
-            r = run(member, progress=False, estimate="peak")
+        _part(_member_label(i, members))
+        # the member solved only where the headline numbers are read, from the fine run's
+        # states (femadh.runner.members); traced whole where it cannot stand in
+        hl_m, how = (reduced_member(scene, member, problem, sink, res, deepest=deepest)
+                     if REDUCED_MEMBERS else (None, "reduced members off"))
+        if hl_m is not None:
+            levels.append(hl_m)
+            solved.append({"member": label, "reduced": True, "solves": how})
+            continue
+        r = run(member, progress=False, estimate="peak")
         _stop_if_stopped(r)
         solved.append({"member": label, "reduced": False, "why": how})
         if r.status != "converged":
@@ -428,15 +430,15 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
     from types import SimpleNamespace
 
     records = []
-    for label, member in members:
+    for i, (label, member) in enumerate(members):
         r = rm = None
-        with _phase(f"estimate: {label}"):
-            hl_m, how = reduced_member(scene, member, problem, sink, res, deepest=deepest,
-                                       rest=False)
-            if hl_m is None:
-                r = run(member, progress=False, estimate="peak")
-            else:
-                rm, how = how, None
+        _part(_member_label(i, members))
+        hl_m, how = reduced_member(scene, member, problem, sink, res, deepest=deepest,
+                                   rest=False)
+        if hl_m is None:
+            r = run(member, progress=False, estimate="peak")
+        else:
+            rm, how = how, None
         _stop_if_stopped(r)
         records.append((label, member, rm, how, r))
         if r is not None and r.status != "converged":
@@ -450,12 +452,14 @@ def _deferred(scene, res, problem, sink, members, deepest, target, parts, run, a
         levels, solved = [], []
         for i, (label, member, rm, how, r) in enumerate(records):
             if rm is not None:
-                with _phase(f"estimate: {label}"):
-                    hl_m, how = ((rm.hl, rm.m.solves) if judged_only else
-                                 reduced_member(scene, member, problem, sink, res,
-                                                deepest=deepest, resume=rm))
-                    if hl_m is None:
-                        r = run(member, progress=False, estimate="peak")
+                if not judged_only:
+                    # (the judged numbers alone are at hand: nothing solved, nothing shown)
+                    _part(_member_label(i, members))
+                hl_m, how = ((rm.hl, rm.m.solves) if judged_only else
+                             reduced_member(scene, member, problem, sink, res,
+                                            deepest=deepest, resume=rm))
+                if hl_m is None:
+                    r = run(member, progress=False, estimate="peak")
                 if hl_m is not None:
                     levels.append(hl_m)
                     solved.append({"member": label, "reduced": True, "solves": how})
@@ -648,11 +652,19 @@ def _stop_if_stopped(member):
     raise Interrupted(code - 128)
 
 
-def _phase(label):
-    """The run's progress display names this part of the estimate (a no-op when none)."""
-    from ..io.progress import phase
+def _part(label):
+    """The run's progress display names this part of its estimate phase (a no-op when none
+    is shown): the estimate is one phase of the run (:func:`femadh.runner.contact._finish`,
+    a deferred rest's :func:`femadh.runner.adaptive.run_adaptive`), its members parts of it,
+    so the line does not fall back to the grid's sweep between them."""
+    from ..io.progress import part
 
-    return phase(label)
+    part(label)
+
+
+def _member_label(i, members):
+    """"member 2/2 (spacing 61.87 nm)": the i-th (0-based) of the estimate's members."""
+    return f"member {i + 1}/{len(members)} ({members[i][0]})"
 
 
 def _fine_label(scene, problem):

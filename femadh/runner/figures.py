@@ -104,7 +104,8 @@ def resume_figures(scene, out_dir, folder_id, figures=True, estimate=True):
         # normal resume makes it)
         return None
     t0 = time.perf_counter()
-    with RunFolder(out_dir, folder_id, scene.name, "resume") as folder:
+    with RunFolder(out_dir, folder_id, scene.name, "resume",
+                   given=scene.as_given) as folder:
         prev = folder.previous          # (read again under the folder's lock)
         outcome = _pending_outcome(prev, scene)
         res = None if outcome is None else _read_result(scene, folder.path, prev)

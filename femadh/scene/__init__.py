@@ -22,7 +22,7 @@ try:
 except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
-from ..errors import SceneError
+from ..errors import SceneError, given_by
 from .build import build_operator, build_problem, operator_key
 from .contact import Scene, parse_contact
 from .meniscus import MeniscusScene, parse_meniscus
@@ -122,15 +122,23 @@ def apply_overrides(raw, changes, file=None):
     return data
 
 
-def replace_scene(scene, changes, kw, si):
-    """Shared body of :meth:`Scene.replace` and :meth:`MeniscusScene.replace`."""
+def replace_scene(scene, changes, kw, si, where=None):
+    """Shared body of :meth:`Scene.replace` and :meth:`MeniscusScene.replace`.
+
+    ``where``: what gave the changed values, named by their errors instead of the scene file,
+    which does not hold them (:func:`~femadh.errors.given_by`); default "given to
+    Scene.replace" (a study passes its ``--vary``)."""
+    where = where or f"given to {type(scene).__name__}.replace"
     if changes is None or isinstance(changes, dict):
         changes = {**(changes or {}), **{k.replace("__", "."): v for k, v in kw.items()}}
-    data = apply_overrides(scene.raw, changes, scene.path)
+    data = apply_overrides(scene.raw, changes, where)
     # the typed keys refuse a bare number for a dimensional value (as a file does); the
     # rest of the scene keeps what it was built with (SI numbers in code-built scenes)
-    return scene_from_dict(data, scene.path, bare_numbers=True,
-                           strict=() if si else tuple(changes))
+    try:
+        return scene_from_dict(data, scene.path, bare_numbers=True,
+                               strict=() if si else tuple(changes))
+    except SceneError as exc:
+        raise given_by(exc, where, changes) from None
 
 
 def reference_page():

@@ -116,6 +116,10 @@ class Scene(Replaceable):
     output: Output
     study: dict | None = None
     raw: dict = field(repr=False, default_factory=dict)
+    #: the ``raw`` of the scene the user gave, where this one is femadh's variant of it (an
+    #: adaptive run's trial, :func:`femadh.runner.estimates.variant`): what its run folder
+    #: records as the scene's keys (:attr:`as_given`)
+    given: dict | None = field(repr=False, compare=False, default=None)
 
     kind = "contact"
 

@@ -16,3 +16,10 @@ class Replaceable:
         from . import replace_scene
 
         return replace_scene(self, changes, kw, si)
+
+    @property
+    def as_given(self):
+        """The scene's keys as the user gave them (``raw``; a variant's, e.g. an adaptive
+        trial's: the keys of the scene it was made from). A run folder records them, so that
+        a ``--resume`` of a changed scene names the keys that changed."""
+        return getattr(self, "given", None) or self.raw

@@ -98,18 +98,18 @@ def study_points(scene, vary, *, zip_=False, source=None):
         combos = list(zip(*lists))
     else:
         combos = list(itertools.product(*lists))
-    from ..scene import scene_id
+    from ..scene import replace_scene, scene_id
 
+    # a varied value's error names where it came from: ``source`` (the command line), or the
+    # scene file whose [study] table gave it
+    where = (lambda key: f"{source} {key}") if source else (scene.path or "study")
     points, groups = [], {}
     for i, combo in enumerate(combos):
         changes = dict(zip(keys, combo))
         try:
-            sc = scene.replace(changes)
+            sc = replace_scene(scene, changes, {}, False, where)
         except SceneError as exc:
             for e in getattr(exc, "errors", [exc]):
-                if source and e.key in keys:
-                    # the value is the varied one: it came from ``source``, not the file
-                    e = SceneError(f"{source} {e.key}", e.key, e.value, e.expected)
                 groups.setdefault((e.key, mask_numbers(e.expected)), []).append((i, e))
             continue
         points.append(Point(i, changes, sc, scene_id(sc)))
