@@ -2496,14 +2496,27 @@ DEFECTS = [
       "even", "femadh/estimate/richardson.py",
       (("    if ratio2 is None or ratio2 == ratio:\n        return ratio**-p",
         "    if True:\n        return ratio**-p"),)),
-    D("decay_on_uniform", "estimate: the coarser difference bounds the finest on uniform grids "
-      "too (a trapped N/4 member inflates the estimate)", "femadh/runner/estimates.py",
-      (("    decay = DECAY_ORDER if scene.grid is not None else None\n",
-        "    decay = DECAY_ORDER\n"),)),
-    D("decay_off_banded", "estimate: banded families' finest difference read alone (the "
-      "chance-small difference under-reads)", "femadh/runner/estimates.py",
-      (("    decay = DECAY_ORDER if scene.grid is not None else None\n",
-        "    decay = None\n"),)),
+    D("decay_no_sigma_gate", "estimate: the coarser difference bounds the finest without a "
+      "sigma-gap too (a smooth number converging faster than second order over-estimated)",
+      "femadh/runner/estimates.py",
+      (("    if problem.sigma is None:\n        return None\n    return DECAY_ORDER",
+        "    return DECAY_ORDER"),)),
+    D("decay_no_trap_gate", "estimate: the coarser difference bounds the finest however near "
+      "a node's stiffness the coarsest member softens", "femadh/runner/estimates.py",
+      (("    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None\n",
+        "    return DECAY_ORDER\n"),)),
+    D("decay_off", "estimate: the finest difference always read alone (the chance-small "
+      "difference under-reads)", "femadh/runner/estimates.py",
+      (("    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None\n",
+        "    return None\n"),)),
+    D("decay_locked_dropped", "estimate: the deepest state's placed members without the bound",
+      "femadh/runner/estimates.py",
+      (("                                       decay_order=decay_order(problem, h2 / h0)).items():",
+        "                                       ).items():"),)),
+    D("decay_zero_finest", "Richardson: an exactly zero finest difference left unbounded",
+      "femadh/estimate/richardson.py",
+      (("        if decay_order is not None and _finite(cc) and v == c and cc != c:",
+        "        if False:"),)),
     # -- newcomer trial (ux14): where a bad value came from, what a resume refusal names, the
     # estimate as one phase of the progress line
     D("ux14_replace_error_on_file", "Scene.replace: a value given to the call reported "

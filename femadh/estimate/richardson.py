@@ -30,15 +30,15 @@ ENVELOPE_ORDER = 1.5
 #: the true error), so the family's envelope order caps it
 MAX_ORDER = ENVELOPE_ORDER
 #: the fastest a difference of consecutive members may fall before the finest is read as small
-#: by chance: second order, the highest a smooth number of the piecewise-linear surface shows
-#: (the Fig 3 family's local orders 1.2-2.2, above). Without it a monotone triple whose finest
-#: difference happens to fall near a sawtooth's zero is extrapolated from that difference
-#: alone: effectivity 0.31-0.43 on 3 of 49 spacings of the Fig 3 and slider families'
-#: largest adhesion, 0.87 or more with it (validation/results/effectivity_spread.md). The
-#: bound needs a coarsest member inside the asymptotic range: the banded families' are
-#: (trapping-safe by the plan's cap), a uniform grid's N/4 need not be (the bundled mu = 2
-#: sphere's softens at 1.37 of a node's stiffness: its pull-off's estimate would be 97x its
-#: error instead of 31x), so the runner applies it to banded families only
+#: by chance: second order, the highest a number of a sigma-gap contact shows on the
+#: piecewise-linear surface (the Fig 3 family's local orders 1.2-2.2, above), whose contact
+#: nodes join and leave one at a time (a sawtooth in the spacing). Without it a monotone
+#: triple whose finest difference happens to fall near a sawtooth's zero is extrapolated from
+#: that difference alone: effectivity 0.31-0.43 on 3 of 50 spacings of the Fig 3 and slider
+#: families' largest adhesion, 0.87 or more with it (validation/results/
+#: effectivity_spread.md). Opt-in (``decay_order``): smooth numbers may converge faster, and
+#: a member near a node's stiffness is not asymptotic (femadh.runner.estimates.decay_order
+#: decides)
 DECAY_ORDER = 2.0
 
 
@@ -93,7 +93,7 @@ def _finite(x):
 
 
 def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_order=MAX_ORDER,
-                   envelope_order=ENVELOPE_ORDER, ratio2=None, decay_order=DECAY_ORDER):
+                   envelope_order=ENVELOPE_ORDER, ratio2=None, decay_order=None):
     """Signed estimate of each number's discretisation error, Q* - Q(h), from the coarser
     members of its grid family.
 
@@ -115,16 +115,18 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
     max_order, envelope_order : float
         Cap of an observed order; order of the envelope where the members oscillate.
     decay_order : float or None
-        The fastest fall of the differences before the coarser one bounds the finest (None:
-        never - where the coarsest member may be outside the asymptotic range, e.g. a
-        uniform grid's N/4 member that lattice-traps).
+        The fastest fall of the differences before the coarser one bounds the finest
+        (DECAY_ORDER; None, the default: never - where the coarsest member may be outside
+        the asymptotic range, e.g. a member that softens near a node's stiffness:
+        :func:`femadh.runner.estimates.decay_order` decides).
 
     Returns
     -------
     dict
         {name: (Q(h) - Q(rh)) / (r^p - 1)} with p observed over three members (clamped to
         [order, max_order]) or ``order`` without the third, the finest difference no smaller
-        than the coarser one scaled at ``decay_order``, |Q(rh) - Q(r^2h)| / r^2; where the
+        than the coarser one implies at ``decay_order`` (:func:`_implied`: |Q(rh) - Q(r^2h)|
+        / r^2 for even ratios); where the
         members oscillate (or diverge) the envelope
         max(|Q(h) - Q(rh)|, |Q(rh) - Q(r^2h)| / r^p) / (r^p - 1) at p = ``envelope_order``,
         with the sign of the finest difference.
@@ -136,6 +138,13 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
             continue
         p = order
         cc = (coarser or {}).get(k)
+        if decay_order is not None and _finite(cc) and v == c and cc != c:
+            # the finest difference exactly zero (members on one lattice value): the coarser
+            # one bounds it at the capped order
+            p = max_order
+            out[k] = math.copysign(abs(c - cc) * _implied(decay_order, ratio, ratio2),
+                                   c - cc) / (ratio**p - 1)
+            continue
         if _finite(cc) and v != c and cc != c:
             uneven = ratio2 is not None and ratio2 != ratio
             seen = (observed_order_uneven(v, c, cc, ratio, ratio2) if uneven

@@ -316,9 +316,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
                                 f"({_short(g.error)}); the FE mesh part of the error is not "
                                 "estimated: the stated errors lack it")
     ratio, members, ratio2 = coarser_members(scene, problem, green)
-    # the coarser difference bounds the finest on banded families only, whose members the
-    # plan keeps trapping-safe (femadh.estimate.richardson.DECAY_ORDER)
-    decay = DECAY_ORDER if scene.grid is not None else None
+    decay = decay_order(problem, ratio * (ratio2 or ratio))
     # the forces at the deepest separation: members placed by its contact edge (the same
     # fraction of a spacing as the fine grid's), where they can be; the family's reduced
     # members then skip that state (its grid part would be replaced)
@@ -348,7 +346,7 @@ def estimate_errors(scene, res, problem, sink, half=0.0, *, run, defer=None):
             h0 = float(problem.grid.nodes[1])
             for k, v in discretisation({k: fine_hl[k] for k in lv1 if k in fine_hl}, lv1, lv2,
                                        ratio=h1 / h0, ratio2=h2 / h1,
-                                       decay_order=decay).items():
+                                       decay_order=decay_order(problem, h2 / h0)).items():
                 parts.setdefault(k, {})["grid"] = v
             if scene.grid is not None:
                 res.grid["deepest_member_spacings_m"] = [h1, h2]
@@ -737,6 +735,34 @@ def guard_bounds(res, problem):
 #: ratio 4x the run's own) takes members at N/sqrt2 and N/2 instead of N/2 and N/4
 #: (:func:`uniform_member_nodes`). False: N/2 and N/4 always (as before)
 UNIFORM_SQRT2_MEMBERS = True
+
+
+def decay_order(problem, spread):
+    """DECAY_ORDER where the coarser difference may bound the finest
+    (:func:`femadh.estimate.richardson.discretisation`), else None. Two conditions:
+
+    - a sigma-gap contact (``problem.sigma``): its nodes join and leave the contact one at a
+      time, so a number read off a fixed grid carries a sawtooth in the spacing, and a finest
+      difference far below the coarser one is its phase, not a fast order (Fig 3 and the
+      slider, validation/results/effectivity_spread.md). Without it the numbers are smooth
+      and may converge faster than second order: the AFM tip of validation/paper2_afm.py
+      (R = 20 nm, p/psat 0.8, LJ without sigma) falls by 15.6 and 11.9 per halving from
+      N = 120 to 480 (order ~3.7), and the bound made its pull-off's estimate 210x its error
+      instead of 6x;
+    - the coarsest member (spacing ``spread`` x the run's) softens no more than TRAP_SAFE of
+      a node's stiffness (a member's trapping ratio grows like its spacing,
+      :func:`uniform_member_nodes`), i.e. it is inside the asymptotic range: the plan keeps a
+      banded family's coarsest member there; an explicit grid's may not be (the Fig 4
+      scene's N = 200 has its N/2 member at 0.48).
+
+    Measured on uniform grids (validation/results/effectivity_spread_uniform.md): the slider
+    at N = 100 (sigma-gap, N/4 at 0.27) read F_LJ at the deepest state at 0.06x its error
+    without the bound."""
+    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
+
+    if problem.sigma is None:
+        return None
+    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None
 
 
 def uniform_member_nodes(problem, n):
