@@ -2513,6 +2513,10 @@ DEFECTS = [
       "femadh/runner/estimates.py",
       (("                                       decay_order=decay_order(problem, h2 / h0)).items():",
         "                                       ).items():"),)),
+    D("regrid_budget_internal", "tracing: a band regrid past the node budget escapes as an "
+      "internal error (exit 1) instead of a failed trial", "femadh/runner/tracing.py",
+      (("    except NodeBudgetError as exc:\n        # the band grew",
+        "    except ZeroDivisionError as exc:\n        # the band grew"),)),
     D("decay_zero_finest", "Richardson: an exactly zero finest difference left unbounded",
       "femadh/estimate/richardson.py",
       (("        if decay_order is not None and _finite(cc) and v == c and cc != c:",

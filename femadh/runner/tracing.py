@@ -65,8 +65,19 @@ def _regridded(band, sink, problem, state, scene, landed=False):
     and a branch's restart need are carried to it (their displacements interpolated: the
     search solves fresh states from them)."""
     from ..discretisation.moving import carry_state
+    from ..elastic.grid import NodeBudgetError
+    from ..estimate.guards import GuardError
 
-    new = band.regrid(problem, state.w, state.d, landed=landed)
+    try:
+        new = band.regrid(problem, state.w, state.d, landed=landed)
+    except NodeBudgetError as exc:
+        # the band grew over the travelling edge past the node budget: a failed trial of the
+        # discretisation (the adaptive loop ends on its budget, naming what it reached), not
+        # a fault of femadh
+        raise GuardError(f"band following the contact edge at d = {state.d * 1e9:.6g} nm: "
+                         f"{exc}; the laws' cohesive zone needs that spacing across the "
+                         "edge's travel (check their parameters, e.g. the Hamaker "
+                         "constant's unit)") from None
     if new is None:
         return None
     st = carry_state(problem, new, state, tol=scene.tolerance, max_iter=scene.max_iter)
