@@ -2517,6 +2517,9 @@ DEFECTS = [
       "internal error (exit 1) instead of a failed trial", "femadh/runner/tracing.py",
       (("    except NodeBudgetError as exc:\n        # the band grew",
         "    except ZeroDivisionError as exc:\n        # the band grew"),)),
+    D("budget_failure_refined", "adaptive: a band's node-budget failure refines h (futile: "
+      "a finer member needs more)", "femadh/runner/adaptive.py",
+      (('        if res.failure_kind == "budget":\n', '        if False:\n'),)),
     D("decay_zero_finest", "Richardson: an exactly zero finest difference left unbounded",
       "femadh/estimate/richardson.py",
       (("        if decay_order is not None and _finite(cc) and v == c and cc != c:",

@@ -242,21 +242,14 @@ def test_nodes_held_at_sigma_count_in_the_band_not_deep_inside_the_contact():
 
 def test_a_band_regrid_past_the_node_budget_is_a_failed_trial_not_a_fault():
     """A band that would need more than the node budget to follow the edge (a newcomer's
-    Hamaker constant in kJ: spacing 0.4 nm over a 25-um disk) ends the trial with a
-    GuardError naming the separation and the spacing - the adaptive loop's budget decides
-    what follows - instead of an internal NodeBudgetError (exit 1, "a bug in femadh")."""
-    from types import SimpleNamespace
-
-    from femadh.elastic.grid import NodeBudgetError
-    from femadh.estimate.guards import GuardError, failure_kind
-    from femadh.runner.tracing import _regridded
-
-    class Band:
-        def regrid(self, problem, w, d, landed=False):
-            raise NodeBudgetError("banded grid needs more than 4000 nodes (spacing 4.15e-10 m "
-                                  "on a radius of 2.53e-05 m)")
-    state = SimpleNamespace(w=None, d=2e-9)
-    with pytest.raises(GuardError, match=r"at d = 2 nm: banded grid needs more than 4000 "
-                       r"nodes \(spacing 4.15e-10 m") as err:
-        _regridded(Band(), None, None, state, None)
-    assert failure_kind(err.value) == "guard"
+    Hamaker constant in kJ, 1000x the Fig 3 scene's: spacing 0.4 nm over a 25-um disk) ends
+    the trial with a BudgetError naming the separation and the spacing, and the adaptive loop
+    ends on it (a finer member needs more nodes) - instead of an internal NodeBudgetError
+    (exit 1, "a bug in femadh") after halving h for 16 s. One short trial (~0.3 s)."""
+    sc = femadh.load_scene("validation/scenes/paper1_fig3.toml").replace(
+        {"effects.lennard_jones.hamaker": "1e-19 kJ"})
+    res = run(sc, None, figures=False, progress=False)
+    assert res.status == "failed" and res.failure_kind == "budget", (res.status, res.error)
+    assert "band following the contact edge at d = " in res.error
+    assert "banded grid needs more than 4000 nodes" in res.error
+    assert [s.get("refined_for") for s in res.accuracy["steps"]] == ["budget"]

@@ -66,10 +66,17 @@ class BoundError(GuardError):
     kind = "bound"
 
 
+class BudgetError(GuardError):
+    """A grid the run must build (a band following the contact edge) would exceed the node
+    budget: a finer member needs more, so refining cannot help."""
+
+    kind = "budget"
+
+
 #: the kinds of a run's failure (``result.failure_kind``), by the exception that ended it:
 #: the guards' own kinds, a solve that did not converge (a stalled continuation, a landing
 #: Newton could not polish), the run's stops, and any other fault
-FAILURE_KINDS = ("analysis_radius", "trapping", "bound", "guard", "convergence",
+FAILURE_KINDS = ("analysis_radius", "trapping", "bound", "budget", "guard", "convergence",
                  "time_limit", "interrupted", "error")
 
 

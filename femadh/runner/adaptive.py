@@ -638,6 +638,11 @@ def _decide(scene, tr, res, estimate, step, plan, target, ahead, history=()):
     if estimate is not True:
         return "not estimated"
     if res.status != "converged":
+        if res.failure_kind == "budget":
+            # a grid the run had to build exceeded the node budget: a finer member needs
+            # more (the loop ends; the trial's own error says where)
+            step["refined_for"] = res.failure_kind
+            return res.error or res.status
         if res.failure_kind == REFINE_RADIUS:
             # the contact reached the disk's edge: a larger disk, the same band spacing
             ahead["next"] = (GridFamily(2 * family.radius, family.band, family.grading), h)

@@ -66,7 +66,7 @@ def _regridded(band, sink, problem, state, scene, landed=False):
     search solves fresh states from them)."""
     from ..discretisation.moving import carry_state
     from ..elastic.grid import NodeBudgetError
-    from ..estimate.guards import GuardError
+    from ..estimate.guards import BudgetError
 
     try:
         new = band.regrid(problem, state.w, state.d, landed=landed)
@@ -74,7 +74,7 @@ def _regridded(band, sink, problem, state, scene, landed=False):
         # the band grew over the travelling edge past the node budget: a failed trial of the
         # discretisation (the adaptive loop ends on its budget, naming what it reached), not
         # a fault of femadh
-        raise GuardError(f"band following the contact edge at d = {state.d * 1e9:.6g} nm: "
+        raise BudgetError(f"band following the contact edge at d = {state.d * 1e9:.6g} nm: "
                          f"{exc}; the laws' cohesive zone needs that spacing across the "
                          "edge's travel (check their parameters, e.g. the Hamaker "
                          "constant's unit)") from None
