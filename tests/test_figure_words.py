@@ -1,6 +1,8 @@
 """The figures say what the terminal says: the force curve's inset states the max adhesion
 with the very digits, unit and error of the terminal's line, and every figure calls the force
 it shows the force on the sphere (no "slider" in one figure and "sphere" in another)."""
+import math
+
 import matplotlib
 import numpy as np
 import pytest
@@ -8,16 +10,36 @@ import pytest
 import femadh
 from conftest import fig3_uniform_text
 from femadh.io import plots
-from femadh.io.plots import force_text
+from femadh.io.plots import force_text, value_error_text
 from femadh.runner.report import headline_lines
 
 
 def test_force_text_picks_the_unit_of_the_force_and_one_digit_of_its_error():
-    assert force_text(3.1152e-5, 2.56e-8) == "31.152 ± 0.03 µN"
+    assert force_text(3.1152e-5, 2.56e-8) == "31.15 ± 0.03 µN"
     # (the unit is the force's own, not the error's: 2.6e-8 N would be nN alone)
     assert force_text(1.6029e-3, 4.4e-7) == "1.6029 ± 0.0004 mN"
     assert force_text(1.5e-3) == "1.5 mN" == force_text(1.5e-3, float("nan"))
     assert force_text(-2.5e-10, 1e-12) == "-250 ± 1 pN"
+
+
+def test_value_printed_to_the_decimal_place_of_its_error():
+    """Each value to the decimal place of its error's one digit (metrology's convention).
+    The newcomer's three lines, with the values and errors of their summary.json: Fig 3 at
+    accuracy 1e-4 printed F_ex -1.602 ± 5e-07 mN (0.0000443 mN off: 89 of its errors),
+    Fig 4 at 1e-4 its max adhesion 109.5 ± 0.008 µN (0.0035 µN off), paper 2 (ethanol,
+    100 nm) F = 60.227 ± 6e-07 nN (0.0002 nN off)."""
+    assert force_text(-1.6020443099635687e-3, 4.64986340651508e-10) == "-1.6020443 ± 5e-07 mN"
+    assert force_text(1.0949652642307841e-4, 8.173821861318682e-09) == "109.497 ± 0.008 µN"
+    assert force_text(6.022721468895611e-08, 6.425871970492789e-16) == "60.2272147 ± 6e-07 nN"
+    # the error rounded first sets the place (0.0096 -> 0.01); above 1 it is an integer;
+    # a value smaller than half the error's digit is 0 (no "-0.0"); tiny numbers in e-form
+    assert value_error_text(0.98765, 0.0096) == "0.99 ± 0.01"
+    assert value_error_text(272.35, 46) == "270 ± 50"
+    assert value_error_text(-0.01, 0.3) == "0 ± 0.3"
+    assert value_error_text(1.2345e-15, 3e-18, 4) == "1.235e-15 ± 3e-18"
+    # no error: the value to its digits, readable; an error of 0 says so
+    assert value_error_text(1.23456789) == "1.2346" == value_error_text(1.23456789, math.nan)
+    assert value_error_text(5.0, 0.0) == "5 ± 0"
 
 
 @pytest.fixture(scope="module")
