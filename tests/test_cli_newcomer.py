@@ -205,9 +205,11 @@ def test_an_abbreviated_flag_is_refused_and_nothing_is_written(tmp_path, capsys)
     assert [p.name for p in old.iterdir()] == ["summary.json"]
     assert (old / "summary.json").read_text() == '{"status": "converged"}\n'
     assert not (tmp_path / "new").exists()
-    # (the other commands' parsers too: a subcommand's option, the program's own)
-    for argv in (["study", "sweep", scene, "--vary", "scene.name=a", "--work", "1"],
-                 ["topography", "f.txt", "--cut", "1 um"], ["--vers"]):
+    # (the other commands' parsers too: a subcommand's option, the program's own; files
+    # that do not exist, so that an abbreviation taken would end in an error, not a study)
+    none = str(tmp_path / "none.toml")
+    for argv in (["study", "sweep", none, "--vary", "scene.name=a", "--work", "1"],
+                 ["topography", none, "--cut", "1 um"], ["--vers"]):
         with pytest.raises(SystemExit) as e:
             main(argv)
         assert e.value.code == 2, argv

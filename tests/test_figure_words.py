@@ -42,6 +42,41 @@ def test_value_printed_to_the_decimal_place_of_its_error():
     assert value_error_text(5.0, 0.0) == "5 ± 0"
 
 
+def test_the_instrument_lines_print_each_value_to_its_errors_place():
+    """The AFM scene's instrument lines (its summary.json values and errors, the run of the
+    README's block): z, d and the hysteresis each to the decimal place of their error."""
+    from types import SimpleNamespace
+
+    from femadh.runner.report import _instrument_lines
+
+    hl = {"instrument_jump_in_z_m": 1.8385732680741112e-09,
+          "instrument_jump_in_z_m_error": 3.232619966080636e-14,
+          "instrument_jump_in_d_m": 1.226096964935722e-09,
+          "instrument_jump_in_d_m_error": 7.244484546993736e-13,
+          "instrument_hysteresis_J": 1.0699531673243805e-16,
+          "instrument_hysteresis_J_error": 1.584026271128711e-20}
+    lines = _instrument_lines(SimpleNamespace(
+        headline=hl, instrument={"spring": {"stiffness_N_per_m": 0.3622}}))
+    assert lines[1:] == ["instrument jumps in at z = 1.83857 ± 3e-05 nm (d = 1.2261 ± 0.0007 "
+                         "nm)", "instrument hysteresis 1.0700e-16 ± 2e-20 J"]
+
+
+def test_the_regime_table_prints_the_pull_off_to_its_errors_place():
+    """`femadh regime`'s table: the pull-off / πRΔγ to the decimal place of its error (was
+    four decimals whatever the error: 1.2346 ± 2e-06, 1.2346 ± 0.003)."""
+    from types import SimpleNamespace
+
+    from femadh.studies.regime import regime_table
+
+    def point(e):
+        return SimpleNamespace(failed=None, mu=1.0, pull_off=1.23456789, error=lambda k: e,
+                               maugis=1.2, jump_in=1.0, jump_out=0.5, hysteresis=0.0,
+                               nodes=100)
+    cells = [regime_table([point(e)]).splitlines()[1].split("  ") for e in (2e-6, 3e-3, None)]
+    assert [next(c.strip() for c in r if "." in c and "1.23" in c) for r in cells] == [
+        "1.234568 ± 2e-06", "1.235 ± 0.003", "1.2346"]
+
+
 @pytest.fixture(scope="module")
 def fig3_small(tmp_path_factory):
     """The Fig 3 scene on 60 uniform nodes in 0.5-nm steps, with its error estimates (the
