@@ -47,16 +47,15 @@ def test_the_instrument_lines_print_each_value_to_its_errors_place():
     README's block): z, d and the hysteresis each to the decimal place of their error."""
     from types import SimpleNamespace
 
-    from femadh.runner.report import _instrument_lines
-
     hl = {"instrument_jump_in_z_m": 1.8385732680741112e-09,
           "instrument_jump_in_z_m_error": 3.232619966080636e-14,
           "instrument_jump_in_d_m": 1.226096964935722e-09,
           "instrument_jump_in_d_m_error": 7.244484546993736e-13,
           "instrument_hysteresis_J": 1.0699531673243805e-16,
           "instrument_hysteresis_J_error": 1.584026271128711e-20}
-    lines = _instrument_lines(SimpleNamespace(
-        headline=hl, instrument={"spring": {"stiffness_N_per_m": 0.3622}}))
+    lines = headline_lines(SimpleNamespace(
+        headline=hl, instrument={"spring": {"stiffness_N_per_m": 0.3622}}, branches={},
+        jumps=[], accuracy=None, status="converged", warnings=[]))
     assert lines[1:] == ["instrument jumps in at z = 1.83857 ± 3e-05 nm (d = 1.2261 ± 0.0007 "
                          "nm)", "instrument hysteresis 1.0700e-16 ± 2e-20 J"]
 
