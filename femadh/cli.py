@@ -78,8 +78,10 @@ EXIT_PIPE = 141
 
 
 def _parser():
+    # allow_abbrev=False on every parser (subparsers do not inherit it): an abbreviation
+    # such as --overwrit is refused, never taken for the destructive --overwrite
     p = argparse.ArgumentParser(
-        prog="femadh",
+        prog="femadh", allow_abbrev=False,
         description="Adhesion of a sphere on an elastic flat (MEMS/NEMS stiction): "
                     "Lennard-Jones surface forces, the asperity sigma-gap, capillary menisci "
                     "and the elastic half-space (Green function or finite elements), swept in "
@@ -91,7 +93,8 @@ def _parser():
                "error (a bug in femadh: please report it).")
     p.add_argument("--version", action="version", version=f"femadh {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    r = sub.add_parser("run", help="solve a scene and write its results and figures",
+    r = sub.add_parser("run", allow_abbrev=False,
+                       help="solve a scene and write its results and figures",
                        description="Solve a scene; write curve.csv, diagnostics.csv, "
                                    "fields.csv, jumps.csv, summary.json and its figures "
                                    "(meniscus scenes: meniscus.csv, profiles.csv).")
@@ -116,23 +119,26 @@ def _parser():
                    help="skip the error estimates of the headline numbers (they solve the "
                         "scene again on two coarser grids)")
     r.add_argument("--quiet", action="store_true", help="no progress bar or summary lines")
-    c = sub.add_parser("check", help="validate a scene without solving it",
+    c = sub.add_parser("check", allow_abbrev=False, help="validate a scene without solving it",
                        description="Validate every key, the optional dependencies the scene "
                                    "needs, and estimate its memory and run time (rates "
                                    "measured on a 2-core CI machine).")
     c.add_argument("scene", help="scene file (TOML)")
     c.add_argument("--force", action="store_true",
                    help="pass a scene whose estimated time is beyond reason")
-    sub.add_parser("keys", help="print every scene key (markdown reference page)",
+    sub.add_parser("keys", allow_abbrev=False,
+                   help="print every scene key (markdown reference page)",
                    description="Print every scene key - its unit, range, default and "
                                "meaning - as a markdown page (the scene file's reference; "
                                "`femadh keys > keys.md`).")
-    m = sub.add_parser("mesh", help="build (or fetch from cache) the FE mesh of a scene",
+    m = sub.add_parser("mesh", allow_abbrev=False,
+                       help="build (or fetch from cache) the FE mesh of a scene",
                        description="Mesh the half-space of a scene with gmsh (cached by a hash "
                                    "of its parameters) and write it as .msh and .vtu.")
     m.add_argument("scene", help="scene file (TOML)")
     m.add_argument("--out", help="output folder (default: the scene's [output] dir)")
-    rd = sub.add_parser("render", help="PNG of an FE run's deformed zone (PyVista)",
+    rd = sub.add_parser("render", allow_abbrev=False,
+                        help="PNG of an FE run's deformed zone (PyVista)",
                         description="Render a state of an FE run off-screen: the deformed "
                                     "near-contact zone coloured by a stress or displacement "
                                     "field, and the surface pressure.")
@@ -142,13 +148,15 @@ def _parser():
     rd.add_argument("--field", default="von_mises", help="field to colour by "
                     "(default von_mises; e.g. sigma_zz, displacement)")
     rd.add_argument("--png", help="output PNG (default RUN_DIR/render.png)")
-    s = sub.add_parser("study", help="parameter studies (sweep) and convergence studies",
+    s = sub.add_parser("study", allow_abbrev=False,
+                       help="parameter studies (sweep) and convergence studies",
                        description="sweep: many variants of a scene in parallel (local "
                                    "processes or a Dask cluster), resumable; convergence: the "
                                    "FE mesh ladder against the Green function and the Green "
                                    "function in N.")
     ss = s.add_subparsers(dest="kind", required=True, metavar="KIND")
-    sw = ss.add_parser("sweep", help="vary scene keys over values, one run per point",
+    sw = ss.add_parser("sweep", allow_abbrev=False,
+                       help="vary scene keys over values, one run per point",
                        description="Run every combination of the --vary values (or the "
                                    "scene's [study] table) and write study.csv, study.png and "
                                    "points/<id>/ (one run folder and record per point). "
@@ -177,7 +185,8 @@ def _parser():
                     help="the number the figure shows (default max_adhesion_N)")
     sw.add_argument("--no-figures", action="store_true", help="skip study.png")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
-    cv = ss.add_parser("convergence", help="FE mesh ladder vs Green, Green in N",
+    cv = ss.add_parser("convergence", allow_abbrev=False,
+                       help="FE mesh ladder vs Green, Green in N",
                        description="The FE mesh ladder against the Green function on the "
                                    "scene's nodes, and the Green function in N; writes "
                                    "convergence.csv/.md/.png.")
@@ -185,7 +194,7 @@ def _parser():
     cv.add_argument("--levels", type=int, default=3, help="FE mesh levels (1-4, default 3)")
     cv.add_argument("--out", help="output folder (default: <scene output dir>/study)")
     rg = sub.add_parser(
-        "regime", help="smooth-sphere LJ adhesion map vs the Tabor parameter",
+        "regime", allow_abbrev=False, help="smooth-sphere LJ adhesion map vs the Tabor parameter",
         description="Trace the force-separation curve of a smooth elastic sphere with LJ "
                     "surface forces (no sigma-gap) through its folds for a range of Tabor "
                     "parameters mu = (R dg^2/(E*^2 z0^3))^(1/3); writes regime.csv (pull-off / "

@@ -15,7 +15,7 @@ COMMANDS = ("compare", "fit")
 def add_parsers(sub):
     """Add the ``compare`` and ``fit`` subcommands to the CLI's subparsers."""
     cp = sub.add_parser(
-        "compare", help="a measured force curve against a run of a scene",
+        "compare", allow_abbrev=False, help="a measured force curve against a run of a scene",
         description="Run the scene (no error estimate) and compare its force curve with a "
                     "measured one (csv: z_m, force_N, branch, or columns with units; JPK, "
                     "Igor, HDF5, tab via afmformats). The force is taken in the AFM sign "
@@ -32,7 +32,8 @@ def add_parsers(sub):
                                                          "(default 0)")
     cp.add_argument("--json", action="store_true", help="print the result as JSON (SI)")
     ft = sub.add_parser(
-        "fit", help="least-squares fit of scene keys and the contact point to a curve",
+        "fit", allow_abbrev=False,
+        help="least-squares fit of scene keys and the contact point to a curve",
         description="Fit 1-3 scene keys (their scene values are the start) and the "
                     "contact-point offset z_offset_m (d = z - z_offset) to a measured force "
                     "curve; every evaluation is a femadh run. Reports values, standard "

@@ -15,7 +15,8 @@ from .errors import SceneError
 def add_parser(sub):
     """Register the subcommand on the ``sub`` subparsers of femadh's parser."""
     t = sub.add_parser(
-        "topography", help="GW asperity statistics (rho, R_a, sigma_a, z_m) of measured "
+        "topography", allow_abbrev=False,
+        help="GW asperity statistics (rho, R_a, sigma_a, z_m) of measured "
                            "surfaces",
         description="Read one topography (or a slider and a disk) with SurfaceTopography, "
                     "compute the profile spectral moments m0, m2, m4 at the pixel scale and "

@@ -126,13 +126,16 @@ def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     if fast is not None:
         return fast
     ureg = _registry()
+    mag, unit = _split(value)
     try:
-        mag, unit = _split(value)
         if mag is not None and unit:
             q = ureg.Quantity(float(mag), unit.replace("^", "**"))
         else:
             q = ureg.Quantity(value.replace("^", "**"))
     except Exception as exc:  # pint raises many types for unparsable input
+        if mag is not None and unit and type(exc).__name__ == "UndefinedUnitError":
+            raise SceneError(file, key, value, f"{words}; '{unit}' is not a recognised unit"
+                             f"{_case_twin(unit, dimension)}") from None
         raise SceneError(file, key, value, f"{words} (could not parse: {exc})") from None
     if not isinstance(q, ureg.Quantity):
         return float(q)
@@ -145,5 +148,37 @@ def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     if not q.check(dim):
         unit = f"{q.units:~}"
         hint = _TEMPERATURE_HINTS.get(unit, "") if dimension == "temperature" else ""
-        raise SceneError(file, key, value, f"{words}, but it has units of {unit}{hint}")
+        if hint or not (mag is not None and unit):
+            raise SceneError(file, key, value, f"{words}, but it has units of {unit}{hint}")
+        # a unit pint knows as another kind ('2 MM' is 2 megamolar): "has units of MM" read
+        # as if MM were a length unit; say it is not one, what pint took it for, the fix
+        kind = words.split(" such as")[0].split(" ", 1)[-1]
+        raise SceneError(file, key, value, f"{words}; '{unit}' is not a recognised {kind} "
+                         f"unit (pint reads it as {q.units}){_case_twin(unit, dimension)}")
     return float(q.to(si.replace("^", "**")).magnitude)
+
+
+def _case_twin(unit, dimension):
+    """``"; did you mean 'mm'?"`` when ``unit`` written in another case is a unit of
+    ``dimension`` ('MM' -> 'mm', 'NM' -> 'nm'; pint's units are case-sensitive), else ""."""
+    global _FAST
+    if _FAST is None:
+        _FAST = _table()
+    dim = DIMENSIONS[dimension][0]
+    low = unit.lower()
+    # the all-lower spelling first ('mm', not the megametre 'Mm')
+    twins = [low] + [u for u in _FAST if u.lower() == low and u != low]
+    for u in twins:
+        if u == unit:
+            continue
+        hit = _FAST.get(u)
+        if hit is not None:
+            ok = DIMENSIONS[hit[0]][0] == dim
+        else:
+            try:
+                ok = _registry().Quantity(1.0, u.replace("^", "**")).check(dim)
+            except Exception:  # (not a unit either)
+                ok = False
+        if ok:
+            return f"; did you mean '{u}'?"
+    return ""

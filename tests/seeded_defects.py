@@ -1136,7 +1136,8 @@ DEFECTS = [
         "    if scene.elements < 4:\n        return 0.0\n"),)),
     D("newcomer_meniscus_error_scale", "meniscus report: the F/4πRγ error not divided by "
       "4πRγ (by 4πR)", "femadh/runner/meniscus.py",
-      (('f" ± {err / unit4:.1g}"', 'f" ± {err / (4 * math.pi * R):.1g}"'),)),
+      (("err / unit4 if estimated else None", "err / (4 * math.pi * R) if estimated else "
+        "None"),)),
     # -- one home for the error machinery: the adaptive run on the refine loop, typed
     #    failure kinds, a study point's time limit (issue 21)
     D("adaptive_kind_by_words", "adaptive grid: the remedy picked by the words 'analysis "
@@ -1272,8 +1273,10 @@ DEFECTS = [
         '"retract.pvd",'),)),
     D("resume_of_a_finished_run", "--resume of a converged run runs it again instead of saying "
       "there is nothing to resume", "femadh/io/run_folder.py",
-      (('            if prev.get("status") == "converged" and not prev.get("trial"):',
-        "            if False:"),)),
+      (('            if _finished(prev):\n                raise OutputError(f"{what}: it has '
+        'finished, there is nothing to resume")',
+        '            if False:\n                raise OutputError(f"{what}: it has '
+        'finished, there is nothing to resume")'),)),
     D("study_time_limit_unrun", "study: a point stopped by its time limit recorded as never "
       "run", "femadh/studies/sweep.py",
       (('return rec.get("status") in ("converged", "failed", "time limit")',
@@ -1981,10 +1984,10 @@ DEFECTS = [
     D("ui_main_import_unguarded", "python -m femadh: a Ctrl-C while femadh.cli is imported "
       "is a traceback", "femadh/__main__.py",
       (("except KeyboardInterrupt:\n", "except ImportError:\n"),)),
-    D("ui_error_two_digits", "the stated force's error to two digits (the figure's old rule)",
+    D("ui_error_two_digits", "the stated force's error to two digits (the figure's old rule; "
+      "re-pointed: the value then to the place of its error's second digit)",
       "femadh/io/plots.py",
-      (('        return f"{x * s:.5g} ± {err * s:.1g} {unit}"',
-        '        return f"{x * s:.5g} ± {err * s:.2g} {unit}"'),)),
+      (('    e = float(f"{abs(err):.1g}")', '    e = float(f"{abs(err):.2g}")'),)),
     D("ui_inset_no_error", "the inset states the max adhesion without its error",
       "femadh/io/plots.py",
       (("        ins.set_title(f\"max adhesion {force_text(F, hl.get('max_adhesion_N_error'))} at \"",
@@ -2550,6 +2553,65 @@ DEFECTS = [
       "as a pass through the members again", "femadh/runner/estimates.py",
       (("                if not judged_only:\n                    # (the judged numbers alone",
         "                if True:\n                    # (the judged numbers alone"),)),
+    # -- newcomer trial, session 14 (ux14b): a value to its error's place, abbreviations
+    #    refused, a refused resume leaves no folder, a finished folder not advised --resume,
+    #    a unit in the wrong case named
+    D("ux14b_value_five_digits", "a value printed to five digits whatever its error (-1.602 "
+      "± 5e-07 mN)", "femadh/io/plots.py",
+      (('        txt = f"{round(v, -place):.{max(-place, 0)}f}"', '        txt = f"{v:.5g}"'),)),
+    D("ux14b_place_of_unrounded_error", "the value's place taken from the unrounded error "
+      "(0.0096: 0.988 ± 0.01)", "femadh/io/plots.py",
+      (('    e = float(f"{abs(err):.1g}")', '    e = abs(err)'),)),
+    D("ux14b_negative_zero", "a value below half the error's digit printed as -0.0 or its "
+      "own digits", "femadh/io/plots.py",
+      (("    if abs(v) < 0.5 * 10.0 ** place:\n", "    if False:\n"),)),
+    D("ux14b_instrument_four_decimals", "the instrument's z and d to four decimals whatever "
+      "their error", "femadh/runner/report.py",
+      (('        return f"{_pm(v, e * 1e9, 8)} nm" if e is not None else f"{v:.4f} nm"',
+        '        return f"{v:.4f} ± {e * 1e9:.1g} nm" if e is not None else f"{v:.4f} nm"'),)),
+    D("ux14b_meniscus_five_digits", "paper 2's F printed to five digits (60.227 ± 6e-07 nN)",
+      "femadh/runner/meniscus.py",
+      (('        F = f"F = {value_error_text(f[k] * s, err * s if estimated else None)} {unit}"',
+        '        F = f"F = {f[k] * s:.5g}" + (f" ± {err * s:.1g}" if estimated else "") + '
+        'f" {unit}"'),)),
+    D("ux14b_regime_four_decimals", "the regime table's pull-off to four decimals whatever "
+      "its error", "femadh/studies/regime.py",
+      (("        return value_error_text(v, e)", '        return f"{v:.4f} ± {e:.1g}"'),)),
+    D("ux14b_run_abbreviations", "femadh run takes --overwrit for --overwrite",
+      "femadh/cli.py",
+      (('    r = sub.add_parser("run", allow_abbrev=False,',
+        '    r = sub.add_parser("run", allow_abbrev=True,'),)),
+    D("ux14b_program_abbreviations", "femadh takes --vers for --version", "femadh/cli.py",
+      (('        prog="femadh", allow_abbrev=False,', '        prog="femadh",'),)),
+    D("ux14b_sweep_abbreviations", "femadh study sweep takes --work for --workers",
+      "femadh/cli.py",
+      (('    sw = ss.add_parser("sweep", allow_abbrev=False,',
+        '    sw = ss.add_parser("sweep", allow_abbrev=True,'),)),
+    D("ux14b_topography_abbreviations", "femadh topography takes --cut for --cutoff",
+      "femadh/cli_topography.py",
+      (('        "topography", allow_abbrev=False,', '        "topography",'),)),
+    D("ux14b_refused_claim_keeps_folder", "a refused --resume leaves the folder it created",
+      "femadh/io/run_folder.py",
+      (("                    q.rmdir()               # (an empty folder only)",
+        "                    break"),)),
+    D("ux14b_refused_claim_removes_existing", "a refused --resume removes an empty folder it "
+      "did not create", "femadh/io/run_folder.py",
+      (("        created = [q for q in (self.path, *self.path.parents) if not q.exists()]",
+        "        created = [self.path]"),)),
+    D("ux14b_finished_advised_resume", "a finished run's folder refused with 'use --resume'",
+      "femadh/io/run_folder.py",
+      (("        if _finished(prev):\n            # (--resume would only be refused",
+        "        if False:\n            # (--resume would only be refused"),)),
+    D("ux14b_unit_has_units_of", "'2 MM' for a length: 'but it has units of MM'",
+      "femadh/units.py",
+      (("        if hint or not (mag is not None and unit):", "        if True:"),)),
+    D("ux14b_unit_case_twin_megametre", "'2 MM' suggests the megametre 'Mm' (the table's "
+      "order) before 'mm'", "femadh/units.py",
+      (("    twins = [low] + [u for u in _FAST if u.lower() == low and u != low]",
+        "    twins = [u for u in _FAST if u.lower() == low and u != low] + [low]"),)),
+    D("ux14b_unknown_unit_pint_words", "'2 NM': pint's 'could not parse' instead of 'not a "
+      "recognised unit'", "femadh/units.py",
+      (('type(exc).__name__ == "UndefinedUnitError":', 'type(exc).__name__ == "Undefined":'),)),
 ]
 
 

@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from femadh.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -185,3 +187,87 @@ def test_a_resume_of_a_changed_scene_names_the_keys_that_changed(tmp_path, capsy
     path.write_text(text)
     assert main(["run", str(path), *quick, "--resume"]) == 4
     assert "it has finished, there is nothing to resume" in capsys.readouterr().err
+
+
+def test_an_abbreviated_flag_is_refused_and_nothing_is_written(tmp_path, capsys):
+    """`femadh run S --overwrit` (a newcomer trial): argparse took the abbreviation for
+    --overwrite and replaced the previous run. Every parser refuses abbreviations: exit 2 with
+    argparse's usage line; the folder's previous run untouched, a new --out not created."""
+    scene = str(ROOT / "validation/scenes/paper1_fig3.toml")
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "summary.json").write_text('{"status": "converged"}\n')
+    for out, flag in ((old, "--overwrit"), (tmp_path / "new", "--resum")):
+        with pytest.raises(SystemExit) as e:
+            main(["run", scene, "--out", str(out), flag])
+        assert e.value.code == 2
+        assert f"unrecognized arguments: {flag}" in capsys.readouterr().err
+    assert [p.name for p in old.iterdir()] == ["summary.json"]
+    assert (old / "summary.json").read_text() == '{"status": "converged"}\n'
+    assert not (tmp_path / "new").exists()
+    # (the other commands' parsers too: a subcommand's option, the program's own; files
+    # that do not exist, so that an abbreviation taken would end in an error, not a study)
+    none = str(tmp_path / "none.toml")
+    for argv in (["study", "sweep", none, "--vary", "scene.name=a", "--work", "1"],
+                 ["topography", none, "--cut", "1 um"], ["--vers"]):
+        with pytest.raises(SystemExit) as e:
+            main(argv)
+        assert e.value.code == 2, argv
+    capsys.readouterr()
+
+
+def test_a_refused_resume_leaves_no_folder_behind(tmp_path, capsys):
+    """`--resume` into a folder that holds no run is refused (exit 4) and leaves the file
+    system as it was: the folders the call would have created are gone again; a folder
+    that was there (empty) stays, without femadh's lock file."""
+    scene = str(ROOT / "validation/scenes/paper1_fig3.toml")
+    out = tmp_path / "out" / "empty"
+    assert main(["run", scene, "--out", str(out), "--resume"]) == 4
+    assert capsys.readouterr().err == (f"femadh: error: nothing to resume in {out}: it holds "
+                                       "no femadh run\n")
+    assert list(tmp_path.iterdir()) == []
+    out.mkdir(parents=True)
+    assert main(["run", scene, "--out", str(out), "--resume"]) == 4
+    assert out.is_dir() and list(out.iterdir()) == []
+    capsys.readouterr()
+
+
+def test_a_finished_folder_is_not_advised_resume(tmp_path):
+    """A folder whose run has finished (converged) is refused with --overwrite or another
+    --out as the way forward - --resume would only be refused in turn ("it has finished,
+    there is nothing to resume"); an unfinished one still advises --resume."""
+    from femadh.errors import OutputError
+    from femadh.io.run_folder import RunFolder
+
+    for status, resume in (("converged", False), ("interrupted", True), ("failed", True)):
+        (tmp_path / "summary.json").write_text(
+            f'{{"scene_id": "x", "status": "{status}", "scene": {{"name": "s"}}}}')
+        with pytest.raises(OutputError) as e:
+            RunFolder(tmp_path, "x", "s")
+        msg = str(e.value)
+        assert ("use --resume to continue it" in msg) == resume, msg
+        assert "--overwrite" in msg and ("--resume" in msg) == resume, msg
+    assert msg.endswith("status failed); use --resume to continue it or --overwrite to "
+                        "replace it (or give another --out)")
+    (tmp_path / "summary.json").write_text(
+        '{"scene_id": "x", "status": "converged", "scene": {"name": "s"}}')
+    with pytest.raises(OutputError) as e:
+        RunFolder(tmp_path, "x", "s")
+    assert str(e.value) == (f"{tmp_path} holds the results of a previous run (scene 's', "
+                            "status converged); it has finished: use --overwrite to replace "
+                            "it or give another --out")
+
+
+def test_a_unit_in_the_wrong_case_is_not_recognised_and_named(tmp_path, capsys):
+    """'2 MM' (pint: 2 megamolar) was "but it has units of MM", as if MM were a length unit.
+    The line says the unit is not a recognised length unit, what pint took it for, and the
+    unit meant; a unit pint does not know at all ('NM') likewise, one line each."""
+    for unit, why in (("MM", "'MM' is not a recognised length unit (pint reads it as "
+                               "megamolar); did you mean 'mm'?"),
+                      ("NM", "'NM' is not a recognised unit; did you mean 'nm'?"),
+                      ("mmm", "'mmm' is not a recognised unit")):
+        code, err, path = _check(tmp_path, capsys, _edit('radius = "2 mm"',
+                                                         f'radius = "2 {unit}"'))
+        assert code == 2
+        assert err == [f"femadh: error: {path}: [sphere.radius] = '2 {unit}': expected a "
+                       f"length such as '2 mm' or '0.165 nm'; {why}"]

@@ -289,7 +289,9 @@ def test_previous_run_refused_overwrite_cleans_it(tmp_path, capsys):
     other = long_scene(tmp_path, step="0.5 nm")
     assert main(["run", str(other), "--out", str(out), "--quiet"]) == 4
     err = capsys.readouterr().err
-    assert err.count("femadh: error:") == 1 and "--overwrite" in err and "--resume" in err
+    # (its run has finished: --resume would only be refused, so it is not advised)
+    assert err.count("femadh: error:") == 1 and "--overwrite" in err and "--resume" not in err
+    assert "it has finished" in err
     assert main(["run", str(other), "--out", str(out), *quick, "--overwrite"]) == 0
     assert not (out / "vtk").exists() and not (out / "approach.pvd").exists()
     assert main(["run", str(other), "--out", str(out), "--quiet", "--resume"]) == 4

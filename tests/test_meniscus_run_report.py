@@ -55,6 +55,12 @@ def test_the_fe_error_printed_is_the_distance_to_the_exact_meniscus(run2):
     for printed, scale in ((float(m.group(4)) * 1e-9, 1.0),
                            (float(m.group(2)), 1 / (4 * math.pi * 1e-7 * 0.02197))):
         assert true * scale / 1.5 <= printed <= 1.5 * true * scale, (printed, true * scale)
+    # each value to the decimal place of its error's digit: within half that digit of the
+    # computed one (60.227 ± 6e-07 nN was 2e-4 nN off, 350 of its errors)
+    for v, e, exact in ((m.group(3), m.group(4), fe["force_N"][0] * 1e9),
+                        (m.group(1), m.group(2), fe["force_over_4piRgamma"][0])):
+        digit = 10.0 ** math.floor(math.log10(float(e)))
+        assert abs(float(v) - exact) <= 0.5 * digit * (1 + 1e-9), (v, e, exact)
     # the two printed numbers agree with each other: F = F/4πRγ x 4πRγ
     assert float(m.group(1)) * float(m.group(5)) == pytest.approx(float(m.group(3)), rel=2e-4,
                                                                   abs=0)

@@ -12,6 +12,8 @@
 - meniscus scenes: ``meniscus_force.png`` (paper 2 Fig 1 style); regime maps: their figures.
 Units are chosen from the magnitudes (nm or um, pN ... mN).
 """
+import math
+
 import numpy as np
 
 from .atomic import save_atomic
@@ -41,15 +43,43 @@ def force_unit(values):
     return 1.0, "N"
 
 
+def value_error_text(v, err=None, digits=5):
+    """``"v ± err"`` as metrology writes it: the error to one significant digit, the value
+    rounded to the decimal place of that digit (``-1.6020443 ± 5e-07``, ``109.497 ± 0.008``,
+    ``31.15 ± 0.03``): a value printed to fewer places hides digits its estimate supports (a
+    newcomer read -1.602 ± 5e-07 mN, 95 errors from the true -1.6020443), to more it claims
+    digits the estimate does not. The value keeps at most 15 significant digits (a double's);
+    below 1e-3 or from 1e6 on it is written with an exponent (``1.234e-15 ± 3e-18``).
+    Without an error (None or not finite) the value to ``digits`` significant digits alone;
+    an error of exactly 0 is printed as ``± 0`` beside those digits. Dimensionless: the
+    caller scales both numbers to one unit."""
+    if err is None or not np.isfinite(err) or not np.isfinite(v):
+        return f"{v:.{digits}g}"
+    if err == 0:
+        return f"{v:.{digits}g} ± 0"
+    e = float(f"{abs(err):.1g}")          # rounded first: 0.0096 -> 0.01 sets the place
+    place = math.floor(math.log10(e))     # the decimal exponent of the error's one digit
+    mag = math.floor(math.log10(abs(v))) if v else place
+    place = max(place, mag - 14)
+    if abs(v) < 0.5 * 10.0 ** place:
+        txt = "0"
+    elif 1e-3 <= abs(v) < 1e6:
+        txt = f"{round(v, -place):.{max(-place, 0)}f}"
+    else:
+        txt = f"{v:.{max(mag - place, 0)}e}"
+    if float(txt) == 0:
+        txt = txt.lstrip("-")             # (no "-0.00")
+    return f"{txt} ± " + (f"{e:.0f}" if e >= 1 else f"{e:.1g}")
+
+
 def force_text(x, err=None):
-    """A force as femadh states it, in the terminal and in a figure alike: five significant
-    digits in the unit that fits the force itself (:func:`force_unit` of ``x`` alone), its
-    estimated error to one significant digit in the same unit (``"31.152 ± 0.03 µN"``);
-    without an error (None or not finite) the number alone. ``x``, ``err`` in N."""
+    """A force as femadh states it, in the terminal and in a figure alike: in the unit that
+    fits the force itself (:func:`force_unit` of ``x`` alone), its estimated error to one
+    significant digit in the same unit and the force to that digit's decimal place
+    (:func:`value_error_text`: ``"31.15 ± 0.03 µN"``); without an error (None or not
+    finite) the force to five significant digits alone. ``x``, ``err`` in N."""
     s, unit = force_unit([x])
-    if err is not None and np.isfinite(err):
-        return f"{x * s:.5g} ± {err * s:.1g} {unit}"
-    return f"{x * s:.5g} {unit}"
+    return f"{value_error_text(x * s, None if err is None else err * s)} {unit}"
 
 
 def length_unit(values):

@@ -40,6 +40,12 @@ def previous_run(path):
     return None
 
 
+def _finished(prev):
+    """Whether the run a folder holds has finished (converged, not a trial): there is
+    nothing in it to resume."""
+    return prev.get("status") == "converged" and not prev.get("trial")
+
+
 def _drop_unheld(fd, lock):
     """Close ``fd`` (open on the lock file ``lock``), removing the file first if this process
     holds (or can now take) its lock and it is still the folder's."""
@@ -86,6 +92,9 @@ class RunFolder:
         if self.path.exists() and not self.path.is_dir():
             raise OutputError(f"output folder {self.path} is an existing file; give a folder "
                               "(--out DIR)")
+        # the folders this call creates (deepest first): a refused claim removes them again
+        # when empty, so that a refusal leaves the file system as it found it
+        created = [q for q in (self.path, *self.path.parents) if not q.exists()]
         try:
             self.path.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -98,8 +107,13 @@ class RunFolder:
         except BaseException:
             # a refusal, or a signal while the folder was being claimed (SIGINT or SIGTERM
             # raised as KeyboardInterrupt: no ``with`` was entered to release it): the lock
-            # file is not left behind
+            # file is not left behind, nor a folder this call created
             self.release()
+            for q in created:
+                try:
+                    q.rmdir()               # (an empty folder only)
+                except OSError:
+                    break
             raise
 
     def _lock(self):
@@ -164,9 +178,13 @@ class RunFolder:
                 return prev
             if prev.get("scene_id") != self.scene_id:
                 raise OutputError(self._changed(what, prev))
-            if prev.get("status") == "converged" and not prev.get("trial"):
+            if _finished(prev):
                 raise OutputError(f"{what}: it has finished, there is nothing to resume")
             return prev
+        if _finished(prev):
+            # (--resume would only be refused: the refusal advises what can be done)
+            raise OutputError(f"{what}; it has finished: use --overwrite to replace it or "
+                              "give another --out")
         raise OutputError(f"{what}; use --resume to continue it or --overwrite to replace it "
                           "(or give another --out)")
 

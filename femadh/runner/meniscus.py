@@ -204,7 +204,7 @@ def report_lines(res):
     error (:func:`_error_estimate`) or a plain "no error estimate" with the reason; the
     circular approximation also with its difference from the exact meniscus (fe, else
     shooting) at the same p/psat when the scene computes one."""
-    from ..io.plots import force_unit
+    from ..io.plots import force_unit, value_error_text
 
     scene = res.scene
     where = ("in contact (D = -2h with the films)" if scene.separation is None else
@@ -224,9 +224,10 @@ def report_lines(res):
         s, unit = force_unit([f[k]])
         err = float(np.asarray(c["force_error_N"], float)[k])
         estimated = meth in ("fe", "no-film") and np.isfinite(err)
-        F = f"F = {f[k] * s:.5g}" + (f" ± {err * s:.1g}" if estimated else "") + f" {unit}"
-        x = f"F/4πRγ = {c['force_over_4piRgamma'][k]:.5g}" + (
-            f" ± {err / unit4:.1g}" if estimated else "")
+        # each value to the decimal place of its error (value_error_text)
+        F = f"F = {value_error_text(f[k] * s, err * s if estimated else None)} {unit}"
+        x = "F/4πRγ = " + value_error_text(c['force_over_4piRgamma'][k],
+                                            err / unit4 if estimated else None)
         if estimated:
             basis = ERROR_BASIS[meth]
         elif meth in ("fe", "no-film"):

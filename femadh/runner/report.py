@@ -8,6 +8,13 @@ def _force(x, err=None):
     return force_text(x, err)
 
 
+def _pm(v, err, digits):
+    """``v ± err``, the value to the error's decimal place (io.plots.value_error_text)."""
+    from ..io.plots import value_error_text
+
+    return value_error_text(v, err, digits)
+
+
 def _nm(x):
     return f"{x * 1e9:.4g} nm"
 
@@ -82,7 +89,7 @@ def _instrument_lines(res):
 
     def nm(name):
         v, e = hl[name] * 1e9, hl.get(f"{name}_error")
-        return f"{v:.4f} ± {e * 1e9:.1g} nm" if e is not None else f"{v:.4f} nm"
+        return f"{_pm(v, e * 1e9, 8)} nm" if e is not None else f"{v:.4f} nm"
     line = f"instrument k = {k:.4g} N/m:"
     if "instrument_pull_off_N" in hl:
         line += (f" pull-off {_force(hl['instrument_pull_off_N'], hl.get('instrument_pull_off_N_error'))}")
@@ -106,8 +113,7 @@ def _instrument_lines(res):
                       "continuously)"))
     if "instrument_hysteresis_J" in hl:
         e = hl.get("instrument_hysteresis_J_error")
-        out.append(f"instrument hysteresis {hl['instrument_hysteresis_J']:.4g}"
-                   + (f" ± {e:.1g}" if e is not None else "") + " J")
+        out.append(f"instrument hysteresis {_pm(hl['instrument_hysteresis_J'], e, 4)} J")
     return out
 
 

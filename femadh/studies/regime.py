@@ -623,7 +623,10 @@ def regime_table(pts):
     def pm(v, e):
         if v is None or not math.isfinite(v):
             return "-"
-        return f"{v:.4f}" + (f" ± {e:.1g}" if e is not None and math.isfinite(e) else "")
+        if e is None or not math.isfinite(e):
+            return f"{v:.4f}"
+        from ..io.plots import value_error_text     # (the value to its error's place)
+        return value_error_text(v, e)
 
     def num(v, fmt=".3f"):
         return "-" if v is None or not math.isfinite(v) else format(v, fmt)
