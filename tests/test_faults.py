@@ -103,10 +103,13 @@ def test_signals_and_kill_9_stop_cleanly_and_three_resumes_complete(tmp_path):
         # can leave more rows than this stop's mark - at ~280 states/s a loaded machine's
         # delay between the poll and the signal lets a run go on from 60 past 100 - the
         # likely cause of one failure in a clean-clone run of the suite (exit -15, no
-        # output, the evidence gone with pytest's tmp folders)
+        # output, the evidence gone with pytest's tmp folders). A few rows of its own show it
+        # is in its sweep (its handlers are installed before it solves); waiting for 20 spent
+        # the margin an overshoot had left (a failure under load in session 14, 1 in ~12
+        # suite runs, assertion not kept: the suspect)
         before = (out / "curve.csv").read_text().count("\n") if k else 0
         p = start(scene, out, *(("--resume",) if k else ()))
-        wait_rows(out, max(rows, before + 20), p)
+        wait_rows(out, max(rows, before + 5), p)
         if how == "kill -9":
             p.kill()
         else:
