@@ -146,15 +146,16 @@ def to_si(value, dimension, *, file=None, key=None, bare_numbers=True):
     if q.dimensionless:
         raise SceneError(file, key, value, f"{words}; a bare number in a string has no unit")
     if not q.check(dim):
-        unit = f"{q.units:~}"
-        hint = _TEMPERATURE_HINTS.get(unit, "") if dimension == "temperature" else ""
+        short = f"{q.units:~}"
+        hint = _TEMPERATURE_HINTS.get(short, "") if dimension == "temperature" else ""
         if hint or not (mag is not None and unit):
-            raise SceneError(file, key, value, f"{words}, but it has units of {unit}{hint}")
-        # a unit pint knows as another kind ('2 MM' is 2 megamolar): "has units of MM" read
-        # as if MM were a length unit; say it is not one, what pint took it for, the fix
+            raise SceneError(file, key, value, f"{words}, but it has units of {short}{hint}")
+        # a unit of another kind ('2 kg' for a length, or '2 MM', which pint reads as 2
+        # megamolar): "has units of MM" read as if MM were a length unit; quote the user's
+        # text, say what pint took it for, and the same letters in another case if they fit
         kind = words.split(" such as")[0].split(" ", 1)[-1]
-        raise SceneError(file, key, value, f"{words}; '{unit}' is not a recognised {kind} "
-                         f"unit (pint reads it as {q.units}){_case_twin(unit, dimension)}")
+        raise SceneError(file, key, value, f"{words}; '{unit}' is not a {kind} unit (pint "
+                         f"reads it as {q.units}){_case_twin(unit, dimension)}")
     return float(q.to(si.replace("^", "**")).magnitude)
 
 

@@ -2523,10 +2523,6 @@ DEFECTS = [
     D("budget_failure_refined", "adaptive: a band's node-budget failure refines h (futile: "
       "a finer member needs more)", "femadh/runner/adaptive.py",
       (('        if res.failure_kind == "budget":\n', '        if False:\n'),)),
-    D("decay_zero_finest", "Richardson: an exactly zero finest difference left unbounded",
-      "femadh/estimate/richardson.py",
-      (("        if decay_order is not None and _finite(cc) and v == c and cc != c:",
-        "        if False:"),)),
     # -- newcomer trial (ux14): where a bad value came from, what a resume refusal names, the
     # estimate as one phase of the progress line
     D("ux14_replace_error_on_file", "Scene.replace: a value given to the call reported "
@@ -2558,7 +2554,7 @@ DEFECTS = [
     #    a unit in the wrong case named
     D("ux14b_value_five_digits", "a value printed to five digits whatever its error (-1.602 "
       "± 5e-07 mN)", "femadh/io/plots.py",
-      (('        txt = f"{round(v, -place):.{max(-place, 0)}f}"', '        txt = f"{v:.5g}"'),)),
+      (('        txt = f"{r:.{max(-place, 0)}f}"', '        txt = f"{v:.5g}"'),)),
     D("ux14b_place_of_unrounded_error", "the value's place taken from the unrounded error "
       "(0.0096: 0.988 ± 0.01)", "femadh/io/plots.py",
       (('    e = float(f"{abs(err):.1g}")', '    e = abs(err)'),)),
@@ -2596,12 +2592,17 @@ DEFECTS = [
         "                    break"),)),
     D("ux14b_refused_claim_removes_existing", "a refused --resume removes an empty folder it "
       "did not create", "femadh/io/run_folder.py",
-      (("        created = [q for q in (self.path, *self.path.parents) if not q.exists()]",
-        "        created = [self.path]"),)),
+      (("                    created.insert(0, q)\n                except FileExistsError:\n"
+        "                    if not q.is_dir():\n                        raise\n",
+        "                    created.insert(0, q)\n                except FileExistsError:\n"
+        "                    created.insert(0, q)\n"),)),
     D("ux14b_finished_advised_resume", "a finished run's folder refused with 'use --resume'",
       "femadh/io/run_folder.py",
       (("        if _finished(prev):\n            # (--resume would only be refused",
         "        if False:\n            # (--resume would only be refused"),)),
+    D("value_text_unrounded_form", "value ± error: the e-form's digits from the unrounded "
+      "value (9.99996e6 ± 100 printed a digit short)", "femadh/io/plots.py",
+      (("    r = round(v, -place)\n", "    r = v\n"),)),
     D("ux14b_unit_has_units_of", "'2 MM' for a length: 'but it has units of MM'",
       "femadh/units.py",
       (("        if hint or not (mag is not None and unit):", "        if True:"),)),

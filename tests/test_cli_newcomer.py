@@ -260,9 +260,9 @@ def test_a_finished_folder_is_not_advised_resume(tmp_path):
 
 def test_a_unit_in_the_wrong_case_is_not_recognised_and_named(tmp_path, capsys):
     """'2 MM' (pint: 2 megamolar) was "but it has units of MM", as if MM were a length unit.
-    The line says the unit is not a recognised length unit, what pint took it for, and the
+    The line says the unit is not a length unit, what pint took it for, and the
     unit meant; a unit pint does not know at all ('NM') likewise, one line each."""
-    for unit, why in (("MM", "'MM' is not a recognised length unit (pint reads it as "
+    for unit, why in (("MM", "'MM' is not a length unit (pint reads it as "
                                "megamolar); did you mean 'mm'?"),
                       ("NM", "'NM' is not a recognised unit; did you mean 'nm'?"),
                       ("mmm", "'mmm' is not a recognised unit")):

@@ -79,12 +79,15 @@ def test_a_finest_difference_falling_faster_than_second_order_is_bounded_by_the_
     d1, d2 = 1e-4, 5e-4
     k = r**-2 if r2 is None else (r**2 - 1) / (r**2 * (r2**2 - 1))
     assert est.DECAY_ORDER == 2.0
-    for d1 in (1e-4, 0.0):                  # an exactly zero finest difference too
-        fine, coarse, coarser = {"q": 1.0}, {"q": 1.0 + d1}, {"q": 1.0 + d1 + d2}
-        e = discretisation(fine, coarse, coarser, ratio=r, ratio2=r2,
-                           decay_order=est.DECAY_ORDER)["q"]
-        assert e == pytest.approx(-d2 * k / (r**est.MAX_ORDER - 1), rel=1e-12, abs=0)
-        assert abs(e) > 2 * d1 / (r**est.MAX_ORDER - 1)    # > 2x the finest pair's reading
+    fine, coarse, coarser = {"q": 1.0}, {"q": 1.0 + d1}, {"q": 1.0 + d1 + d2}
+    e = discretisation(fine, coarse, coarser, ratio=r, ratio2=r2,
+                       decay_order=est.DECAY_ORDER)["q"]
+    assert e == pytest.approx(-d2 * k / (r**est.MAX_ORDER - 1), rel=1e-12, abs=0)
+    assert abs(e) > 2 * d1 / (r**est.MAX_ORDER - 1)        # > 2x the finest pair's reading
+    # two members exactly equal (a fold on one value of the stepping lattice, whose own
+    # resolution part states the step): a grid part of 0, as before
+    assert discretisation({"q": 1.0}, {"q": 1.0}, {"q": 1.0 + d2}, ratio=r, ratio2=r2,
+                          decay_order=est.DECAY_ORDER)["q"] == 0.0
     # opt-in: without decay_order, Richardson at the capped order from the finest pair
     fine, coarse, coarser = {"q": 1.0}, {"q": 1.0 + 1e-4}, {"q": 1.0 + 1e-4 + d2}
     assert discretisation(fine, coarse, coarser, ratio=r, ratio2=r2)["q"] == pytest.approx(

@@ -37,6 +37,12 @@ def test_value_printed_to_the_decimal_place_of_its_error():
     assert value_error_text(272.35, 46) == "270 ± 50"
     assert value_error_text(-0.01, 0.3) == "0 ± 0.3"
     assert value_error_text(1.2345e-15, 3e-18, 4) == "1.235e-15 ± 3e-18"
+    # the form and the digits of the value rounded to the error's place (review: 9.99996e6
+    # +- 100 printed 1.0000e+07, a digit short; 6e-4 +- 0.005 printed 6e-04, a place finer
+    # than its error); an e-form value keeps its error in e-form
+    assert value_error_text(9.99996e6, 100) == "1.00000e+07 ± 100"
+    assert value_error_text(6e-4, 0.005) == "0.001 ± 0.005"
+    assert value_error_text(1.5e9, 3e7) == "1.50e+09 ± 3e+07"
     # no error: the value to its digits, readable; an error of 0 says so
     assert value_error_text(1.23456789) == "1.2346" == value_error_text(1.23456789, math.nan)
     assert value_error_text(5.0, 0.0) == "5 ± 0"

@@ -35,7 +35,7 @@ def test_every_error_of_a_scene_at_once(tmp_path):
     lines = str(e.value).splitlines()
     assert len(lines) == 3 and all(line.startswith(str(p)) for line in lines)
     assert "did you mean 'nodes'?" in lines[2]
-    assert "(-1, 0.5)" in lines[0] and "'kg' is not a recognised length unit" in lines[1]
+    assert "(-1, 0.5)" in lines[0] and "'kg' is not a length unit" in lines[1]
 
 
 def test_misspelt_table_and_effect_get_suggestions(tmp_path):

@@ -138,13 +138,6 @@ def discretisation(fine, coarse, coarser=None, ratio=2.0, *, order=ORDER, max_or
             continue
         p = order
         cc = (coarser or {}).get(k)
-        if decay_order is not None and _finite(cc) and v == c and cc != c:
-            # the finest difference exactly zero (members on one lattice value): the coarser
-            # one bounds it at the capped order
-            p = max_order
-            out[k] = math.copysign(abs(c - cc) * _implied(decay_order, ratio, ratio2),
-                                   c - cc) / (ratio**p - 1)
-            continue
         if _finite(cc) and v != c and cc != c:
             uneven = ratio2 is not None and ratio2 != ratio
             seen = (observed_order_uneven(v, c, cc, ratio, ratio2) if uneven

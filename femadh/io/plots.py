@@ -61,15 +61,21 @@ def value_error_text(v, err=None, digits=5):
     place = math.floor(math.log10(e))     # the decimal exponent of the error's one digit
     mag = math.floor(math.log10(abs(v))) if v else place
     place = max(place, mag - 14)
+    # the form and the digits from the value rounded to that place (9.99996e6 +- 100 is
+    # 1.00000e+07, 6e-4 +- 0.005 is 0.001), the rounding itself by the format
+    r = round(v, -place)
+    rmag = math.floor(math.log10(abs(r))) if r else place
+    expo = r != 0 and not 1e-3 <= abs(r) < 1e6
     if abs(v) < 0.5 * 10.0 ** place:
         txt = "0"
-    elif 1e-3 <= abs(v) < 1e6:
-        txt = f"{round(v, -place):.{max(-place, 0)}f}"
+    elif not expo:
+        txt = f"{r:.{max(-place, 0)}f}"
     else:
-        txt = f"{v:.{max(mag - place, 0)}e}"
+        txt = f"{r:.{max(rmag - place, 0)}e}"
     if float(txt) == 0:
         txt = txt.lstrip("-")             # (no "-0.00")
-    return f"{txt} ± " + (f"{e:.0f}" if e >= 1 else f"{e:.1g}")
+    etxt = f"{e:.0e}" if expo and not 1e-3 <= e < 1e6 else f"{e:.0f}" if e >= 1 else f"{e:.1g}"
+    return f"{txt} ± {etxt}"
 
 
 def force_text(x, err=None):

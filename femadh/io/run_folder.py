@@ -83,7 +83,7 @@ class RunFolder:
     """
 
     def __init__(self, path, scene_id, scene_name, mode="new", given=None):
-        self.path = Path(path)
+        self.path = Path(os.path.normpath(path))      # ('a/../b' is b: a is not made)
         self.scene_id, self.scene_name, self.mode = scene_id, scene_name, mode
         # as summary.json holds them (JSON's lists and numbers), to compare with a previous
         # run's
@@ -93,10 +93,19 @@ class RunFolder:
             raise OutputError(f"output folder {self.path} is an existing file; give a folder "
                               "(--out DIR)")
         # the folders this call creates (deepest first): a refused claim removes them again
-        # when empty, so that a refusal leaves the file system as it found it
-        created = [q for q in (self.path, *self.path.parents) if not q.exists()]
+        # when empty, so that a refusal leaves the file system as it found it. Made one level
+        # at a time on the normalised path, each counted only if this call's mkdir made it
+        # ('a/../b' names b, not a; a folder another process makes meanwhile is not ours)
+        full = Path(os.path.abspath(self.path))
+        created = []
         try:
-            self.path.mkdir(parents=True, exist_ok=True)
+            for q in reversed([full, *full.parents]):
+                try:
+                    q.mkdir()
+                    created.insert(0, q)
+                except FileExistsError:
+                    if not q.is_dir():
+                        raise
         except OSError as exc:
             raise OutputError(f"cannot create the output folder {self.path}: "
                               f"{exc.strerror or exc}") from None

@@ -744,7 +744,10 @@ def decay_order(problem, spread):
     - a sigma-gap contact (``problem.sigma``): its nodes join and leave the contact one at a
       time, so a number read off a fixed grid carries a sawtooth in the spacing, and a finest
       difference far below the coarser one is its phase, not a fast order (Fig 3 and the
-      slider, validation/results/effectivity_spread.md). Without it the numbers are smooth
+      slider, validation/results/effectivity_spread.md). The paper's Hertz closure (its
+      contact radius continuous, no node-release sawtooth) is a sigma-gap model too and keeps
+      the bound on measurement: Fig 3 at N = 200, F_ex at the deepest state 3x its error with
+      it, 0.1x without (session 14's review). Without a sigma-gap the numbers are smooth
       and may converge faster than second order: the AFM tip of validation/paper2_afm.py
       (R = 20 nm, p/psat 0.8, LJ without sigma) falls by 15.6 and 11.9 per halving from
       N = 120 to 480 (order ~3.7), and the bound made its pull-off's estimate 210x its error

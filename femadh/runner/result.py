@@ -53,8 +53,9 @@ class RunResult:
     failure_kind : str or None
         What ended a run that did not converge, by the exception's type
         (:func:`femadh.estimate.guards.failure_kind`: "analysis_radius", "trapping",
-        "bound", "convergence", "time_limit", "interrupted", "error", ...; "accuracy": an
-        accuracy request not met); None for a converged run. The refine loops switch on it.
+        "bound", "budget", "convergence", "time_limit", "interrupted", "error", ...;
+        "accuracy": an accuracy request not met); None for a converged run. The refine loops
+        switch on it.
     """
 
     name: str
