@@ -402,8 +402,17 @@ class FigureWorker:
         self.pid = None
 
 
+#: whether the worker has its job (its figure processes to stop on SIGTERM)
+_BUSY = [False]
+
+
 def _terminate(signum, frame):
-    raise SystemExit(0)
+    if _BUSY[0]:
+        raise SystemExit(0)         # (the finally of _serve stops the figure processes)
+    # still importing matplotlib or waiting: nothing to clean up, and an exception raised
+    # inside an import leaves half-built objects whose __del__ writes "Exception ignored"
+    # tracebacks on the run's stderr (a stop caught in the suite: pyparsing's Forward)
+    os._exit(0)
 
 
 def _serve(job_r, ans_w):
@@ -421,6 +430,7 @@ def _serve(job_r, ans_w):
         res, folder, only = _recv(job_r)
     except EOFError:
         return
+    _BUSY[0] = True
     names = _names(res, only)
     if not names:
         _send(ans_w, ("end",))
