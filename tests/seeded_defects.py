@@ -2600,6 +2600,10 @@ DEFECTS = [
       "femadh/io/run_folder.py",
       (("        if _finished(prev):\n            # (--resume would only be refused",
         "        if False:\n            # (--resume would only be refused"),)),
+    D("study_stop_no_way_on", "study stopped by a signal: the line says neither to run the "
+      "same again nor that none is left", "femadh/cli.py",
+      (('               + (f"run the same command again to compute the other {left}" if left else',
+        '               + ("" if left else'),)),
     D("worker_term_raises_in_import", "figure worker: a SIGTERM while it imports raises "
       "SystemExit there (exit 1; half-built objects' __del__ tracebacks on the run's stderr)",
       "femadh/runner/figures.py",

@@ -338,7 +338,10 @@ def test_signalled_study_stops_its_workers_and_a_rerun_ends_equal(study_scene, t
     _, err = p.communicate(timeout=60)
     stop_s = time.time() - t_sig
     assert p.returncode == 128 + sig, err
-    assert f"interrupted by {signal.Signals(sig).name}" in err and "run the same" in err
+    assert f"interrupted by {signal.Signals(sig).name}" in err
+    # the way on: run the same again, or - every point finished before the signal landed
+    # (below) - nothing left (failed once in session 14 asking for "run the same" there)
+    assert ("run the same" in err) != ("none is left to compute" in err), err
     assert stop_s < 15, stop_s            # measured 0.2 s (pool) and 1.0 s (Dask)
     t0 = time.time()
     while _alive(kids) and time.time() - t0 < 10:
