@@ -1860,8 +1860,8 @@ DEFECTS = [
         '    if "max_adhesion_N" in hl and getattr(sink, "peak", None) is None \\'),)),
     D("uniform_half_member_rule", "uniform members chosen by the N/2 member's softening",
       "femadh/runner/estimates.py",
-      (("    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5)",
-        "    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 2 - 0.5)"),)),
+      (("member_safe(problem, (n - 0.5) / (n // 4 - 0.5))",
+        "member_safe(problem, (n - 0.5) / (n // 2 - 0.5))"),)),
     D("uniform_sqrt2_nominal_ratio", "uniform sqrt2 members: Richardson at sqrt 2, not their "
       "spacings' ratio", "femadh/runner/estimates.py",
       (("        return (n - 0.5) / (n1 - 0.5), out, (n1 - 0.5) / (n2 - 0.5)",
@@ -2343,8 +2343,8 @@ DEFECTS = [
         "            data.pop(STOPPED_IN_FIGURES, None)\n"),)),
     D("figres_unchecked_rows", "figures resume: curve.csv rows taken without their checksum "
       "(a changed digit drawn and reported)", "femadh/runner/figures.py",
-      (("                    row_crc(r[:n_crc], run_id) != r[n_crc]:",
-        "                    False:"),)),
+      (("            if row_problem(line, k, head, n_crc, plan, run_id):\n",
+        "            if False:\n"),)),
     D("figres_iters_float", "figures resume: the iteration counts read back as floats",
       "femadh/runner/figures.py",
       (('np.array([int(v) for v in x], dtype=int) if c == "n_iter"',
@@ -2506,11 +2506,11 @@ DEFECTS = [
         "    return DECAY_ORDER"),)),
     D("decay_no_trap_gate", "estimate: the coarser difference bounds the finest however near "
       "a node's stiffness the coarsest member softens", "femadh/runner/estimates.py",
-      (("    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None\n",
+      (("    return DECAY_ORDER if member_safe(problem, spread) else None\n",
         "    return DECAY_ORDER\n"),)),
     D("decay_off", "estimate: the finest difference always read alone (the chance-small "
       "difference under-reads)", "femadh/runner/estimates.py",
-      (("    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None\n",
+      (("    return DECAY_ORDER if member_safe(problem, spread) else None\n",
         "    return None\n"),)),
     D("decay_locked_dropped", "estimate: the deepest state's placed members without the bound",
       "femadh/runner/estimates.py",

@@ -54,7 +54,7 @@ def _floats_ok(cells):
     return True
 
 
-def _plan_rows(scene):
+def plan_rows(scene):
     """(branch, d) of every committed state of a stepping sweep, in the order it runs."""
     d = list(scene.d_values)
     out = []
@@ -93,10 +93,10 @@ def check_curve(folder, scene, problem, run_id, resume_from=None):
     else:
         raise DamagedFolder(f"{path} row 0 (the header) does not match its record (expected "
                             f"{','.join(with_crc)}); use --overwrite")
-    plan = _plan_rows(scene)
+    plan = plan_rows(scene)
     rows, why = [], None
     for i, line in enumerate(lines[1:]):
-        why = _row_problem(line, i, header, n_crc, plan, run_id)
+        why = row_problem(line, i, header, n_crc, plan, run_id)
         if why:
             break
         rows.append(next(csv.reader([line])))
@@ -117,7 +117,7 @@ def check_curve(folder, scene, problem, run_id, resume_from=None):
     return len(rows), rows, []
 
 
-def _row_problem(line, i, header, n_crc, plan, run_id):
+def row_problem(line, i, header, n_crc, plan, run_id):
     """Why curve.csv data row i (0-based) does not match its record, or None."""
     try:
         cells = next(csv.reader([line]))

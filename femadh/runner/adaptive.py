@@ -406,9 +406,13 @@ def reference_trial(scene):
     """The :class:`Trial` the loop would start from at REFERENCE_ACCURACY whatever the
     scene's request (the edge route's trap measure,
     :func:`femadh.runner.edge_route.edge_trap_ratio`)."""
-    plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
-                     scene.sphere, scene.analysis_radius, scene.d_values, REFERENCE_ACCURACY)
-    return first_trial(scene, plan, REFERENCE_ACCURACY)
+    return first_trial(scene, _plan(scene, REFERENCE_ACCURACY), REFERENCE_ACCURACY)
+
+
+def _plan(scene, target):
+    """The scene's grid plan for ``target`` (:func:`~femadh.discretisation.plan_grid`)."""
+    return plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
+                     scene.sphere, scene.analysis_radius, scene.d_values, target)
 
 
 def planned_first_nodes(scene):
@@ -419,8 +423,7 @@ def planned_first_nodes(scene):
     plan's scaled spacing (the trapping cap, measured on a built member, can only make
     either finer)."""
     target = scene.target_accuracy
-    plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
-                     scene.sphere, scene.analysis_radius, scene.d_values, target)
+    plan = _plan(scene, target)
     h = _plan_start(plan, target)
     coarsest = plan.family.count(h)
     hz = _zone_start(scene, target, h)
@@ -450,9 +453,7 @@ def run_adaptive(scene, out_dir, *, run, figures=True, progress=None, overwrite=
 
     t0 = time.perf_counter()
     target = scene.target_accuracy
-    plan = plan_grid(scene.effects, None if scene.gap is None else scene.gap.sigma,
-                     scene.sphere, scene.analysis_radius,
-                     scene.d_values, target)
+    plan = _plan(scene, target)
     family = plan.family
     mode = {"overwrite": overwrite, "resume": resume}
     steps = []

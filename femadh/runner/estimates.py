@@ -761,11 +761,20 @@ def decay_order(problem, spread):
     Measured on uniform grids (validation/results/effectivity_spread_uniform.md): the slider
     at N = 100 (sigma-gap, N/4 at 0.27) read F_LJ at the deepest state at 0.06x its error
     without the bound."""
-    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
-
     if problem.sigma is None:
         return None
-    return DECAY_ORDER if trapping_ratio(problem) * spread <= TRAP_SAFE else None
+    return DECAY_ORDER if member_safe(problem, spread) else None
+
+
+def member_safe(problem, spread):
+    """Whether a member of the run's family at ``spread`` x its spacing softens no more
+    than TRAP_SAFE of a node's stiffness: a member's trapping ratio
+    (:func:`femadh.discretisation.plan.trapping_ratio`) grows like its spacing. The one
+    test of an estimate's coarsest member (:func:`uniform_member_nodes`,
+    :func:`decay_order`)."""
+    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
+
+    return trapping_ratio(problem) * spread <= TRAP_SAFE
 
 
 def uniform_member_nodes(problem, n):
@@ -779,10 +788,8 @@ def uniform_member_nodes(problem, n):
     lattice steps (validation/results/effectivity.md, sec 3-4). The plan keeps a banded
     family's coarsest member below TRAP_SAFE (:func:`~femadh.discretisation.plan.safe_spacing`);
     an explicit N gets the finer pair where its N/4 would not be."""
-    from ..discretisation.plan import TRAP_SAFE, trapping_ratio
-
-    quarter = trapping_ratio(problem) * (n - 0.5) / (n // 4 - 0.5) if n // 4 >= 1 else math.inf
-    if UNIFORM_SQRT2_MEMBERS and quarter > TRAP_SAFE:
+    quarter_safe = n // 4 >= 1 and member_safe(problem, (n - 0.5) / (n // 4 - 0.5))
+    if UNIFORM_SQRT2_MEMBERS and not quarter_safe:
         return int(round(n / 2**0.5)), n // 2
     return n // 2, n // 4
 

@@ -174,22 +174,26 @@ def _read_result(scene, path, prev):
 
     import numpy as np
 
-    from ..io.writers import CRC, row_crc
+    from ..io.resume_check import plan_rows, row_problem
+    from ..io.writers import CRC
     from .result import ContactResult, contact_summary
     from .sink import _picks
     from .tracing import branch_plan
 
     try:
-        with open(path / "curve.csv", newline="") as f:
-            head, *rows = list(csv.reader(f))
-        n_crc, run_id = head.index(CRC), prev["run_id"]
+        lines = (path / "curve.csv").read_text().splitlines()
+        head = next(csv.reader([lines[0]]))
+        n_crc, run_id, plan = head.index(CRC), prev["run_id"], plan_rows(scene)
         cols = [c for c in head if c not in ("state", "branch", CRC)]
         where = [head.index(c) for c in cols]
-        per_branch, table = {}, {}
-        for k, r in enumerate(rows):
-            if len(r) != len(head) or int(r[0]) != k or \
-                    row_crc(r[:n_crc], run_id) != r[n_crc]:
+        per_branch, table, rows = {}, {}, []
+        for k, line in enumerate(lines[1:]):
+            # each row as a resume checks it: its checksum, state number and place in the
+            # sweep (femadh.io.resume_check, the one home of that check)
+            if row_problem(line, k, head, n_crc, plan, run_id):
                 return None
+            r = next(csv.reader([line]))
+            rows.append(r)
             per_branch.setdefault(r[1], []).append(k)
             table.setdefault(r[1], []).append([r[j] for j in where])
         res = ContactResult(scene.name, scene, out_dir=str(path))
