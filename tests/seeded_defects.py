@@ -1990,8 +1990,8 @@ DEFECTS = [
       (('    e = float(f"{abs(err):.1g}")', '    e = float(f"{abs(err):.2g}")'),)),
     D("ui_inset_no_error", "the inset states the max adhesion without its error",
       "femadh/io/plots.py",
-      (("        ins.set_title(f\"max adhesion {force_text(F, hl.get('max_adhesion_N_error'))} at \"",
-        "        ins.set_title(f\"max adhesion {F * fs:.5g} {fl} at \""),)),
+      (("    return f\"max adhesion {force_text(hl['max_adhesion_N'], e_f)} at d = {d} nm\"",
+        "    return f\"max adhesion {force_text(hl['max_adhesion_N'], None)} at d = {d} nm\""),)),
     D("ui_slider_words", "panel (d) calls the force the force on the slider",
       "femadh/io/plots.py",
       (('ax[3].set(xlabel="d (nm)", ylabel=f"force on the sphere ({fl}), adhesion < 0",',
@@ -2604,6 +2604,11 @@ DEFECTS = [
       "same again nor that none is left", "femadh/cli.py",
       (('               + (f"run the same command again to compute the other {left}" if left else',
         '               + ("" if left else'),)),
+    D("max_adhesion_d_four_digits", "the largest adhesion's separation printed to four "
+      "digits whatever its error (1.134 nm, known to 0.01)", "femadh/io/plots.py",
+      (("    d = value_error_text(hl[\"d_at_max_adhesion_m\"] * 1e9, None if e_d is None else "
+        "e_d * 1e9,\n", "    d = value_error_text(hl[\"d_at_max_adhesion_m\"] * 1e9, None if True "
+        "else e_d * 1e9,\n"),)),
     D("worker_term_raises_in_import", "figure worker: a SIGTERM while it imports raises "
       "SystemExit there (exit 1; half-built objects' __del__ tracebacks on the run's stderr)",
       "femadh/runner/figures.py",

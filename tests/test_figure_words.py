@@ -2,6 +2,7 @@
 with the very digits, unit and error of the terminal's line, and every figure calls the force
 it shows the force on the sphere (no "slider" in one figure and "sphere" in another)."""
 import math
+import re
 
 import matplotlib
 import numpy as np
@@ -111,8 +112,20 @@ def test_the_inset_states_the_terminal_s_max_adhesion(fig3_small):
     line = next(ln for ln in headline_lines(res) if ln.startswith("max adhesion "))
     inset = [t for t in texts["force_curve.png"] if t.startswith("max adhesion ")]
     # the terminal's line goes on with the DMT and JKR values: the inset is its beginning
-    assert len(inset) == 1 and "±" in inset[0] and line.startswith(inset[0] + " ("), (
-        inset, line)
+    assert len(inset) == 1 and line.startswith(inset[0] + " ("), (inset, line)
+    # the force and its separation each with its own error, to one digit, the value to that
+    # digit's place (the separation was printed to four digits whatever its error)
+    m = re.match(r"max adhesion ([\d.]+) ± ([\d.e-]+) µN at d = ([\d.]+) ± ([\d.e-]+) nm$",
+                 inset[0])
+    assert m, inset[0]
+    for (v, e), name, s in ((m.group(1, 2), "max_adhesion_N", 1e6),
+                            (m.group(3, 4), "d_at_max_adhesion_m", 1e9)):
+        err = res.headline[f"{name}_error"] * s
+        assert float(e) == float(f"{err:.1g}"), (name, e, err)
+        place = math.floor(math.log10(float(e)))
+        decimals = len(v.split(".")[1]) if "." in v else 0
+        assert decimals == max(-place, 0), (name, v, e)
+        assert abs(float(v) - res.headline[name] * s) <= 0.5 * 10.0**place, (name, v)
 
 
 def test_every_figure_calls_the_force_the_force_on_the_sphere(fig3_small):

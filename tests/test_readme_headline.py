@@ -18,7 +18,8 @@ def printed():
     block = text[text.index("prints its headline numbers"):]
     block = block[:block.index("results in out/paper1-fig3")]
     pats = {
-        "adhesion": rf"max adhesion {NUM} ± {NUM} µN at d = {NUM} nm \(DMT 2πRW = {NUM} µN, "
+        "adhesion": rf"max adhesion {NUM} ± {NUM} µN at d = {NUM} ± {NUM} nm \(DMT 2πRW = "
+                    rf"{NUM} µN, "
                     rf"JKR 1.5πRW = {NUM} µN\)",
         "deepest": rf"F_ex\(d = -5 nm\) = {NUM} ± {NUM} mN, F_LJ = {NUM} ± {NUM} µN",
         "grid": rf"accuracy {NUM} met: (\d+) nodes, band spacing {NUM} nm to {NUM} µm, "
@@ -54,9 +55,9 @@ def fig3():
 
 def test_readme_headline_of_the_fig3_scene(fig3):
     p, hl, acc = printed(), fig3.headline, fig3.accuracy
-    F, Fe, d, dmt, jkr = p["adhesion"]
+    F, Fe, d, de, dmt, jkr = p["adhesion"]
     assert close(hl["max_adhesion_N"] * 1e6, F, Fe)
-    assert close(hl["d_at_max_adhesion_m"] * 1e9, d)
+    assert close(hl["d_at_max_adhesion_m"] * 1e9, d, de)
     assert close(hl["dmt_pull_off_N"] * 1e6, dmt) and close(hl["jkr_pull_off_N"] * 1e6, jkr)
     fex, fex_e, flj, flj_e = p["deepest"]
     assert close(hl["F_ex_deepest_N"] * 1e3, fex, fex_e)
@@ -68,6 +69,7 @@ def test_readme_headline_of_the_fig3_scene(fig3):
                                                             radius)
     # the printed errors are the estimate's, to its one printed digit
     assert close(hl["max_adhesion_N_error"] * 1e6, Fe)
+    assert close(hl["d_at_max_adhesion_m_error"] * 1e9, de)
     assert close(hl["F_ex_deepest_N_error"] * 1e3, fex_e)
     assert close(hl["F_LJ_deepest_N_error"] * 1e6, flj_e)
 

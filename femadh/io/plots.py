@@ -88,6 +88,17 @@ def force_text(x, err=None):
     return f"{value_error_text(x * s, None if err is None else err * s)} {unit}"
 
 
+def max_adhesion_text(hl):
+    """"max adhesion 31.15 ± 0.03 µN at d = 1.13 ± 0.01 nm" from a headline: the force and
+    the separation it is reached at, each to the place its own error supports (the
+    separation of a flat maximum is known to ~1e-2 at the defaults, not to four digits).
+    The terminal's line and the force curve's inset both."""
+    e_f, e_d = hl.get("max_adhesion_N_error"), hl.get("d_at_max_adhesion_m_error")
+    d = value_error_text(hl["d_at_max_adhesion_m"] * 1e9, None if e_d is None else e_d * 1e9,
+                         4)
+    return f"max adhesion {force_text(hl['max_adhesion_N'], e_f)} at d = {d} nm"
+
+
 def length_unit(values):
     """(scale, label) for lengths: nm below 1 um, else um (mm above 1 mm)."""
     m = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
@@ -447,8 +458,7 @@ def _adhesion_zoom(ax, res, ls, ll):
         F, dm = hl["max_adhesion_N"], hl["d_at_max_adhesion_m"]
         ins.plot([dm * ls], [-F * fs], "v", color="C3")
         # the very words and digits of the terminal's line (femadh.runner.report)
-        ins.set_title(f"max adhesion {force_text(F, hl.get('max_adhesion_N_error'))} at "
-                      f"d = {dm * 1e9:.4g} nm", fontsize=7)
+        ins.set_title(max_adhesion_text(hl), fontsize=7)
     ins.set_xlabel(f"d ({ll})", fontsize=6, labelpad=1)
     ins.set_ylabel(f"force ({fl})", fontsize=6, labelpad=1)
     ins.tick_params(labelsize=6)

@@ -35,8 +35,9 @@ def headline_lines(res):
         out.append(f"{b}: {len(c['d_m'])} states from d = {_nm(c['d_m'][0])} to "
                    f"{_nm(c['d_m'][-1])}" + (f", {n_j} jump{'s' * (n_j > 1)}" if n_j else ""))
     if "max_adhesion_N" in hl:
-        out.append(f"max adhesion {_force(hl['max_adhesion_N'], hl.get('max_adhesion_N_error'))}"
-                   f" at d = {hl['d_at_max_adhesion_m'] * 1e9:.4g} nm"
+        from ..io.plots import max_adhesion_text    # (the force curve's inset says it too)
+
+        out.append(max_adhesion_text(hl)
                    + (f" (DMT 2πRW = {_force(hl['dmt_pull_off_N'])}, JKR 1.5πRW = "
                       f"{_force(hl['jkr_pull_off_N'])})" if "dmt_pull_off_N" in hl else ""))
     if "F_ex_deepest_N" in hl:
